@@ -1,0 +1,352 @@
+"""The frictionless contact terms of the augmented-Lagrangian weak form.
+
+For one contact pair (slave facet tag, master facet tag) this module builds, in UFL, the
+contact integrals of ``formulation.md``
+
+    - int_{S_oc} <lambda_N + eps_N g> nu . (U1* - U2*(Y)) dS_o
+    - int_{S_oc} (lambda_N - <lambda_N + eps_N g>) lambda_N* / eps_N dS_o
+
+(the seed's weak form times -1, so that the bulk term reads ``+ int Pi : Grad U*``).
+
+What UFL cannot see, the master surface at the projected points, is carried to every slave
+quadrature point as data on the slave submesh (quadrature elements):
+
+``xhat``
+    the current positions of the nodes of the master facet found by the closest-point
+    projection. It is a *field of the assembled system* (it has a test function, which is
+    the master virtual displacement at the nodes), tied to the unknowns by ``xhat = Xhat +
+    P u`` (``P`` gathers master dofs; see :mod:`contact_ufl.layout`).
+``xhat0, x0, xi0, M``
+    copies of the current master nodes and slave point, the reference coordinates of the
+    projection and its linearisation matrix (``contact_ufl.projection``), held as data.
+
+The projected point is written as ``xi = xi0 + M b(x - x0, xhat - xhat0)`` (the linearised
+closest-point condition of ``consistent-tangent.md``): its value is the one found by the
+search, and its Gateaux derivative is the implicit-function derivative. The master point
+``y(xi)``, the tangents ``a_alpha(xi)``, the normal ``nu`` and the proximity ``g = -nu . (x -
+y)`` are then UFL expressions of the unknowns, and ``ufl.derivative`` gives every term of
+the tangent (sliding of ``y``, rotation of ``nu``, ``Grad U2*`` times ``d xi``).
+
+Discrete multiplier: ``lambda_N`` is continuous piecewise linear on the slave submesh (P1).
+It interpolates a continuous contact pressure with the same resolution as the slave trace
+of a P1 displacement, so the active set and the gap condition are imposed in the weak
+(mortar) sense at the contact quadrature points, and the multiplier *is* the nodal pressure
+(property (c) of ``formulation.md``). The slave side should be the finer mesh, as usual
+with standard mortar multipliers.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import basix.ufl
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from contact_ufl.errors import check_positive, collective_check
+from contact_ufl.layout import StackedLayout
+from contact_ufl.projection import Projection, closest_points
+from contact_ufl.surfaces import MasterSurface, SlaveSurface
+
+
+@dataclass(frozen=True)
+class ContactPair:
+    """A contact pair of a scene.
+
+    Parameters
+    ----------
+    slave
+        Facet tag of the slave (contactor) surface; it carries the multipliers.
+    master
+        Facet tag of the master (target) surface.
+    eps_N
+        Normal augmentation parameter (> 0). It does not change the exact solution; a value
+        of the order of ``E / h`` gives good Newton convergence.
+    mu
+        Coulomb friction coefficient (>= 0). Friction terms exist only where ``mu > 0``.
+    eps_T
+        Tangential augmentation parameter (> 0), defaults to ``eps_N``.
+    search_radius
+        Distance beyond which a slave point is known not to be in contact in a Newton
+        iteration; only master facets within it are searched. Defaults to a quarter of the
+        diagonal of the bounding box of the two surfaces.
+    quadrature_degree
+        Degree of the quadrature rule of the contact integrals (defaults to ``2 p + 1`` for
+        displacement degree ``p``).
+    """
+
+    slave: int
+    master: int
+    eps_N: float
+    mu: float = 0.0
+    eps_T: float | None = None
+    search_radius: float | None = None
+    quadrature_degree: int | None = None
+
+    def validate(self, comm: MPI.Comm) -> None:
+        """Raise a clear error (on every rank) for invalid parameters."""
+        check_positive(comm, eps_N=self.eps_N)
+        collective_check(comm, self.mu >= 0.0, f"mu must be >= 0, got mu = {self.mu}")
+        if self.eps_T is not None:
+            check_positive(comm, eps_T=self.eps_T)
+        if self.search_radius is not None:
+            check_positive(comm, search_radius=self.search_radius)
+        collective_check(comm, self.slave != self.master,
+                         f"slave and master tags must differ (both {self.slave})")
+
+
+def macaulay(a: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    """Macaulay bracket ``<a> = max(a, 0)``."""
+    return ufl.conditional(ufl.gt(a, 0.0), a, 0.0)
+
+
+def master_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
+    """UFL shape functions of a master facet and their xi-derivatives.
+
+    Conventions as in :mod:`contact_ufl.projection`: segment (2 nodes), triangle (3 nodes),
+    bilinear quadrilateral (4 nodes, basix vertex order).
+    """
+    if nn == 2:
+        s = xi[0]
+        return [1 - s, s], [[-1.0], [1.0]]
+    if nn == 3:
+        s, t = xi[0], xi[1]
+        return [1 - s - t, s, t], [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]
+    if nn == 4:
+        s, t = xi[0], xi[1]
+        N = [(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t]
+        dN = [[-(1 - t), -(1 - s)], [1 - t, -s], [-t, 1 - s], [t, s]]
+        return N, dN
+    raise ValueError(f"no master facet with {nn} nodes")
+
+
+def _interpolate(coeffs, nodes, gdim: int) -> ufl.core.expr.Expr:
+    return ufl.as_vector([sum(c * nodes[a, i] for a, c in enumerate(coeffs)) for i in range(gdim)])
+
+
+def _unit_normal(tangents: list, mask: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    """Master normal from the tangents; zero (not NaN) where ``mask`` is 0."""
+    if len(tangents) == 1:
+        a1 = tangents[0]
+        perp = ufl.as_vector([a1[1], -a1[0]])
+    else:
+        perp = ufl.cross(tangents[0], tangents[1])
+    return perp / ufl.sqrt(ufl.dot(perp, perp) + (1.0 - mask))
+
+
+class FrictionlessContact:
+    """Frictionless contact terms of one contact pair.
+
+    Parameters
+    ----------
+    u
+        The displacement (one function over the mesh of all bodies).
+    facet_tags
+        Facet tags of the mesh.
+    pair
+        The contact pair.
+    """
+
+    def __init__(self, u: dolfinx.fem.Function, facet_tags: dolfinx.mesh.MeshTags,
+                 pair: ContactPair):
+        V = u.function_space
+        mesh = V.mesh
+        pair.validate(mesh.comm)
+        self.u, self.V, self.pair = u, V, pair
+        self.gdim = gdim = mesh.geometry.dim
+        self.fdim = fdim = mesh.topology.dim - 1
+        degree = V.ufl_element().embedded_superdegree
+        qdeg = pair.quadrature_degree or 2 * degree + 1
+        self.slave = SlaveSurface(V, facet_tags, pair.slave, qdeg)
+        self.master = MasterSurface(V, facet_tags, pair.master)
+        self.nn = nn = comm_max(mesh.comm, self.master.nodes.shape[1])
+        sub = self.slave.submesh
+
+        def space(shape):
+            element = basix.ufl.quadrature_element(sub.basix_cell(), value_shape=shape,
+                                                   degree=qdeg)
+            return dolfinx.fem.functionspace(sub, element)
+
+        self.Qx = space((nn * gdim,))
+        self.xhat = dolfinx.fem.Function(self.Qx, name="master_nodes")
+        self.xhat0 = dolfinx.fem.Function(self.Qx)
+        self.x0 = dolfinx.fem.Function(space((gdim,)))
+        self.xi0 = dolfinx.fem.Function(space((fdim,)))
+        self.M = dolfinx.fem.Function(space((fdim, fdim)))
+        self.mask = dolfinx.fem.Function(space(()))
+        self.L = dolfinx.fem.functionspace(sub, ("Lagrange", 1))
+        self.lambda_N = dolfinx.fem.Function(self.L, name="lambda_N")
+        p1 = self.L.ufl_element().basix_element
+        self._phi_lambda = p1.tabulate(0, self.slave.points_ref)[0, :, :, 0]
+        self.eps_N = dolfinx.fem.Constant(mesh, float(pair.eps_N))
+        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags,
+                              subdomain_id=pair.slave, metadata={"quadrature_degree": qdeg})
+        self._kinematics()
+        self.radius = pair.search_radius or self._default_radius()
+        self._check_facing()
+        self.search_time = 0.0
+        self.projection: Projection | None = None
+
+    # -- UFL ----------------------------------------------------------------------------
+    def _kinematics(self) -> None:
+        gdim, fdim, nn = self.gdim, self.fdim, self.nn
+        X = ufl.SpatialCoordinate(self.V.mesh)
+        self.x = x = X + self.u
+
+        def nodes(f):
+            return ufl.as_matrix([[f[a * gdim + i] for i in range(gdim)] for a in range(nn)])
+
+        xh, xh0 = nodes(self.xhat), nodes(self.xhat0)
+        N0, dN0 = master_shape_functions(nn, self.xi0)
+        y0 = _interpolate(N0, xh0, gdim)
+        dxh = xh - xh0
+        dx = x - self.x0
+        b = []
+        for al in range(fdim):
+            a0 = _interpolate([dN0[a][al] for a in range(nn)], xh0, gdim)
+            slide = dx - _interpolate(N0, dxh, gdim)
+            b.append(ufl.dot(a0, slide)
+                     + ufl.dot(self.x0 - y0, _interpolate([dN0[a][al] for a in range(nn)],
+                                                            dxh, gdim)))
+        self.xi = xi = self.xi0 + self.M * ufl.as_vector(b)
+        self.N, dN = master_shape_functions(nn, xi)
+        self.y = _interpolate(self.N, xh, gdim)
+        tangents = [_interpolate([dN[a][al] for a in range(nn)], xh, gdim) for al in range(fdim)]
+        self.nu = _unit_normal(tangents, self.mask)
+        self.gap = -ufl.dot(self.nu, x - self.y)
+        self.t_N = self.mask * macaulay(self.lambda_N + self.eps_N * self.gap)
+
+    def master_test_at_projection(self, vhat: ufl.Argument) -> ufl.core.expr.Expr:
+        """The master virtual displacement ``U2*(Y(X)) = sum_a N_a(xi) vhat_a``."""
+        gdim = self.gdim
+        nodes = ufl.as_matrix([[vhat[a * gdim + i] for i in range(gdim)] for a in range(self.nn)])
+        return _interpolate(self.N, nodes, gdim)
+
+    def residuals(self, v, vhat, lambda_test) -> tuple:
+        """Contact parts of the residuals of ``u``, ``xhat`` and ``lambda_N``."""
+        traction = self.t_N * self.nu
+        F_u = -ufl.dot(traction, v) * self.ds
+        F_x = ufl.dot(traction, self.master_test_at_projection(vhat)) * self.ds
+        F_l = -(self.lambda_N - self.t_N) / self.eps_N * lambda_test * self.ds
+        return F_u, F_x, F_l
+
+    # -- search -------------------------------------------------------------------------
+    def _default_radius(self) -> float:
+        comm = self.V.mesh.comm
+        pts = [self.slave.X.reshape(-1, self.gdim), self.master.X_nodes.reshape(-1, self.gdim)]
+        pts = np.vstack(pts)
+        lo = comm.allreduce(pts.min(axis=0) if len(pts) else np.full(self.gdim, np.inf), MPI.MIN)
+        hi = comm.allreduce(pts.max(axis=0) if len(pts) else np.full(self.gdim, -np.inf), MPI.MAX)
+        return 0.25 * float(np.linalg.norm(hi - lo))
+
+    def _check_facing(self) -> None:
+        """Raise if no slave point faces the master surface in the reference configuration."""
+        x = self.slave.X.reshape(-1, self.gdim)
+        nodes, _, _ = self._candidates(self.master.X_nodes, x)
+        proj = closest_points(x, nodes, np.inf)
+        # a slave point faces the master when it lies on the outer side of the master facet
+        # and the two outward normals oppose each other
+        normals = np.repeat(self.slave.normals, self.slave.num_points, axis=0)
+        outside = np.einsum("pd,pd->p", proj.normal, x - proj.y) >= -1e-8 * (1 + proj.distance)
+        opposed = np.einsum("pd,pd->p", proj.normal, normals) < 0.0
+        facing = np.count_nonzero((proj.facet >= 0) & outside & opposed)
+        total = self.V.mesh.comm.allreduce(facing, MPI.SUM)
+        collective_check(
+            self.V.mesh.comm, total > 0,
+            f"slave surface (tag {self.pair.slave}) never faces master surface "
+            f"(tag {self.pair.master}): no slave point lies on the outer side of the master "
+            "facets (wrong tags or swapped bodies?)")
+
+    def _candidates(self, master_nodes: np.ndarray, points: np.ndarray, payload=None):
+        """Master facets of all ranks near this rank's slave points (bounding-box filter)."""
+        comm = self.V.mesh.comm
+        box = self.slave.bounding_box(points, comm)
+        boxes = comm.allgather(box)
+        n = len(master_nodes)
+        payload = np.zeros((n, 0)) if payload is None else payload
+        if n:
+            lo, hi = master_nodes.min(axis=1), master_nodes.max(axis=1)
+        sends = []
+        for b in boxes:
+            if n == 0:
+                sends.append((master_nodes, payload))
+                continue
+            near = np.all((lo <= b[1] + self.radius) & (hi >= b[0] - self.radius),
+                          axis=1)
+            sends.append((master_nodes[near], payload[near]))
+        received = comm.alltoall(sends) if comm.size > 1 else sends
+        nodes = np.concatenate([r[0] for r in received]).reshape(-1, *master_nodes.shape[1:])
+        data = np.concatenate([r[1] for r in received]).reshape(len(nodes), *payload.shape[1:])
+        return nodes, data, len(nodes)
+
+    def update(self, layout: StackedLayout) -> np.ndarray:
+        """Project the slave points onto the master surface and refresh the data.
+
+        Parameters
+        ----------
+        layout
+            Layout of the unknowns; block 0 is the displacement.
+
+        Returns
+        -------
+        For every owned dof of ``xhat`` (unrolled, local order), the stacked index of the
+        displacement unknown it gathers, or -1.
+        """
+        start = time.perf_counter()
+        gdim, nn = self.gdim, self.nn
+        bs = self.V.dofmap.index_map_bs
+        points = self.slave.positions(self.u).reshape(-1, gdim)
+        current = self.master.current_nodes(self.u)
+        cols = layout.from_block_global(0, self.master.global_nodes.astype(np.int64) * bs)
+        nodes, cols, _ = self._candidates(current, points, cols)
+        proj = closest_points(points, nodes, self.radius)
+        self.projection = proj
+        paired = proj.facet >= 0
+        npts = len(points)
+        xhat = np.zeros((npts, nn * gdim))
+        xhat[paired] = nodes[proj.facet[paired]].reshape(-1, nn * gdim)
+        gather = np.full((npts, nn, gdim), -1, dtype=np.int64)
+        gather[paired] = cols[proj.facet[paired]][:, :, None] + np.arange(gdim)
+        self._set(self.xhat, xhat)
+        self._set(self.xhat0, xhat)
+        self._set(self.x0, points)
+        self._set(self.xi0, np.where(paired[:, None], proj.xi, 0.0))
+        self._set(self.M, np.where(paired[:, None, None], proj.sliding, 0.0))
+        self._set(self.mask, paired.astype(float))
+        self.search_time += time.perf_counter() - start
+        return self._unrolled(self.Qx, gather.reshape(npts, -1), fill=-1)
+
+    def multiplier_at_points(self) -> np.ndarray:
+        """lambda_N at the owned slave quadrature points, ``(ncells * nq,)``."""
+        dofs = self.L.dofmap.list[: self.slave.num_cells]
+        return np.einsum("qn,cn->cq", self._phi_lambda, self.lambda_N.x.array[dofs]).ravel()
+
+    def active(self) -> np.ndarray:
+        """Mask of the owned slave quadrature points in contact (``lambda_N + eps_N g > 0``)."""
+        proj = self.projection
+        lam = self.multiplier_at_points()
+        gap = np.where(proj.facet >= 0, proj.gap, -np.inf)
+        return (proj.facet >= 0) & (lam + float(self.eps_N.value) * gap > 0.0)
+
+    def _owned_blocks(self, Q: dolfinx.fem.FunctionSpace) -> np.ndarray:
+        return Q.dofmap.list[: self.slave.num_cells].ravel()
+
+    def _set(self, f: dolfinx.fem.Function, values: np.ndarray) -> None:
+        bs = f.function_space.dofmap.index_map_bs
+        f.x.array.reshape(-1, bs)[self._owned_blocks(f.function_space)] = values.reshape(
+            -1, bs)
+        f.x.scatter_forward()
+
+    def _unrolled(self, Q, values: np.ndarray, fill) -> np.ndarray:
+        bs = Q.dofmap.index_map_bs
+        out = np.full((Q.dofmap.index_map.size_local, bs), fill, dtype=values.dtype)
+        out[self._owned_blocks(Q)] = values
+        return out.ravel()
+
+
+def comm_max(comm: MPI.Comm, value: int) -> int:
+    """Largest value over the ranks."""
+    return int(comm.allreduce(value, MPI.MAX))

@@ -1,0 +1,109 @@
+"""Global numbering of blocked (monolithic) PETSc systems, and the chain-rule operator.
+
+DOLFINx numbers a blocked system ``[V_0, V_1, ...]`` by concatenating, on each rank, the
+owned dofs of every block; ranks follow one another. :class:`StackedLayout` turns a dof of
+one block, known by its global index *within that block*, into its index in the stacked
+system, for dofs owned by any rank.
+
+The contact residual is assembled over ``[u, xhat, lambda...]`` where ``xhat`` are master
+node positions carried to the slave quadrature points. They are not unknowns: ``xhat =
+Xhat + P u``. The operator ``T`` maps the unknowns ``[u, lambda...]`` to ``[u, xhat,
+lambda...]`` (identity on ``u`` and the multipliers, ``P`` on ``xhat``), so that the
+residual is ``T^T r`` and the Jacobian ``T^T K T`` (chain rule).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import dolfinx
+import numpy as np
+import numpy.typing as npt
+from petsc4py import PETSc
+
+
+class StackedLayout:
+    """Numbering of a blocked system over function spaces.
+
+    Parameters
+    ----------
+    spaces
+        The function spaces of the blocks, in order.
+    """
+
+    def __init__(self, spaces: Sequence[dolfinx.fem.FunctionSpace]):
+        comm = spaces[0].mesh.comm
+        self.comm = comm
+        maps = [(V.dofmap.index_map, V.dofmap.index_map_bs) for V in spaces]
+        self.bs = np.array([bs for _, bs in maps])
+        sizes = np.array([im.size_local * bs for im, bs in maps], dtype=np.int64)
+        starts = np.array([im.local_range[0] * bs for im, bs in maps], dtype=np.int64)
+        all_sizes = np.array(comm.allgather(sizes))  # (nranks, nblocks)
+        self.block_starts = np.array(comm.allgather(starts)).T  # (nblocks, nranks)
+        totals = all_sizes.sum(axis=1)
+        self.rank_offsets = np.concatenate([[0], np.cumsum(totals)[:-1]])
+        self.block_offsets = np.hstack(
+            [np.zeros((len(totals), 1), np.int64), np.cumsum(all_sizes, axis=1)[:, :-1]]
+        )  # (nranks, nblocks)
+        self.local_sizes = sizes
+        self.local_size = int(sizes.sum())
+        self.global_size = int(totals.sum())
+        self.rank = comm.rank
+
+    def owned(self, block: int, local: npt.ArrayLike) -> npt.NDArray[np.int64]:
+        """Stacked index of owned dofs of ``block`` given by their local (unrolled) index."""
+        local = np.asarray(local, dtype=np.int64)
+        return self.rank_offsets[self.rank] + self.block_offsets[self.rank, block] + local
+
+    def from_block_global(self, block: int, index: npt.ArrayLike) -> npt.NDArray[np.int64]:
+        """Stacked index of dofs of ``block`` given by their global (unrolled) block index."""
+        index = np.asarray(index, dtype=np.int64)
+        starts = self.block_starts[block]
+        owner = np.searchsorted(starts, index, side="right") - 1
+        return self.rank_offsets[owner] + self.block_offsets[owner, block] + index - starts[owner]
+
+
+def chain_operator(
+    rows: StackedLayout,
+    cols: StackedLayout,
+    identity_blocks: Sequence[tuple[int, int]],
+    gather_blocks: Sequence[int],
+    gather_cols: Sequence[npt.NDArray[np.int64]],
+) -> PETSc.Mat:
+    """The operator ``T`` from the unknowns to the assembled fields.
+
+    Parameters
+    ----------
+    rows, cols
+        Layouts of the assembled system (rows) and of the unknowns (columns).
+    identity_blocks
+        Pairs ``(row block, column block)`` mapped by the identity.
+    gather_blocks
+        The row blocks filled by gathering unknowns (the master node positions).
+    gather_cols
+        For each gather block, for each of its owned dofs (unrolled, in local order), the
+        stacked column index of the unknown it copies, or -1 for none (a quadrature point
+        without a master facet).
+
+    Returns
+    -------
+    A parallel AIJ matrix of local size ``(rows.local_size, cols.local_size)``.
+    """
+    row_index = np.full(rows.local_size, -1, dtype=np.int64)
+    offset = np.concatenate([[0], np.cumsum(rows.local_sizes)])
+    for rb, cb in identity_blocks:
+        n = rows.local_sizes[rb]
+        row_index[offset[rb] : offset[rb] + n] = cols.owned(cb, np.arange(n))
+    for gb, cols_b in zip(gather_blocks, gather_cols, strict=True):
+        row_index[offset[gb] : offset[gb + 1]] = cols_b
+    has = row_index >= 0
+    indptr = np.concatenate([[0], np.cumsum(has)]).astype(PETSc.IntType)
+    indices = row_index[has].astype(PETSc.IntType)
+    values = np.ones(len(indices), dtype=PETSc.ScalarType)
+    T = PETSc.Mat().createAIJ(
+        size=((rows.local_size, rows.global_size), (cols.local_size, cols.global_size)),
+        csr=(indptr, indices, values),
+        comm=rows.comm,
+    )
+    T.assemble()
+    return T

@@ -1,0 +1,89 @@
+"""Hyperelastic materials: strain energies written once in UFL.
+
+Each material is a stored-energy density ``psi(F)`` per unit reference volume. The first
+Piola-Kirchhoff stress is its derivative, taken by UFL. The same expression serves 3D solids
+and 2D plane strain (a 2x2 deformation gradient with F_33 = 1: the terms below are written
+with the dimension ``d`` of ``F`` so that they equal the 3D energy in plane strain).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ufl
+
+
+def lame_parameters(E: float, nu: float) -> tuple[float, float]:
+    """Shear modulus and first Lame parameter of Young's modulus ``E`` and Poisson ratio ``nu``."""
+    if not E > 0.0:
+        raise ValueError(f"Young's modulus must be positive, got E = {E}")
+    if not -1.0 < nu < 0.5:
+        raise ValueError(f"Poisson's ratio must lie in (-1, 0.5), got nu = {nu}")
+    mu = E / (2.0 * (1.0 + nu))
+    lmbda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    return mu, lmbda
+
+
+@dataclass(frozen=True)
+class Hyperelastic:
+    """Base class of isotropic hyperelastic materials given by ``E`` and ``nu``.
+
+    Parameters
+    ----------
+    E
+        Young's modulus (small-strain limit).
+    nu
+        Poisson's ratio (small-strain limit).
+    """
+
+    E: float
+    nu: float
+
+    def __post_init__(self) -> None:
+        lame_parameters(self.E, self.nu)
+
+    @property
+    def mu(self) -> float:
+        """Shear modulus."""
+        return lame_parameters(self.E, self.nu)[0]
+
+    @property
+    def lmbda(self) -> float:
+        """First Lame parameter."""
+        return lame_parameters(self.E, self.nu)[1]
+
+    def strain_energy(self, F: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Stored energy per unit reference volume."""
+        raise NotImplementedError
+
+    def first_piola(self, F: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """First Piola-Kirchhoff stress ``d psi / d F``."""
+        Fv = ufl.variable(F)
+        return ufl.diff(self.strain_energy(Fv), Fv)
+
+
+@dataclass(frozen=True)
+class NeoHookean(Hyperelastic):
+    """Compressible Neo-Hookean solid.
+
+    ``psi = mu/2 (tr C - 3 - 2 ln J) + lambda/2 (ln J)^2`` (Ciarlet/Simo form).
+    """
+
+    def strain_energy(self, F):
+        d = F.ufl_shape[0]
+        C = F.T * F
+        J = ufl.det(F)
+        return 0.5 * self.mu * (ufl.tr(C) - d - 2.0 * ufl.ln(J)) + 0.5 * self.lmbda * ufl.ln(J) ** 2
+
+
+@dataclass(frozen=True)
+class SaintVenantKirchhoff(Hyperelastic):
+    """Saint Venant-Kirchhoff solid: ``psi = lambda/2 (tr E)^2 + mu tr(E^2)``, E Green-Lagrange.
+
+    Valid for large rotations with small strains; not polyconvex (it softens in compression).
+    """
+
+    def strain_energy(self, F):
+        d = F.ufl_shape[0]
+        E = 0.5 * (F.T * F - ufl.Identity(d))
+        return 0.5 * self.lmbda * ufl.tr(E) ** 2 + self.mu * ufl.inner(E, E)

@@ -1,0 +1,879 @@
+"""Gmsh meshes of two-body contact scenes.
+
+Each generator builds two disjoint bodies, each meshed on its own (the meshes do not match
+at the contact interface and share no node, even where the bodies touch), and returns them
+as *one* DOLFINx mesh with named cell and facet tags. The gmsh model is built on rank 0 of
+``comm`` and distributed by :func:`dolfinx.io.gmsh.model_to_mesh`.
+
+Generators
+----------
+* :func:`hertz_2d`: half disc on a rectangular block (plane, Hertz problem).
+* :func:`curved_2d`: half disc on a block whose top is a circular arc.
+* :func:`patch_2d`: two stacked rectangles (contact patch test), triangles or quadrilaterals.
+* :func:`patch_3d`: two stacked boxes, tetrahedra or hexahedra.
+* :func:`cylinders_3d`: half cylinder on a block with a cylindrical top of crossed axis.
+
+Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
+11, 12, ... in the order they are listed in each generator's documentation; always look them
+up by name through :attr:`SceneMesh.tags`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import dolfinx
+import dolfinx.io.gmsh
+import gmsh
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+__all__ = [
+    "SceneMesh",
+    "gmsh_session",
+    "hertz_2d",
+    "curved_2d",
+    "patch_2d",
+    "patch_3d",
+    "cylinders_3d",
+]
+
+_CELL_TAG0 = 1
+_FACET_TAG0 = 11
+
+
+@dataclass(frozen=True, eq=False)
+class SceneMesh:
+    """A two-body contact scene in one DOLFINx mesh.
+
+    Attributes
+    ----------
+    mesh
+        The mesh holding both bodies (disjoint, no shared vertex).
+    cell_tags
+        Cell markers; one value per body.
+    facet_tags
+        Facet markers of the named boundary parts.
+    tags
+        Physical name -> tag value, for cells and facets alike (values are unique).
+    """
+
+    mesh: dolfinx.mesh.Mesh
+    cell_tags: dolfinx.mesh.MeshTags
+    facet_tags: dolfinx.mesh.MeshTags
+    tags: dict[str, int]
+
+    def cells(self, name: str) -> npt.NDArray[np.int32]:
+        """Local indices (owned and ghost) of the cells of the group ``name``."""
+        return self.cell_tags.find(self.tags[name])
+
+    def facets(self, name: str) -> npt.NDArray[np.int32]:
+        """Local indices (owned and ghost) of the facets of the group ``name``."""
+        return self.facet_tags.find(self.tags[name])
+
+
+# --------------------------------------------------------------------------------------------
+# gmsh plumbing
+# --------------------------------------------------------------------------------------------
+
+
+@contextmanager
+def gmsh_session(name: str, options: dict[str, float] | None = None) -> Iterator[None]:
+    """Work in a fresh gmsh model, and clean up afterwards.
+
+    Initialises gmsh unless it is initialised already (then finalises it on exit), silences the
+    terminal, adds a model ``name`` and makes it current, and sets the numeric ``options``.
+    On exit the model is removed; if gmsh was initialised by the caller, the options and the
+    previous current model are restored.
+
+    Parameters
+    ----------
+    name
+        Name of the gmsh model.
+    options
+        Numeric gmsh options, e.g. ``{"Mesh.Algorithm": 6}``.
+
+    Yields
+    ------
+    None
+        Use the ``gmsh`` module API inside the block.
+    """
+    initialised_here = not gmsh.isInitialized()
+    if initialised_here:
+        gmsh.initialize(interruptible=False)
+    all_options = {"General.Terminal": 0.0, **(options or {})}
+    saved = {key: gmsh.option.getNumber(key) for key in all_options}
+    previous = gmsh.model.getCurrent() if not initialised_here else None
+    try:
+        for key, value in all_options.items():
+            gmsh.option.setNumber(key, value)
+        gmsh.model.add(name)
+        yield
+    finally:
+        if initialised_here:
+            gmsh.finalize()
+        else:
+            gmsh.model.remove()
+            for key, value in saved.items():
+                gmsh.option.setNumber(key, value)
+            if previous:
+                try:
+                    gmsh.model.setCurrent(previous)
+                except Exception:  # the caller's model may have gone: nothing to restore
+                    pass
+
+
+def _add_groups(groups: list[tuple[str, int, list[int]]], tdim: int) -> None:
+    """Add named physical groups: cells numbered from 1, facets from 11."""
+    next_tag = {tdim: _CELL_TAG0, tdim - 1: _FACET_TAG0}
+    for name, dim, entities in groups:
+        if len(entities) == 0:
+            raise RuntimeError(f"physical group '{name}' has no geometric entity")
+        gmsh.model.addPhysicalGroup(dim, list(entities), tag=next_tag[dim], name=name)
+        next_tag[dim] += 1
+
+
+def _check_groups_meshed() -> None:
+    """Raise if a physical group holds no mesh element."""
+    for dim, tag in gmsh.model.getPhysicalGroups():
+        count = 0
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, tag):
+            _, element_tags, _ = gmsh.model.mesh.getElements(dim, entity)
+            count += sum(len(t) for t in element_tags)
+        if count == 0:
+            name = gmsh.model.getPhysicalName(dim, tag)
+            raise RuntimeError(f"physical group '{name}' has no mesh element")
+
+
+def _generate(
+    comm: MPI.Comm,
+    name: str,
+    build: Callable[[], None],
+    gdim: int,
+    options: dict[str, float],
+    msh_file: str | Path | None,
+    ghost_mode: dolfinx.mesh.GhostMode,
+) -> SceneMesh:
+    """Run ``build`` (geometry, fields, groups, meshing) on rank 0 and distribute the mesh.
+
+    Errors on rank 0 are raised on every rank.
+    """
+    error = None
+    with _on_rank0(comm, name, options):
+        if comm.rank == 0:
+            try:
+                build()
+                _check_groups_meshed()
+                if msh_file is not None:
+                    path = Path(msh_file)
+                    path.parent.mkdir(parents=True, exist_ok=True)
+                    gmsh.write(str(path))
+            except Exception as exc:  # made collective just below
+                error = f"{type(exc).__name__}: {exc}"
+        error = comm.bcast(error, root=0)
+        if error is not None:
+            raise RuntimeError(f"building the gmsh model '{name}' failed: {error}")
+        partitioner = dolfinx.mesh.create_cell_partitioner(ghost_mode, 2)
+        data = dolfinx.io.gmsh.model_to_mesh(
+            gmsh.model if comm.rank == 0 else None, comm, 0, gdim=gdim, partitioner=partitioner
+        )
+    data.mesh.name = name
+    tags = {key: int(group.tag) for key, group in data.physical_groups.items()}
+    return SceneMesh(data.mesh, data.cell_tags, data.facet_tags, tags)
+
+
+@contextmanager
+def _on_rank0(comm: MPI.Comm, name: str, options: dict[str, float]) -> Iterator[None]:
+    """A :func:`gmsh_session` on rank 0 of ``comm``, nothing on the other ranks."""
+    if comm.rank == 0:
+        with gmsh_session(name, options):
+            yield
+    else:
+        yield
+
+
+def _mesh_options(order: int) -> dict[str, float]:
+    """Options common to all scenes: sizes from the background field only."""
+    return {
+        "Mesh.MeshSizeFromPoints": 0.0,
+        "Mesh.MeshSizeFromCurvature": 0.0,
+        "Mesh.MeshSizeExtendFromBoundary": 0.0,
+        "Mesh.Algorithm": 6.0,  # Frontal-Delaunay
+        "Mesh.Algorithm3D": 1.0,  # Delaunay
+        "Mesh.ElementOrder": float(order),
+        "Mesh.SecondOrderLinear": 0.0,  # high-order nodes on the curved geometry
+        "Mesh.HighOrderOptimize": 0.0,
+        "Mesh.SecondOrderIncomplete": 0.0,
+    }
+
+
+def _restricted(field: int, dim: int, entities: list[int]) -> int:
+    """Restrict ``field`` to entities of dimension ``dim`` and their boundaries."""
+    key = {1: "CurvesList", 2: "SurfacesList", 3: "VolumesList"}[dim]
+    restrict = gmsh.model.mesh.field.add("Restrict")
+    gmsh.model.mesh.field.setNumber(restrict, "InField", field)
+    gmsh.model.mesh.field.setNumbers(restrict, key, entities)
+    gmsh.model.mesh.field.setNumber(restrict, "IncludeBoundary", 1)
+    return restrict
+
+
+def _constant(h: float) -> int:
+    """A constant size field."""
+    field = gmsh.model.mesh.field.add("MathEval")
+    gmsh.model.mesh.field.setString(field, "F", repr(float(h)))
+    return field
+
+
+def _threshold(distance: int, h_min: float, h_max: float, d_min: float, d_max: float) -> int:
+    """Size ``h_min`` within ``d_min`` of the distance field, growing to ``h_max`` at ``d_max``."""
+    field = gmsh.model.mesh.field.add("Threshold")
+    gmsh.model.mesh.field.setNumber(field, "InField", distance)
+    gmsh.model.mesh.field.setNumber(field, "SizeMin", h_min)
+    gmsh.model.mesh.field.setNumber(field, "SizeMax", h_max)
+    gmsh.model.mesh.field.setNumber(field, "DistMin", d_min)
+    gmsh.model.mesh.field.setNumber(field, "DistMax", d_max)
+    return field
+
+
+def _distance_to(point: tuple[float, float, float]) -> int:
+    """Distance to a point that need not be a vertex of the geometry (a MathEval field)."""
+    x0, y0, z0 = (repr(float(c)) for c in point)
+    field = gmsh.model.mesh.field.add("MathEval")
+    gmsh.model.mesh.field.setString(field, "F", f"Sqrt((x-{x0})^2+(y-{y0})^2+(z-{z0})^2)")
+    return field
+
+
+def _set_background(fields: list[int]) -> None:
+    """The minimum of ``fields`` as the background size field."""
+    field = gmsh.model.mesh.field.add("Min")
+    gmsh.model.mesh.field.setNumbers(field, "FieldsList", fields)
+    gmsh.model.mesh.field.setAsBackgroundMesh(field)
+
+
+def _boundary(dim: int, entities: list[int], target: int) -> list[int]:
+    """Entities of dimension ``target`` < ``dim`` on the boundary of the given entities."""
+    tags = {(dim, e) for e in entities}
+    for _ in range(dim - target):
+        tags = set(gmsh.model.getBoundary(sorted(tags), combined=False, oriented=False))
+    return sorted({abs(t) for _, t in tags})
+
+
+def _bbox(dim: int, tag: int) -> npt.NDArray[np.float64]:
+    """Bounding box ``[[xmin, ymin, zmin], [xmax, ymax, zmax]]`` of an entity."""
+    return np.asarray(gmsh.model.getBoundingBox(dim, tag)).reshape(2, 3)
+
+
+def _flat(tag: int, tol: float) -> tuple[int, float] | None:
+    """``(axis, coordinate)`` if the surface ``tag`` lies in a plane normal to an axis."""
+    lo, hi = _bbox(2, tag)
+    extent = hi - lo
+    axis = int(np.argmin(extent))
+    if extent[axis] > tol:
+        return None
+    return axis, float(0.5 * (lo[axis] + hi[axis]))
+
+
+def _check_positive(**values: float) -> None:
+    for key, value in values.items():
+        if not (value > 0.0 and math.isfinite(value)):
+            raise ValueError(f"{key} must be positive and finite, got {value}")
+
+
+def _check_common(gap: float, order: int) -> None:
+    if not (gap >= 0.0 and math.isfinite(gap)):
+        raise ValueError(f"gap must be >= 0, got {gap}")
+    if order not in (1, 2):
+        raise ValueError(f"order must be 1 or 2, got {order}")
+
+
+def _divisions(length: float, h: float) -> int:
+    """Number of element edges of size about ``h`` on a line of the given length."""
+    return max(1, int(math.floor(length / h + 0.5)))
+
+
+# --------------------------------------------------------------------------------------------
+# 2D: half disc on a block (flat or curved top)
+# --------------------------------------------------------------------------------------------
+
+
+def _disc_on_block(
+    radius: float,
+    gap: float,
+    width: float,
+    height: float,
+    lower_radius: float | None,
+    h_contact: float,
+    h_far: float,
+    master_ratio: float,
+    refine_radius: float,
+    order: int,
+) -> None:
+    """Build and mesh the half disc over a block with a flat (``lower_radius`` None) or arc top."""
+    geo = gmsh.model.geo
+    R, a = radius, 0.5 * width
+    yc = R + gap
+    # upper body: lower half of the circle of centre (0, R + gap)
+    c = geo.addPoint(0.0, yc, 0.0)
+    p_left = geo.addPoint(-R, yc, 0.0)
+    p_bottom = geo.addPoint(0.0, gap, 0.0)
+    p_right = geo.addPoint(R, yc, 0.0)
+    arc_left = geo.addCircleArc(p_left, c, p_bottom)
+    arc_right = geo.addCircleArc(p_bottom, c, p_right)
+    diameter = geo.addLine(p_right, p_left)
+    disc = geo.addPlaneSurface([geo.addCurveLoop([arc_left, arc_right, diameter])])
+    # lower body: [-a, a] x [-height, top(x)]
+    q0 = geo.addPoint(-a, -height, 0.0)
+    q1 = geo.addPoint(a, -height, 0.0)
+    if lower_radius is None:
+        y_top = 0.0
+        q2 = geo.addPoint(a, y_top, 0.0)
+        q3 = geo.addPoint(-a, y_top, 0.0)
+        top = [geo.addLine(q2, q3)]
+    else:
+        R2 = abs(lower_radius)
+        sign = 1.0 if lower_radius > 0 else -1.0  # convex (centre below) or concave
+        y_top = sign * (math.sqrt(R2 * R2 - a * a) - R2)
+        q2 = geo.addPoint(a, y_top, 0.0)
+        q3 = geo.addPoint(-a, y_top, 0.0)
+        c2 = geo.addPoint(0.0, -sign * R2, 0.0)
+        top = [geo.addCircleArc(q2, c2, q3)]
+    bottom = geo.addLine(q0, q1)
+    right = geo.addLine(q1, q2)
+    left = geo.addLine(q3, q0)
+    block = geo.addPlaneSurface([geo.addCurveLoop([bottom, right, *top, left])])
+    geo.synchronize()
+
+    _add_groups(
+        [
+            ("cylinder", 2, [disc]),
+            ("block", 2, [block]),
+            ("cylinder_contact", 1, [arc_left, arc_right]),
+            ("cylinder_top", 1, [diameter]),
+            ("block_contact", 1, top),
+            ("block_bottom", 1, [bottom]),
+            ("block_sides", 1, [left, right]),
+        ],
+        tdim=2,
+    )
+    distance = gmsh.model.mesh.field.add("Distance")
+    gmsh.model.mesh.field.setNumbers(distance, "PointsList", [p_bottom])
+    d_min = refine_radius * R
+    d_max = d_min + R
+    upper = _threshold(distance, h_contact, h_far, d_min, d_max)
+    lower = _threshold(distance, master_ratio * h_contact, h_far, d_min, d_max)
+    _set_background([_restricted(upper, 2, [disc]), _restricted(lower, 2, [block])])
+    gmsh.model.mesh.generate(2)
+    if order > 1:
+        gmsh.model.mesh.setOrder(order)
+
+
+def hertz_2d(
+    radius: float = 1.0,
+    block: tuple[float, float] = (4.0, 1.5),
+    gap: float = 0.0,
+    h_contact: float | None = None,
+    h_far: float | None = None,
+    master_ratio: float = 1.3,
+    refine_radius: float = 0.3,
+    order: int = 1,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> SceneMesh:
+    """Plane Hertz scene: a half disc resting on a rectangular block.
+
+    The half disc is the lower half of the circle of radius ``radius`` and centre
+    ``(0, radius + gap)``; the block is ``[-w/2, w/2] x [-height, 0]``. Both bodies are refined
+    near the contact point ``(0, 0)`` (size ``h_contact`` within ``refine_radius * radius`` of
+    the lowest point of the disc, growing to ``h_far`` over a further ``radius``); the block is
+    ``master_ratio`` times coarser there, so the interface meshes do not match.
+
+    Parameters
+    ----------
+    radius
+        Radius R of the disc.
+    block
+        ``(width, height)`` of the block.
+    gap
+        Initial gap between the lowest point of the disc and the block (>= 0).
+    h_contact
+        Element size near the contact point (default ``0.02 * radius``).
+    h_far
+        Element size away from it (default ``0.2 * radius``).
+    master_ratio
+        Block size / disc size near the contact point.
+    refine_radius
+        Radius of the refined zone, in units of ``radius``.
+    order
+        Geometry order, 1 or 2 (P2 nodes lie on the arcs).
+    comm
+        Communicator of the mesh; the model is built on its rank 0.
+    msh_file
+        If given, the gmsh mesh is also written there (e.g. ``"meshes/hertz_2d.msh"``).
+    ghost_mode
+        Ghost mode of the cell partitioner.
+
+    Returns
+    -------
+    SceneMesh
+        Cell groups ``"cylinder"`` (1), ``"block"`` (2); facet groups ``"cylinder_contact"``
+        (lower arc, 11), ``"cylinder_top"`` (diameter, 12), ``"block_contact"`` (top edge, 13),
+        ``"block_bottom"`` (14), ``"block_sides"`` (left and right, 15).
+    """
+    h_contact = 0.02 * radius if h_contact is None else h_contact
+    h_far = 0.2 * radius if h_far is None else h_far
+    width, height = block
+    _check_positive(
+        radius=radius,
+        width=width,
+        height=height,
+        h_contact=h_contact,
+        h_far=h_far,
+        master_ratio=master_ratio,
+        refine_radius=refine_radius,
+    )
+    _check_common(gap, order)
+
+    def build() -> None:
+        _disc_on_block(
+            radius, gap, width, height, None, h_contact, h_far, master_ratio, refine_radius, order
+        )
+
+    return _generate(comm, "hertz_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+
+
+def curved_2d(
+    radius: float = 1.0,
+    lower_radius: float | None = None,
+    block: tuple[float, float] = (4.0, 1.5),
+    gap: float = 0.0,
+    h_contact: float | None = None,
+    h_far: float | None = None,
+    master_ratio: float = 1.3,
+    refine_radius: float = 0.3,
+    order: int = 1,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> SceneMesh:
+    """Plane curved-on-curved scene: the half disc of :func:`hertz_2d` on an arched block.
+
+    The lower body is ``{-w/2 <= x <= w/2, -height <= y <= top(x)}`` whose top is a circular
+    arc of radius ``R2 = |lower_radius|`` through ``(0, 0)``: convex, ``top(x) =
+    sqrt(R2^2 - x^2) - R2``, for ``lower_radius > 0``; concave, ``top(x) = R2 - sqrt(R2^2 -
+    x^2)``, for ``lower_radius < 0`` (then ``R2 > radius`` is required).
+
+    Parameters
+    ----------
+    radius
+        Radius R of the disc.
+    lower_radius
+        Signed radius of the top arc of the lower body (default ``3 * radius``, convex).
+    block
+        ``(width, height)`` of the lower body; ``width / 2 < |lower_radius|``.
+    gap, h_contact, h_far, master_ratio, refine_radius, order, comm, msh_file, ghost_mode
+        As in :func:`hertz_2d`.
+
+    Returns
+    -------
+    SceneMesh
+        The names and values of :func:`hertz_2d`; ``"block_contact"`` is the top arc.
+    """
+    h_contact = 0.02 * radius if h_contact is None else h_contact
+    h_far = 0.2 * radius if h_far is None else h_far
+    lower_radius = 3.0 * radius if lower_radius is None else lower_radius
+    width, height = block
+    _check_positive(
+        radius=radius,
+        width=width,
+        height=height,
+        h_contact=h_contact,
+        h_far=h_far,
+        master_ratio=master_ratio,
+        refine_radius=refine_radius,
+    )
+    _check_common(gap, order)
+    R2 = abs(lower_radius)
+    if not 0.5 * width < R2:
+        raise ValueError(f"need width / 2 < |lower_radius|, got {width}, {lower_radius}")
+    if lower_radius < 0 and not R2 > radius:
+        raise ValueError(f"a concave top needs |lower_radius| > radius, got {lower_radius}")
+    if lower_radius > 0 and not (math.sqrt(R2 * R2 - 0.25 * width * width) - R2) > -height:
+        raise ValueError("the top arc of the lower body goes below its bottom: increase height")
+
+    def build() -> None:
+        _disc_on_block(
+            radius,
+            gap,
+            width,
+            height,
+            lower_radius,
+            h_contact,
+            h_far,
+            master_ratio,
+            refine_radius,
+            order,
+        )
+
+    return _generate(comm, "curved_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+
+
+# --------------------------------------------------------------------------------------------
+# Patch tests
+# --------------------------------------------------------------------------------------------
+
+
+def patch_2d(
+    width: float = 1.0,
+    height: float = 0.5,
+    h_upper: float | None = None,
+    h_lower: float | None = None,
+    gap: float = 0.0,
+    cell: str = "triangle",
+    order: int = 1,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> SceneMesh:
+    """Plane patch test: two stacked rectangles with non-matching meshes.
+
+    Lower body ``[0, w] x [-height, 0]``, upper body ``[0, w] x [gap, gap + height]``. Every
+    edge is divided uniformly into ``round(length / h)`` segments of its body (at least one);
+    triangles are then unstructured, quadrilaterals structured (transfinite, recombined).
+
+    Parameters
+    ----------
+    width
+        Width w of both bodies.
+    height
+        Height of each body.
+    h_upper
+        Element size of the upper body (default ``width / 10``).
+    h_lower
+        Element size of the lower body (default ``width / 7``: 10 and 7 divisions of the contact
+        edges, which meet only at their end points).
+    gap
+        Initial gap (>= 0).
+    cell
+        ``"triangle"`` or ``"quadrilateral"``.
+    order
+        Geometry order, 1 or 2.
+    comm, msh_file, ghost_mode
+        As in :func:`hertz_2d`.
+
+    Returns
+    -------
+    SceneMesh
+        Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"`` (bottom
+        of upper, 11), ``"lower_contact"`` (top of lower, 12), ``"upper_top"`` (13),
+        ``"lower_bottom"`` (14), ``"upper_left"`` (15), ``"lower_left"`` (16),
+        ``"upper_right"`` (17), ``"lower_right"`` (18).
+    """
+    h_upper = width / 10.0 if h_upper is None else h_upper
+    h_lower = width / 7.0 if h_lower is None else h_lower
+    _check_positive(width=width, height=height, h_upper=h_upper, h_lower=h_lower)
+    _check_common(gap, order)
+    if cell not in ("triangle", "quadrilateral"):
+        raise ValueError(f"cell must be 'triangle' or 'quadrilateral', got {cell!r}")
+
+    def rectangle(y0: float, h: float) -> tuple[int, list[int]]:
+        geo = gmsh.model.geo
+        p = [geo.addPoint(x, y, 0.0) for x, y in ((0, y0), (width, y0), (width, y0 + height))]
+        p.append(geo.addPoint(0.0, y0 + height, 0.0))
+        lines = [geo.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]  # bottom, right, top, left
+        surface = geo.addPlaneSurface([geo.addCurveLoop(lines)])
+        # constraints through geo.mesh: a later geo.synchronize() keeps them
+        nx, ny = _divisions(width, h), _divisions(height, h)
+        for line, n in zip(lines, (nx, ny, nx, ny), strict=True):
+            geo.mesh.setTransfiniteCurve(line, n + 1)
+        if cell == "quadrilateral":
+            geo.mesh.setTransfiniteSurface(surface)
+            geo.mesh.setRecombine(2, surface)
+        return surface, lines
+
+    def build() -> None:
+        up, (up_bottom, up_right, up_top, up_left) = rectangle(gap, h_upper)
+        lo, (lo_bottom, lo_right, lo_top, lo_left) = rectangle(-height, h_lower)
+        gmsh.model.geo.synchronize()
+        _add_groups(
+            [
+                ("upper", 2, [up]),
+                ("lower", 2, [lo]),
+                ("upper_contact", 1, [up_bottom]),
+                ("lower_contact", 1, [lo_top]),
+                ("upper_top", 1, [up_top]),
+                ("lower_bottom", 1, [lo_bottom]),
+                ("upper_left", 1, [up_left]),
+                ("lower_left", 1, [lo_left]),
+                ("upper_right", 1, [up_right]),
+                ("lower_right", 1, [lo_right]),
+            ],
+            tdim=2,
+        )
+        # interior sizes of the unstructured triangles
+        _set_background(
+            [
+                _restricted(_constant(h_upper), 2, [up]),
+                _restricted(_constant(h_lower), 2, [lo]),
+            ]
+        )
+        gmsh.model.mesh.generate(2)
+        if order > 1:
+            gmsh.model.mesh.setOrder(order)
+
+    return _generate(comm, "patch_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+
+
+def patch_3d(
+    width: float = 1.0,
+    height: float = 0.5,
+    h_upper: float | None = None,
+    h_lower: float | None = None,
+    gap: float = 0.0,
+    cell: str = "tetrahedron",
+    order: int = 1,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> SceneMesh:
+    """Patch test in 3D: two stacked boxes with non-matching meshes.
+
+    Lower body ``[0, w]^2 x [-height, 0]``, upper body ``[0, w]^2 x [gap, gap + height]``.
+    Tetrahedra are unstructured with the size of their body; hexahedra are structured
+    (transfinite, recombined) with ``round(length / h)`` divisions of each edge.
+
+    Parameters
+    ----------
+    width
+        Width w of both bodies in x and y.
+    height
+        Height of each body.
+    h_upper
+        Element size of the upper body (default ``width / 6``).
+    h_lower
+        Element size of the lower body (default ``width / 5``).
+    gap
+        Initial gap (>= 0).
+    cell
+        ``"tetrahedron"`` or ``"hexahedron"``.
+    order
+        Geometry order, 1 or 2.
+    comm, msh_file, ghost_mode
+        As in :func:`hertz_2d`.
+
+    Returns
+    -------
+    SceneMesh
+        Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"`` (11),
+        ``"lower_contact"`` (12), ``"upper_top"`` (13), ``"lower_bottom"`` (14), then the
+        side faces ``"upper_x0"``, ``"lower_x0"``, ``"upper_y0"``, ``"lower_y0"`` (faces
+        x = 0 and y = 0, 15-18) and ``"upper_x1"``, ``"lower_x1"``, ``"upper_y1"``,
+        ``"lower_y1"`` (faces x = w and y = w, 19-22).
+    """
+    h_upper = width / 6.0 if h_upper is None else h_upper
+    h_lower = width / 5.0 if h_lower is None else h_lower
+    _check_positive(width=width, height=height, h_upper=h_upper, h_lower=h_lower)
+    _check_common(gap, order)
+    if cell not in ("tetrahedron", "hexahedron"):
+        raise ValueError(f"cell must be 'tetrahedron' or 'hexahedron', got {cell!r}")
+    tol = 1e-5 * max(width, height)
+
+    def classify(volume: int, z0: float) -> dict[str, int]:
+        faces: dict[str, int] = {}
+        for face in _boundary(3, [volume], 2):
+            axis, coord = _flat(face, tol)  # type: ignore[misc]  (all faces are flat)
+            side = "0" if abs(coord - (z0 if axis == 2 else 0.0)) < tol else "1"
+            faces["xyz"[axis] + side] = face
+        return faces
+
+    def build() -> None:
+        up = gmsh.model.occ.addBox(0.0, 0.0, gap, width, width, height)
+        lo = gmsh.model.occ.addBox(0.0, 0.0, -height, width, width, height)
+        gmsh.model.occ.synchronize()
+        fu, fl = classify(up, gap), classify(lo, -height)
+        if cell == "hexahedron":
+            for volume, h in ((up, h_upper), (lo, h_lower)):
+                for c in _boundary(3, [volume], 1):
+                    lo_, hi_ = _bbox(1, c)
+                    n = _divisions(float(np.max(hi_ - lo_)), h)
+                    gmsh.model.mesh.setTransfiniteCurve(c, n + 1)
+                for face in _boundary(3, [volume], 2):
+                    gmsh.model.mesh.setTransfiniteSurface(face)
+                    gmsh.model.mesh.setRecombine(2, face)
+                gmsh.model.mesh.setTransfiniteVolume(volume)
+        _add_groups(
+            [
+                ("upper", 3, [up]),
+                ("lower", 3, [lo]),
+                ("upper_contact", 2, [fu["z0"]]),
+                ("lower_contact", 2, [fl["z1"]]),
+                ("upper_top", 2, [fu["z1"]]),
+                ("lower_bottom", 2, [fl["z0"]]),
+                ("upper_x0", 2, [fu["x0"]]),
+                ("lower_x0", 2, [fl["x0"]]),
+                ("upper_y0", 2, [fu["y0"]]),
+                ("lower_y0", 2, [fl["y0"]]),
+                ("upper_x1", 2, [fu["x1"]]),
+                ("lower_x1", 2, [fl["x1"]]),
+                ("upper_y1", 2, [fu["y1"]]),
+                ("lower_y1", 2, [fl["y1"]]),
+            ],
+            tdim=3,
+        )
+        _set_background(
+            [
+                _restricted(_constant(h_upper), 3, [up]),
+                _restricted(_constant(h_lower), 3, [lo]),
+            ]
+        )
+        gmsh.model.mesh.generate(3)
+        if order > 1:
+            gmsh.model.mesh.setOrder(order)
+
+    return _generate(comm, "patch_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
+
+
+# --------------------------------------------------------------------------------------------
+# 3D curved-on-curved: half cylinder on a block with a cylindrical top (crossed axes)
+# --------------------------------------------------------------------------------------------
+
+
+def cylinders_3d(
+    radius: float = 1.0,
+    length: float = 1.0,
+    lower_radius: float | None = None,
+    block: tuple[float, float, float] | None = None,
+    gap: float = 0.0,
+    h_contact: float | None = None,
+    h_far: float | None = None,
+    master_ratio: float = 1.3,
+    refine_radius: float = 0.3,
+    order: int = 1,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> SceneMesh:
+    """3D curved-on-curved scene: a half cylinder on a block with a cylindrical top.
+
+    Upper body: the lower half of the cylinder of radius R with axis along y through
+    ``(0, ., R + gap)``, for ``-length/2 <= y <= length/2``. Lower body: ``{|x| <= wx/2,
+    |y| <= wy/2, -height <= z <= top(y)}`` whose top is the convex cylinder of radius
+    ``R2 = lower_radius`` with axis along x through ``(., 0, -R2)``: ``top(y) = sqrt(R2^2 -
+    y^2) - R2``. The axes cross, so the bodies touch at the origin only (for ``gap = 0``) and
+    the contact surfaces are curved in different directions. (A concave top would meet the
+    straight generators of the upper body at its ends first, so it is not offered.)
+    Tetrahedra, refined near the origin as in :func:`hertz_2d`.
+
+    Parameters
+    ----------
+    radius
+        Radius R of the upper half cylinder.
+    length
+        Length of the upper half cylinder along y.
+    lower_radius
+        Radius of the convex top of the lower body (default ``3 * radius``).
+    block
+        ``(wx, wy, height)`` of the lower body (default ``(2 R, 1.5 length, 0.5 R)``);
+        ``wy / 2 < lower_radius``.
+    gap
+        Initial gap (>= 0).
+    h_contact
+        Element size near the contact point (default ``0.1 * radius``).
+    h_far
+        Element size away from it (default ``0.25 * radius``).
+    master_ratio, refine_radius, order, comm, msh_file, ghost_mode
+        As in :func:`hertz_2d`.
+
+    Returns
+    -------
+    SceneMesh
+        Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"``
+        (curved face, 11), ``"lower_contact"`` (curved top, 12), ``"upper_top"`` (flat face
+        z = R + gap, 13), ``"lower_bottom"`` (14), ``"upper_ends"`` (faces y = +-length/2,
+        15), ``"lower_sides"`` (the four vertical faces, 16).
+    """
+    R = radius
+    h_contact = 0.1 * R if h_contact is None else h_contact
+    h_far = 0.25 * R if h_far is None else h_far
+    lower_radius = 3.0 * R if lower_radius is None else lower_radius
+    wx, wy, height = (2.0 * R, 1.5 * length, 0.5 * R) if block is None else block
+    _check_positive(
+        radius=R,
+        length=length,
+        wx=wx,
+        wy=wy,
+        height=height,
+        h_contact=h_contact,
+        h_far=h_far,
+        master_ratio=master_ratio,
+        refine_radius=refine_radius,
+    )
+    _check_common(gap, order)
+    _check_positive(lower_radius=lower_radius)
+    R2 = lower_radius
+    if not 0.5 * wy < R2:
+        raise ValueError(f"need wy / 2 < lower_radius, got {wy}, {lower_radius}")
+    if not (math.sqrt(R2 * R2 - 0.25 * wy * wy) - R2) > -height:
+        raise ValueError("the top of the lower body goes below its bottom: increase height")
+    tol = 1e-5 * max(R, length, wx, wy, height)
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        zc = R + gap
+        # upper body: cylinder along y intersected with the half space z <= zc (the cutting
+        # box overhangs the cylinder, so no face of it is tangent to the cylinder)
+        cyl = occ.addCylinder(0.0, -0.5 * length, zc, 0.0, length, 0.0, R)
+        cut = occ.addBox(-2 * R, -length, zc - 2 * R, 4 * R, 2 * length, 2 * R)
+        (upper_dt,), _ = occ.intersect([(3, cyl)], [(3, cut)])
+        # lower body: a box, overhanging at the top, intersected with a cylinder along x
+        cyl2 = occ.addCylinder(-wx, 0.0, -R2, 2 * wx, 0.0, 0.0, R2)
+        box = occ.addBox(-0.5 * wx, -0.5 * wy, -height, wx, wy, 2 * height)
+        (lower_dt,), _ = occ.intersect([(3, box)], [(3, cyl2)])
+        occ.synchronize()
+        up, lo = upper_dt[1], lower_dt[1]
+
+        names: dict[str, list[int]] = {
+            "upper_contact": [],
+            "lower_contact": [],
+            "upper_top": [],
+            "lower_bottom": [],
+            "upper_ends": [],
+            "lower_sides": [],
+        }
+        for face in _boundary(3, [up], 2):
+            flat = _flat(face, tol)
+            if flat is not None and flat[0] == 2:
+                names["upper_top"].append(face)
+            elif flat is not None:
+                names["upper_ends"].append(face)
+            else:
+                names["upper_contact"].append(face)
+        for face in _boundary(3, [lo], 2):
+            flat = _flat(face, tol)
+            if flat is not None and flat[0] == 2:
+                names["lower_bottom"].append(face)
+            elif flat is not None:
+                names["lower_sides"].append(face)
+            else:
+                names["lower_contact"].append(face)
+        _add_groups(
+            [("upper", 3, [up]), ("lower", 3, [lo])]
+            + [(key, 2, value) for key, value in names.items()],
+            tdim=3,
+        )
+        distance = _distance_to((0.0, 0.0, gap))
+        d_min = refine_radius * R
+        d_max = d_min + R
+        upper = _threshold(distance, h_contact, h_far, d_min, d_max)
+        lower = _threshold(distance, master_ratio * h_contact, h_far, d_min, d_max)
+        _set_background([_restricted(upper, 3, [up]), _restricted(lower, 3, [lo])])
+        gmsh.model.mesh.generate(3)
+        if order > 1:
+            gmsh.model.mesh.setOrder(order)
+
+    return _generate(comm, "cylinders_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)

@@ -1,0 +1,377 @@
+"""The contact problem: forms of a scene, PETSc SNES Newton, load stepping with cut-back.
+
+Data flow: scene -> forms (bulk in UFL, contact terms of :mod:`contact_ufl.contact`) ->
+assembled system over ``[u, xhat_1, lambda_1, ...]`` -> chain rule ``T^T r``, ``T^T K T``
+onto the unknowns ``[u, lambda_1, ...]`` -> SNES.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import dolfinx
+import dolfinx.fem.petsc as fem_petsc
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from contact_ufl.contact import FrictionlessContact
+from contact_ufl.errors import ConvergenceError
+from contact_ufl.layout import StackedLayout, chain_operator
+from contact_ufl.loads import BodyForce, DeadTraction, evaluate, load_constant
+from contact_ufl.scene import Scene
+
+DEFAULT_PETSC_OPTIONS = {
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "basic",
+    "snes_rtol": 1e-9,
+    "snes_stol": 0.0,
+    "snes_max_it": 25,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+
+@dataclass
+class StepRecord:
+    """What happened in one accepted load step."""
+
+    step: int
+    t: float
+    newton_iterations: int
+    residual: float
+    active_points: int
+    contact_force: np.ndarray
+    wall_s: float
+
+
+@dataclass
+class History:
+    """Accepted steps and cut-backs of a run."""
+
+    steps: list[StepRecord] = field(default_factory=list)
+    cutbacks: list[tuple[float, str]] = field(default_factory=list)
+
+
+def _nonempty(form: ufl.Form) -> ufl.Form | None:
+    form = ufl.algorithms.expand_derivatives(form)
+    return None if form.empty() else form
+
+
+class ContactProblem:
+    """Quasi-static large-deformation contact of the bodies of a scene.
+
+    Parameters
+    ----------
+    scene
+        Mesh, bodies, supports, loads and contact pairs.
+    degree
+        Polynomial degree of the displacement.
+    quadrature_degree
+        Quadrature degree of the bulk integrals (default: exact for P1 simplices, ``2 p``
+        otherwise).
+    petsc_options
+        PETSc options (SNES, KSP, PC) overriding :data:`DEFAULT_PETSC_OPTIONS`.
+    petsc_options_prefix
+        Prefix of those options in the PETSc options database.
+    verbose
+        Print one line per load step (rank 0).
+    """
+
+    def __init__(self, scene: Scene, degree: int = 1, quadrature_degree: int | None = None,
+                 petsc_options: dict | None = None, petsc_options_prefix: str = "contact_",
+                 verbose: bool = True):
+        scene.validate()
+        self.scene = scene
+        mesh = scene.mesh
+        self.comm = mesh.comm
+        self.verbose = verbose
+        gdim = mesh.geometry.dim
+        self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (gdim,)))
+        self.u = dolfinx.fem.Function(self.V, name="displacement")
+        simplex = mesh.topology.cell_type in (dolfinx.mesh.CellType.triangle,
+                                              dolfinx.mesh.CellType.tetrahedron)
+        qdeg = quadrature_degree or (2 * degree - 1 if simplex else 2 * degree)
+        self.dx = ufl.Measure("dx", domain=mesh, subdomain_data=scene.cell_tags,
+                              metadata={"quadrature_degree": qdeg})
+        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=scene.facet_tags)
+        self.t = 0.0
+        self.contacts = [FrictionlessContact(self.u, scene.facet_tags, p) for p in scene.contacts]
+        self._build_forms()
+        self._build_dirichlet()
+        self._build_solver(petsc_options or {}, petsc_options_prefix)
+        self.history = History()
+
+    # -- forms ------------------------------------------------------------------------
+    def first_piola(self, body) -> ufl.core.expr.Expr:
+        """First Piola-Kirchhoff stress of ``body`` at the current displacement."""
+        F = ufl.Identity(self.V.mesh.geometry.dim) + ufl.grad(self.u)
+        return body.material.first_piola(F)
+
+    def _build_forms(self) -> None:
+        u, v = self.u, ufl.TestFunction(self.V)
+        F_u = sum(ufl.inner(self.first_piola(b), ufl.grad(v)) * self.dx(b.tag)
+                  for b in self.scene.bodies)
+        self._load_constants = []
+        for load in self.scene.loads:
+            c = load_constant(self.V.mesh, load)
+            self._load_constants.append((load, c))
+            measure = self.dx if isinstance(load, BodyForce) else self.ds
+            F_u -= load.virtual_work(u, v, measure, c)
+        residuals = [F_u]
+        fields, unknowns = [u], [u]
+        for c in self.contacts:
+            vhat, mu = ufl.TestFunction(c.Qx), ufl.TestFunction(c.L)
+            Fu_c, Fx_c, Fl_c = c.residuals(v, vhat, mu)
+            residuals[0] = residuals[0] + Fu_c
+            residuals += [Fx_c, Fl_c]
+            fields += [c.xhat, c.lambda_N]
+            unknowns.append(c.lambda_N)
+        self.fields, self.unknowns = fields, unknowns
+        jacobian = [[_nonempty(ufl.derivative(Fi, f, ufl.TrialFunction(f.function_space)))
+                     for f in fields] for Fi in residuals]
+        entity_maps = [c.slave.entity_map for c in self.contacts]
+        self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
+        self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
+        spaces = [f.function_space for f in fields]
+        self.full_layout = StackedLayout(spaces)
+        self.layout = StackedLayout([f.function_space for f in unknowns])
+        self._r = fem_petsc.create_vector(spaces, kind="mpi")
+        self._K = fem_petsc.create_matrix(self.jacobian_form, kind="mpi")
+        self._contact_force_forms = [
+            [dolfinx.fem.form(c.t_N * c.nu[i] * c.ds, entity_maps=[c.slave.entity_map])
+             for i in range(self.V.mesh.geometry.dim)] for c in self.contacts]
+
+    def _build_dirichlet(self) -> None:
+        mesh, fdim = self.V.mesh, self.V.mesh.topology.dim - 1
+        gdim = mesh.geometry.dim
+        self._bc_dofs, self._bc_values = [], []
+        owned = self.V.dofmap.index_map.size_local * gdim
+        for bc in self.scene.dirichlet:
+            facets = self.scene.facet_tags.find(bc.tag)
+            comps = range(gdim) if bc.component is None else [bc.component]
+            for i in comps:
+                blocks = dolfinx.fem.locate_dofs_topological(self.V.sub(i), fdim, facets)
+                dofs = blocks[blocks < owned]
+                self._bc_dofs.append(dofs)
+                self._bc_values.append((bc, i))
+        self._bc_rows = (np.concatenate(self._bc_dofs).astype(np.int64)
+                         if self._bc_dofs else np.zeros(0, np.int64))
+
+    def _prescribed(self, t: float) -> np.ndarray:
+        values = []
+        for dofs, (bc, i) in zip(self._bc_dofs, self._bc_values, strict=True):
+            value = evaluate(bc.value, t)
+            value = value if bc.component is not None or value.ndim == 0 else value[i]
+            values.append(np.full(len(dofs), float(value)))
+        return np.concatenate(values) if values else np.zeros(0)
+
+    # -- solver -----------------------------------------------------------------------
+    def _build_solver(self, options: dict, prefix: str) -> None:
+        self.x = fem_petsc.create_vector([f.function_space for f in self.unknowns], kind="mpi")
+        fem_petsc.assign(self.unknowns, self.x)
+        self._R = self.x.duplicate()
+        self._J = None
+        self._T = None
+        self._JT = None
+        self._pattern = None
+        self._state = None
+        self._update_contact()
+        self._J = self._assemble_jacobian_matrix(first=True)
+        self.snes = PETSc.SNES().create(self.comm)
+        self.snes.setOptionsPrefix(prefix)
+        opts = PETSc.Options()
+        for key, value in {**DEFAULT_PETSC_OPTIONS, "snes_atol": self._default_atol(),
+                           **options}.items():
+            opts[f"{prefix}{key}"] = value
+        self.snes.setFunction(self._residual, self._R)
+        self.snes.setJacobian(self._jacobian, self._J)
+        self.snes.setFromOptions()
+        self.snes.getKSP().setFromOptions()
+
+    def _default_atol(self) -> float:
+        """A force scale: 1e-11 of ``E_max L^(d-1)`` with L the scene's diameter."""
+        x = self.V.mesh.geometry.x
+        lo = self.comm.allreduce(x.min(axis=0), MPI.MIN)
+        hi = self.comm.allreduce(x.max(axis=0), MPI.MAX)
+        size = float(np.linalg.norm(hi - lo))
+        E = max(b.material.E for b in self.scene.bodies)
+        return 1e-11 * E * size ** (self.V.mesh.geometry.dim - 1)
+
+    def _set_state(self, x: PETSc.Vec) -> None:
+        if self._state is not None and x.equal(self._state):
+            return
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        fem_petsc.assign(x, self.unknowns)
+        for f in self.unknowns:
+            f.x.scatter_forward()
+        self._update_contact()
+        self._state = x.copy()
+
+    def _update_contact(self) -> None:
+        """Search, refresh the contact data and (if the pairing changed) the operator T."""
+        gathers = [c.update(self.layout) for c in self.contacts]
+        pattern = np.concatenate(gathers) if gathers else np.zeros(0, np.int64)
+        changed = self._pattern is None or not np.array_equal(pattern, self._pattern)
+        changed = self.comm.allreduce(changed, MPI.LOR)
+        if changed:
+            self._pattern = pattern
+            blocks = [(0, 0)] + [(2 + 2 * k, 1 + k) for k in range(len(self.contacts))]
+            self._T = chain_operator(self.full_layout, self.layout, blocks,
+                                     [1 + 2 * k for k in range(len(self.contacts))], gathers)
+            self._JT = None
+
+    def _residual(self, snes, x, F) -> None:
+        self._set_state(x)
+        r = self._r
+        with r.localForm() as r_local:
+            r_local.set(0.0)
+        fem_petsc.assemble_vector(r, self.residual_form)
+        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self._T.multTranspose(r, F)
+        if len(self._bc_rows):
+            u = self.u.x.array[self._bc_rows]
+            F.array[self._bc_rows] = u - self._prescribed(self.t)
+
+    def _assemble_jacobian_matrix(self, first: bool = False) -> PETSc.Mat:
+        K = self._K
+        K.zeroEntries()
+        fem_petsc.assemble_matrix(K, self.jacobian_form)
+        K.assemble()
+        if self._JT is None:
+            self._JT = K.PtAP(self._T)
+            new_pattern = True
+        else:
+            K.PtAP(self._T, result=self._JT)
+            new_pattern = False
+        if first:
+            J = self._JT.duplicate(copy=True)
+            J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+            self._zero_bc_rows(J)
+            return J
+        J = self._J
+        J.zeroEntries()
+        structure = (PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN if new_pattern
+                     else PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        J.axpy(1.0, self._JT, structure=structure)
+        if new_pattern:
+            J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+            self.snes.getKSP().getPC().reset()
+        self._zero_bc_rows(J)
+        return J
+
+    def _zero_bc_rows(self, J: PETSc.Mat) -> None:
+        rows = self.layout.owned(0, self._bc_rows).astype(PETSc.IntType)
+        J.zeroRows(rows, diag=1.0)
+
+    def _jacobian(self, snes, x, J, P) -> None:
+        self._set_state(x)
+        self._assemble_jacobian_matrix()
+
+    def evaluate_residual(self, x: PETSc.Vec) -> PETSc.Vec:
+        """The residual at the unknowns ``x`` (a new vector); sets the state to ``x``."""
+        F = self._R.duplicate()
+        self._residual(self.snes, x, F)
+        return F
+
+    def evaluate_jacobian(self, x: PETSc.Vec) -> PETSc.Mat:
+        """The Jacobian at the unknowns ``x`` (the solver's matrix); sets the state to ``x``."""
+        self._jacobian(self.snes, x, self._J, self._J)
+        return self._J
+
+    # -- load stepping --------------------------------------------------------------
+    def set_time(self, t: float) -> None:
+        """Set the pseudo-time (load factor) of loads and prescribed displacements."""
+        self.t = t
+        for load, c in self._load_constants:
+            c.value = evaluate(load.value, t)
+
+    def solve_step(self, t: float) -> tuple[bool, int, str]:
+        """Solve for pseudo-time ``t`` from the current state.
+
+        Returns
+        -------
+        converged, Newton iterations, SNES converged reason (name)
+        """
+        self.set_time(t)
+        fem_petsc.assign(self.unknowns, self.x)
+        self._state = None
+        self.snes.solve(None, self.x)
+        reason = self.snes.getConvergedReason()
+        self._state = None
+        self._set_state(self.x)
+        names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
+        return reason > 0, self.snes.getIterationNumber(), names.get(reason, str(reason))
+
+    def solve(self, num_steps: int = 10, t_end: float = 1.0, max_cutbacks: int = 8,
+              callback: Callable[[ContactProblem, StepRecord], None] | None = None) -> History:
+        """Load stepping from the current pseudo-time to ``t_end`` with cut-backs.
+
+        A step whose Newton solve diverges is restored and halved, at most ``max_cutbacks``
+        times in a row; then :class:`ConvergenceError` names the step. Accepted steps are in
+        :attr:`history` (and were passed to ``callback``) whatever happens later.
+        """
+        t0 = self.t
+        dt = (t_end - t0) / num_steps
+        failures = 0
+        while self.t < t_end - 1e-12 * abs(t_end):
+            t_new = min(self.t + dt, t_end)
+            saved = [f.x.array.copy() for f in self.unknowns]
+            t_prev = self.t
+            start = time.perf_counter()
+            ok, its, reason = self.solve_step(t_new)
+            if not ok:
+                for f, a in zip(self.unknowns, saved, strict=True):
+                    f.x.array[:] = a
+                self.set_time(t_prev)
+                self._state = None
+                self.history.cutbacks.append((t_new, reason))
+                failures += 1
+                self._print(f"  step to t = {t_new:.5g} failed ({reason}): cutting back")
+                if failures > max_cutbacks:
+                    raise ConvergenceError(
+                        f"load step from t = {t_prev:.6g} to t = {t_new:.6g} did not converge "
+                        f"({reason}) after {max_cutbacks} cut-backs")
+                dt *= 0.5
+                continue
+            failures = 0
+            record = StepRecord(len(self.history.steps) + 1, t_new, its, self.snes.getFunctionNorm(),
+                                self.active_points(), self.contact_force(),
+                                time.perf_counter() - start)
+            self.history.steps.append(record)
+            self._print(self._format(record))
+            if callback is not None:
+                callback(self, record)
+        return self.history
+
+    # -- results --------------------------------------------------------------------
+    def contact_force(self, k: int | None = None) -> np.ndarray:
+        """Resultant contact force on the slave body, ``int t_N nu dS_o`` (all pairs)."""
+        pairs = range(len(self.contacts)) if k is None else [k]
+        total = np.zeros(self.V.mesh.geometry.dim)
+        for j in pairs:
+            total += [self.comm.allreduce(dolfinx.fem.assemble_scalar(f), MPI.SUM)
+                      for f in self._contact_force_forms[j]]
+        return total
+
+    def active_points(self) -> int:
+        """Number of slave quadrature points in contact (all pairs)."""
+        return int(self.comm.allreduce(sum(c.active().sum() for c in self.contacts), MPI.SUM))
+
+    @property
+    def search_time(self) -> float:
+        """Seconds spent in the closest-point projection so far."""
+        return sum(c.search_time for c in self.contacts)
+
+    def _format(self, r: StepRecord) -> str:
+        force = " ".join(f"{f: .4e}" for f in r.contact_force)
+        return (f"step {r.step:3d}  t = {r.t:.4f}  newton {r.newton_iterations:2d}  "
+                f"|R| = {r.residual:.2e}  active {r.active_points:5d}  contact force [{force}]")
+
+    def _print(self, text: str) -> None:
+        if self.verbose and self.comm.rank == 0:
+            print(text, flush=True)

@@ -1,0 +1,74 @@
+"""A scene: bodies of one mesh, their materials, supports, loads and contact pairs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import dolfinx
+import numpy as np
+from mpi4py import MPI
+
+from contact_ufl.contact import ContactPair
+from contact_ufl.errors import collective_check
+from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet
+from contact_ufl.materials import Hyperelastic
+
+
+@dataclass(frozen=True)
+class Body:
+    """A body: the cells with ``tag`` and their material."""
+
+    tag: int
+    material: Hyperelastic
+    name: str = ""
+
+
+@dataclass
+class Scene:
+    """Everything the forms are built from.
+
+    Parameters
+    ----------
+    mesh
+        One mesh holding all bodies (disjoint, non-matching).
+    cell_tags, facet_tags
+        Tags of the bodies and of the boundary parts.
+    bodies
+        The bodies (cell tag and material).
+    contacts
+        Contact pairs (slave and master facet tags, parameters).
+    dirichlet
+        Prescribed displacements.
+    loads
+        Dead tractions and body forces.
+    """
+
+    mesh: dolfinx.mesh.Mesh
+    cell_tags: dolfinx.mesh.MeshTags
+    facet_tags: dolfinx.mesh.MeshTags
+    bodies: list[Body]
+    contacts: list[ContactPair] = field(default_factory=list)
+    dirichlet: list[Dirichlet] = field(default_factory=list)
+    loads: list[DeadTraction | BodyForce] = field(default_factory=list)
+
+    def validate(self) -> None:
+        """Check the scene against its mesh; raise a clear error on every rank."""
+        comm = self.mesh.comm
+        gdim, tdim = self.mesh.geometry.dim, self.mesh.topology.dim
+        collective_check(comm, gdim == tdim and gdim in (2, 3),
+                         f"solid bodies need a 2D (plane strain) or 3D mesh of full dimension; "
+                         f"got topological dimension {tdim} in {gdim}D")
+        collective_check(comm, self.cell_tags.dim == tdim,
+                         f"cell_tags have dimension {self.cell_tags.dim}, the mesh {tdim}")
+        collective_check(comm, self.facet_tags.dim == tdim - 1,
+                         f"facet_tags have dimension {self.facet_tags.dim}, expected {tdim - 1}")
+        collective_check(comm, len(self.bodies) > 0, "a scene needs at least one body")
+        for body in self.bodies:
+            count = comm.allreduce(len(self.cell_tags.find(body.tag)), MPI.SUM)
+            collective_check(comm, count > 0,
+                             f"body {body.name or body.tag}: cell tag {body.tag} has no cells")
+        facet_values = comm.allreduce(set(np.unique(self.facet_tags.values).tolist()), MPI.BOR)
+        for item in [*self.dirichlet, *[ld for ld in self.loads if isinstance(ld, DeadTraction)]]:
+            collective_check(comm, item.tag in facet_values,
+                             f"{type(item).__name__}: facet tag {item.tag} does not exist "
+                             f"(facet tags: {sorted(facet_values)})")

@@ -1,0 +1,281 @@
+"""Contact surfaces: the slave surface with its quadrature points, the master surface facets.
+
+The slave surface S_oc^(1) is a submesh of the tagged facets. It carries the multipliers and
+the per-quadrature-point data of the contact terms (quadrature elements on the submesh). The
+master surface S_oc^(2) is a set of oriented facets whose nodes are displacement dofs; its
+current geometry is interpolated from those nodes, so the closest-point projection and the
+master virtual displacement U2*(Y) use one and the same surface.
+
+Two facts of DOLFINx 0.11 fix the layout used here (see ``shared/dolfinx-0.11-notes.md``):
+
+* a quadrature element on the submesh stores values at the quadrature points of each
+  *submesh cell in its own reference orientation*, and a parent ``ds`` integral reads them
+  in that order; so the slave points are computed from the submesh cells, and mapped into
+  the parent cells through a vertex matching;
+* a facet of the parent mesh is on the boundary of exactly one cell, owned by the rank that
+  owns that cell.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import basix
+import dolfinx
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+from contact_ufl.errors import collective_check
+
+
+def _basix_cell(mesh: dolfinx.mesh.Mesh, dim: int) -> basix.CellType:
+    cell = mesh.topology.cell_type if dim == mesh.topology.dim else mesh.topology.entity_types[dim][0]
+    return getattr(basix.CellType, cell.name)
+
+
+def _coordinate_element(mesh: dolfinx.mesh.Mesh) -> basix.finite_element.FiniteElement:
+    return mesh.ufl_domain().ufl_coordinate_element().basix_element
+
+
+def _scalar_element(V: dolfinx.fem.FunctionSpace) -> basix.finite_element.FiniteElement:
+    element = V.ufl_element()
+    if element.num_sub_elements:
+        element = element.sub_elements[0]
+    return element.basix_element
+
+
+def tagged_facets(facet_tags: dolfinx.mesh.MeshTags, tag: int, role: str) -> npt.NDArray[np.int32]:
+    """Local facets carrying ``tag``; raise on every rank when no rank has any."""
+    comm = facet_tags.topology.comm
+    facets = facet_tags.find(tag)
+    total = comm.allreduce(len(facets), op=MPI.SUM)
+    known = comm.allreduce(set(np.unique(facet_tags.values).tolist()), op=MPI.BOR)
+    collective_check(
+        comm,
+        total > 0,
+        f"{role} surface: facet tag {tag} is empty or does not exist "
+        f"(tags present: {sorted(known)})",
+    )
+    return facets
+
+
+def exterior_facet_cells(
+    mesh: dolfinx.mesh.Mesh, facets: npt.NDArray[np.int32], role: str
+) -> tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]:
+    """The (cell, local facet) of boundary facets; raise if a facet is interior."""
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    mesh.topology.create_connectivity(tdim, tdim - 1)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    c2f = mesh.topology.connectivity(tdim, tdim - 1)
+    offsets = f2c.offsets
+    ncells = offsets[facets + 1] - offsets[facets]
+    collective_check(
+        mesh.comm,
+        bool(np.all(ncells == 1)),
+        f"{role} surface: {int(np.sum(ncells != 1))} tagged facets are interior facets "
+        "(a contact surface must be on the boundary of its body)",
+    )
+    cells = f2c.array[offsets[facets]]
+    nfc = c2f.offsets[1] - c2f.offsets[0]
+    cell_facets = c2f.array.reshape(-1, nfc)[cells]
+    local = np.argmax(cell_facets == facets[:, None], axis=1).astype(np.int32)
+    return cells.astype(np.int32), local
+
+
+@dataclass
+class SlaveSurface:
+    """The slave contact surface and its quadrature points.
+
+    Parameters
+    ----------
+    V
+        Displacement space of the (parent) mesh.
+    facet_tags
+        Facet tags of the mesh.
+    tag
+        Tag of the slave facets.
+    quadrature_degree
+        Degree of the quadrature rule of the contact integrals.
+
+    Attributes
+    ----------
+    submesh, entity_map
+        The facet submesh and its map to the parent mesh.
+    points_ref
+        Reference coordinates of the quadrature points in the submesh cell, ``(nq, fdim)``.
+    parent_cells
+        Parent cell of each owned submesh cell.
+    X
+        Reference (undeformed) positions of the quadrature points, ``(ncells, nq, gdim)``.
+    """
+
+    V: dolfinx.fem.FunctionSpace
+    facet_tags: dolfinx.mesh.MeshTags
+    tag: int
+    quadrature_degree: int
+    submesh: dolfinx.mesh.Mesh = field(init=False)
+    entity_map: dolfinx.mesh.EntityMap = field(init=False)
+
+    def __post_init__(self) -> None:
+        mesh = self.V.mesh
+        tdim, fdim = mesh.topology.dim, mesh.topology.dim - 1
+        facets = tagged_facets(self.facet_tags, self.tag, "slave")
+        cells, local = exterior_facet_cells(mesh, facets, "slave")
+        self.submesh, self.entity_map = dolfinx.mesh.create_submesh(mesh, fdim, facets)[:2]
+        num_owned = self.submesh.topology.index_map(fdim).size_local
+        sub_cells = np.arange(num_owned, dtype=np.int32)
+        parent = self.entity_map.sub_topology_to_topology(sub_cells, inverse=False)
+        order = np.argsort(facets)
+        pos = order[np.searchsorted(facets, parent, sorter=order)]
+        self.parent_cells = cells[pos]
+        parent_local = local[pos]
+
+        sub_cell = _basix_cell(self.submesh, fdim)
+        self.points_ref, self.weights_ref = basix.make_quadrature(sub_cell, self.quadrature_degree)
+        self.num_points = len(self.weights_ref)
+        ref = self._parent_reference_points(sub_cell, parent_local, tdim)
+        self._ref = ref
+        nc, nq = len(self.parent_cells), self.num_points
+        flat = ref.reshape(-1, tdim)
+        cmap = _coordinate_element(mesh)
+        phi_geom = cmap.tabulate(0, flat)[0, :, :, 0].reshape(nc, nq, -1)
+        xg = mesh.geometry.x[mesh.geometry.dofmaps[0][self.parent_cells], : mesh.geometry.dim]
+        self.X = np.einsum("cqn,cnd->cqd", phi_geom, xg)
+        nv = len(basix.topology(sub_cell)[0])
+        vertices = self.submesh.geometry.x[self.submesh.geometry.dofmaps[0][:nc, :nv],
+                                           : mesh.geometry.dim]
+        self.normals = outward_normals(vertices, xg.mean(axis=1))
+        phi_u = _scalar_element(self.V).tabulate(0, flat)[0, :, :, 0]
+        self._phi_u = phi_u.reshape(nc, nq, -1)
+        self._cell_dofs = self.V.dofmap.list[self.parent_cells]
+
+    def _parent_reference_points(self, sub_cell, parent_local, tdim) -> np.ndarray:
+        """Map the submesh quadrature points into the parent reference cells.
+
+        The submesh cell's vertices are a permutation of its parent facet's vertices; matching
+        them by position gives an affine map between the two reference facets.
+        """
+        mesh = self.V.mesh
+        gdim, fdim = mesh.geometry.dim, tdim - 1
+        parent_cell = _basix_cell(mesh, tdim)
+        ref_vertices = basix.geometry(parent_cell)
+        facet_vertices = np.array(basix.topology(parent_cell)[fdim])  # (nfacets, nv)
+        nv = facet_vertices.shape[1]
+        # vertex positions of the parent facets (geometry nodes = first nodes are vertices)
+        cell_nodes = mesh.geometry.dofmaps[0][self.parent_cells]
+        local_vertices = facet_vertices[parent_local]  # (nc, nv)
+        xpar = mesh.geometry.x[np.take_along_axis(cell_nodes, local_vertices, axis=1), :gdim]
+        sub_nodes = self.submesh.geometry.dofmaps[0][: len(self.parent_cells), :nv]
+        xsub = self.submesh.geometry.x[sub_nodes, :gdim]
+        dist = np.linalg.norm(xsub[:, :, None, :] - xpar[:, None, :, :], axis=-1)
+        perm = np.argmin(dist, axis=2)  # sub vertex i == parent facet vertex perm[i]
+        vert_ref = ref_vertices[np.take_along_axis(local_vertices, perm, axis=1)]  # (nc, nv, tdim)
+        p1 = basix.create_element(basix.ElementFamily.P, sub_cell, 1)
+        phi = p1.tabulate(0, self.points_ref)[0, :, :, 0]  # (nq, nv)
+        return np.einsum("qv,cvd->cqd", phi, vert_ref)
+
+    @property
+    def num_cells(self) -> int:
+        """Owned submesh cells (slave facets) on this rank."""
+        return len(self.parent_cells)
+
+    def displacement(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Displacement at the quadrature points, ``(ncells, nq, gdim)``."""
+        bs = self.V.dofmap.index_map_bs
+        values = u.x.array.reshape(-1, bs)[self._cell_dofs]  # (nc, ndofs, gdim)
+        return np.einsum("cqn,cnd->cqd", self._phi_u, values)
+
+    def positions(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Current positions x = X + u of the quadrature points, ``(ncells, nq, gdim)``."""
+        return self.X + self.displacement(u)
+
+    def bounding_box(self, x: np.ndarray, comm: MPI.Comm) -> np.ndarray:
+        """Bounding box ``(2, gdim)`` of the points of this rank (inverted if none)."""
+        gdim = self.V.mesh.geometry.dim
+        if x.size == 0:
+            return np.vstack([np.full(gdim, np.inf), np.full(gdim, -np.inf)])
+        pts = x.reshape(-1, gdim)
+        return np.vstack([pts.min(axis=0), pts.max(axis=0)])
+
+
+@dataclass
+class MasterSurface:
+    """The master contact surface: oriented facets whose nodes are displacement dofs.
+
+    Facet nodes are the vertices of the facets (linear segments, triangles, bilinear
+    quadrilaterals), ordered so that the normal of ``contact_ufl.projection`` points out of
+    the master body.
+
+    Attributes
+    ----------
+    nodes
+        Local block index (displacement dof block) of each facet node, ``(nf, nn)``.
+    X_nodes
+        Reference positions of the nodes, ``(nf, nn, gdim)``.
+    global_nodes
+        Global block index of each node in the displacement index map, ``(nf, nn)``.
+    facet_ids
+        A global, rank-independent id of each facet (global index of its first node and
+        the others, hashed into one int64), used for tie-breaking and change detection.
+    """
+
+    V: dolfinx.fem.FunctionSpace
+    facet_tags: dolfinx.mesh.MeshTags
+    tag: int
+
+    def __post_init__(self) -> None:
+        mesh = self.V.mesh
+        tdim, fdim = mesh.topology.dim, mesh.topology.dim - 1
+        facets = tagged_facets(self.facet_tags, self.tag, "master")
+        num_owned = mesh.topology.index_map(fdim).size_local
+        facets = facets[facets < num_owned]
+        cells, local = exterior_facet_cells(mesh, facets, "master")
+        layout = self.V.dofmap.dof_layout
+        nv = basix.topology(_basix_cell(mesh, tdim))[fdim][0].__len__()
+        closure = np.array([layout.entity_closure_dofs(fdim, f)[:nv] for f in range(len(
+            basix.topology(_basix_cell(mesh, tdim))[fdim]))])
+        cell_dofs = self.V.dofmap.list[cells]
+        nodes = np.take_along_axis(cell_dofs, closure[local], axis=1)
+        coords = self.V.tabulate_dof_coordinates()[:, : mesh.geometry.dim]
+        X = coords[nodes]
+        # orient: the normal must point away from the cell
+        cell_centre = coords[cell_dofs].mean(axis=1)
+        flip = np.einsum("fd,fd->f", _facet_normals(X), X.mean(axis=1) - cell_centre) < 0.0
+        swap = (0, 1) if nv == 2 else (1, 2)
+        nodes[flip, swap[0]], nodes[flip, swap[1]] = nodes[flip, swap[1]], nodes[flip, swap[0]]
+        self.nodes = nodes
+        self.X_nodes = coords[nodes]
+        imap = self.V.dofmap.index_map
+        self.global_nodes = imap.local_to_global(nodes.ravel().astype(np.int32)).reshape(
+            nodes.shape
+        )
+
+    @property
+    def num_facets(self) -> int:
+        """Owned master facets on this rank."""
+        return len(self.nodes)
+
+    def current_nodes(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Current node positions ``(nf, nn, gdim)``."""
+        bs = self.V.dofmap.index_map_bs
+        return self.X_nodes + u.x.array.reshape(-1, bs)[self.nodes]
+
+
+def _facet_normals(X: np.ndarray) -> np.ndarray:
+    """Un-normalised normals of oriented facets under the projection's conventions."""
+    if X.shape[1] == 2:
+        a = X[:, 1] - X[:, 0]
+        return np.stack([a[:, 1], -a[:, 0]], axis=1)
+    if X.shape[1] == 3:
+        return np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
+    return np.cross(X[:, 1] - X[:, 0] + X[:, 3] - X[:, 2], X[:, 2] - X[:, 0] + X[:, 3] - X[:, 1])
+
+
+def outward_normals(vertices: np.ndarray, cell_centres: np.ndarray) -> np.ndarray:
+    """Unit normals of facets given by their vertices, pointing away from their cells."""
+    n = _facet_normals(vertices)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    sign = np.sign(np.einsum("fd,fd->f", n, vertices.mean(axis=1) - cell_centres))
+    return n * sign[:, None]
