@@ -1,0 +1,650 @@
+"""Closest-point projection of many slave points onto a master surface made of facets.
+
+Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search), vectorised over
+points and facets: the only Python loops run over a fixed small number of items (edges of a
+facet, Newton iterations, K-doublings of the neighbour search, blocks of points).
+
+Facet kinds and conventions
+---------------------------
+The master facets are given as ``nodes``, an array ``(nf, nn, gdim)`` of current node
+positions, already oriented by the caller. The kind follows from ``(nn, gdim)``:
+
+* segment, ``nn = 2, gdim = 2``: ``N = [1 - xi, xi]``, ``xi`` in ``[0, 1]``,
+  ``a1 = x1 - x0``, normal ``nu = (a1[1], -a1[0]) / |a1|``;
+* triangle, ``nn = 3, gdim = 3``: ``N = [1 - xi1 - xi2, xi1, xi2]``, ``a1 = x1 - x0``,
+  ``a2 = x2 - x0``, ``nu = a1 x a2 / |a1 x a2|``;
+* quadrilateral, ``nn = 4, gdim = 3``, bilinear in the basix vertex order:
+  ``N = [(1-s)(1-t), s(1-t), (1-s)t, st]``, ``(s, t)`` in ``[0, 1]^2``, ``a1 = dy/ds``,
+  ``a2 = dy/dt``, ``nu = a1 x a2 / |a1 x a2|`` (not constant on a warped quadrilateral).
+
+With these conventions the proximity ``g = -nu . (x - y)`` is positive when the slave point
+``x`` lies behind the master surface (penetration) and negative when it is in front of it.
+
+Linearisation
+-------------
+The reference coordinates ``xi`` of the closest point move with the slave point ``x`` and the
+master nodes ``x_a`` as ``d(xi) = M b``, with
+
+``b_alpha = a_alpha . (dx - sum_a N_a dx_a) + (x - y) . sum_a dN_a/dxi^alpha dx_a``
+
+and ``A_ab = a_a . a_b - (x - y) . d(a_a)/d(xi^b)``. ``M`` depends on where the closest point
+lies, classified with the exact clamped reference coordinates (a coordinate clamped to its bound
+is on that bound, one that is not clamped is not):
+
+* strictly inside the facet: ``M = A^-1``;
+* on an edge (one bound active, for the triangle ``xi1 = 0``, ``xi2 = 0`` or the hypotenuse
+  ``xi1 + xi2 = 1``), ``t`` the edge direction in reference space: ``M = t t^T / (t^T A t)``;
+* at a vertex (end point of a segment, two bounds active): ``M = 0``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.spatial import cKDTree
+
+__all__ = ["Projection", "closest_points", "facet_kind", "shape_functions"]
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+#: Facet kind of each supported ``(nn, gdim)``.
+_KINDS = {(2, 2): "segment", (3, 3): "triangle", (4, 3): "quadrilateral"}
+
+#: Straight edges of each 2D facet kind: (start node, end node, xi at start, xi at end).
+#: Along an edge ``xi = xi_start + u (xi_end - xi_start)``, ``y = x_start + u (x_end - x_start)``.
+_EDGES = {
+    "triangle": (
+        (0, 1, (0.0, 0.0), (1.0, 0.0)),  # xi2 = 0
+        (1, 2, (1.0, 0.0), (0.0, 1.0)),  # xi1 + xi2 = 1
+        (0, 2, (0.0, 0.0), (0.0, 1.0)),  # xi1 = 0
+    ),
+    "quadrilateral": (
+        (0, 1, (0.0, 0.0), (1.0, 0.0)),  # t = 0
+        (1, 3, (1.0, 0.0), (1.0, 1.0)),  # s = 1
+        (2, 3, (0.0, 1.0), (1.0, 1.0)),  # t = 1
+        (0, 2, (0.0, 0.0), (0.0, 1.0)),  # s = 0
+    ),
+}
+
+_K0 = 8  # first number of neighbours asked from the KD-tree
+_BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
+_NEWTON_ITERATIONS = 25
+_NEWTON_TOL = 1e-13  # on the reference-coordinate step
+_TIE = 1e-10  # relative distance tolerance of the tie-break
+
+
+@dataclass
+class Projection:
+    """Closest points of slave points on a master surface.
+
+    Attributes
+    ----------
+    facet : ndarray of int64, shape (np,)
+        Index into the facets given of the facet holding the closest point, ``-1`` where no
+        facet lies within the search radius.
+    xi : ndarray, shape (np, fdim)
+        Reference coordinates of the closest point on that facet.
+    y : ndarray, shape (np, gdim)
+        Closest point ``y = sum_a N_a(xi) x_a``.
+    normal : ndarray, shape (np, gdim)
+        Master unit normal ``nu`` at ``xi``.
+    gap : ndarray, shape (np,)
+        Proximity ``g = -nu . (x - y)``; ``g > 0`` means penetration.
+    distance : ndarray, shape (np,)
+        ``|x - y|``.
+    sliding : ndarray, shape (np, fdim, fdim)
+        Linearisation matrix ``M``: ``d(xi) = M b`` (see the module docstring).
+
+    Notes
+    -----
+    Where ``facet == -1`` the other fields hold placeholders: ``xi = 0``, ``y = x`` (the slave
+    point itself), ``normal = 0``, ``distance = inf``, ``gap = -inf`` (never in contact) and
+    ``sliding = 0``.
+    """
+
+    facet: IntArray
+    xi: FloatArray
+    y: FloatArray
+    normal: FloatArray
+    gap: FloatArray
+    distance: FloatArray
+    sliding: FloatArray
+
+
+def facet_kind(nn: int, gdim: int) -> str:
+    """Name the facet kind of ``nn`` nodes in dimension ``gdim``.
+
+    Parameters
+    ----------
+    nn : int
+        Number of nodes of a facet.
+    gdim : int
+        Geometric dimension.
+
+    Returns
+    -------
+    str
+        ``"segment"``, ``"triangle"`` or ``"quadrilateral"``.
+
+    Raises
+    ------
+    ValueError
+        For any other combination.
+    """
+    try:
+        return _KINDS[(int(nn), int(gdim))]
+    except KeyError:
+        raise ValueError(
+            f"unsupported master facet: {nn} nodes in {gdim}D "
+            "(segments: 2 nodes in 2D; triangles: 3 nodes, quadrilaterals: 4 nodes in 3D)"
+        ) from None
+
+
+def shape_functions(
+    nn: int, gdim: int, xi: npt.ArrayLike
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Shape functions of a master facet and their first and second derivatives.
+
+    Parameters
+    ----------
+    nn : int
+        Number of nodes of the facet (2, 3 or 4).
+    gdim : int
+        Geometric dimension (2 for segments, 3 otherwise).
+    xi : array_like, shape (np, fdim)
+        Reference coordinates, ``fdim = gdim - 1``.
+
+    Returns
+    -------
+    N : ndarray, shape (np, nn)
+        Shape functions.
+    dN : ndarray, shape (np, nn, fdim)
+        ``dN[p, a, alpha] = dN_a / dxi^alpha``.
+    d2N : ndarray, shape (np, nn, fdim, fdim)
+        ``d2N[p, a, alpha, beta] = d2N_a / dxi^alpha dxi^beta``.
+    """
+    kind = facet_kind(nn, gdim)
+    fdim = gdim - 1
+    xi = np.asarray(xi, dtype=np.float64).reshape(-1, fdim)
+    npts = xi.shape[0]
+    dN = np.zeros((npts, nn, fdim))
+    d2N = np.zeros((npts, nn, fdim, fdim))
+    if kind == "segment":
+        u = xi[:, 0]
+        N = np.stack([1.0 - u, u], axis=1)
+        dN[:, :, 0] = [-1.0, 1.0]
+    elif kind == "triangle":
+        N = np.stack([1.0 - xi[:, 0] - xi[:, 1], xi[:, 0], xi[:, 1]], axis=1)
+        dN[:] = [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]
+    else:
+        s, t = xi[:, 0], xi[:, 1]
+        N = np.stack([(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t], axis=1)
+        dN[:, :, 0] = np.stack([t - 1.0, 1.0 - t, -t, t], axis=1)
+        dN[:, :, 1] = np.stack([s - 1.0, -s, 1.0 - s, s], axis=1)
+        d2N[:, :, 0, 1] = d2N[:, :, 1, 0] = [1.0, -1.0, -1.0, 1.0]
+    return N, dN, d2N
+
+
+def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
+    return np.einsum("...i,...i->...", a, b)
+
+
+def _unit_normal(a: FloatArray) -> FloatArray:
+    """Unit normal from the tangent vectors ``a`` (P, fdim, gdim); zero if degenerate."""
+    if a.shape[1] == 1:
+        n = np.stack([a[:, 0, 1], -a[:, 0, 0]], axis=1)
+    else:
+        n = np.cross(a[:, 0], a[:, 1])
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+
+
+def _segment_params(x: FloatArray, p: FloatArray, e: FloatArray) -> FloatArray:
+    """Clamped parameter of the projection of ``x`` on the segments ``p + u e``, u in [0, 1]."""
+    ee = _dot(e, e)
+    u = _dot(x - p, e) / np.where(ee > 0, ee, 1.0)
+    return np.clip(u, 0.0, 1.0)
+
+
+@dataclass
+class _Pairs:
+    """Exact projections of (point, facet) pairs."""
+
+    xi: FloatArray  # (P, fdim)
+    dist: FloatArray  # (P,)
+    edge: IntArray  # (P,) -1 interior, else edge number in _EDGES[kind]
+    vertex: npt.NDArray[np.bool_]  # (P,) closest point at a vertex
+
+
+class _Master:
+    """Master facets with the per-facet data of the search and the projections."""
+
+    def __init__(self, nodes: FloatArray) -> None:
+        self.nodes = nodes
+        self.nf, self.nn, self.gdim = nodes.shape
+        self.fdim = self.gdim - 1
+        self.kind = facet_kind(self.nn, self.gdim)
+        self.centroid = nodes.mean(axis=1)
+        # every point of a facet is a convex combination of its nodes (also for the bilinear
+        # quadrilateral), so it lies within this radius of the centroid, which is on the facet
+        self.size = np.linalg.norm(nodes - self.centroid[:, None], axis=2).max(axis=1)
+        self.R_max = float(self.size.max()) if self.nf else 0.0
+        self.tree = cKDTree(self.centroid) if self.nf else None
+        # slab of the facet: unit normal at the centroid, largest node offset along it
+        half = np.full((1, self.fdim), 0.5)
+        _, dN, _ = shape_functions(self.nn, self.gdim, half)
+        self.axis = _unit_normal(np.einsum("na,fng->fag", dN[0], nodes))
+        offset = np.einsum("fng,fg->fn", nodes - self.centroid[:, None], self.axis)
+        self.thickness = np.abs(offset).max(axis=1)
+        if self.kind == "triangle":
+            a1 = nodes[:, 1] - nodes[:, 0]
+            a2 = nodes[:, 2] - nodes[:, 0]
+            g11, g12, g22 = _dot(a1, a1), _dot(a1, a2), _dot(a2, a2)
+            det = g11 * g22 - g12 * g12
+            ok = det > 1e-14 * g11 * g22
+            inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)  # degenerate: never inside
+            self.gram_inv = np.stack([g22 * inv, -g12 * inv, g11 * inv], axis=1)
+        elif self.kind == "quadrilateral":
+            x0, x1, x2, x3 = (nodes[:, a] for a in range(4))
+            self.bilinear = np.stack([x0, x1 - x0, x2 - x0, x0 - x1 - x2 + x3], axis=1)
+
+    def lower_bound(self, x: FloatArray, f: IntArray) -> FloatArray:
+        """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``.
+
+        Every facet point ``p`` lies in the convex hull of the nodes, so within ``R_f`` of the
+        centroid ``c`` and within ``T_f`` of it along the normal ``n`` at the centre: with
+        ``d = x - c``, ``|x - p|^2 >= (|n . d| - T_f)_+^2 + (|d - (n . d) n| - R_f)_+^2``.
+        """
+        d = x - self.centroid[f]
+        normal = np.abs(_dot(d, self.axis[f]))
+        tangent = np.sqrt(np.maximum(_dot(d, d) - normal * normal, 0.0))
+        return np.hypot(
+            np.maximum(normal - self.thickness[f], 0.0), np.maximum(tangent - self.size[f], 0.0)
+        )
+
+    # -- exact projections on (point, facet) pairs ----------------------------------------
+
+    def project(self, x: FloatArray, f: IntArray, pid: IntArray, npts: int) -> _Pairs:
+        """Project the points ``x`` (P, gdim) on the facets ``f`` (P,).
+
+        ``pid`` (P,) numbers the points of the pairs (``0 <= pid < npts``); the quadrilateral
+        projection uses it to skip the facets that cannot hold the closest point.
+        """
+        if self.kind == "segment":
+            p = self.nodes[f, 0]
+            u = _segment_params(x, p, self.nodes[f, 1] - p)
+            y = p + u[:, None] * (self.nodes[f, 1] - p)
+            return _Pairs(
+                xi=u[:, None],
+                dist=np.linalg.norm(x - y, axis=1),
+                edge=np.full(u.shape, -1, dtype=np.int64),
+                vertex=(u == 0.0) | (u == 1.0),
+            )
+        pairs = self._edges(x, f)
+        if self.kind == "triangle":
+            self._triangle_interior(x, f, pairs)
+        else:
+            self._quadrilateral_interior(x, f, pid, npts, pairs)
+        return pairs
+
+    def _edges(self, x: FloatArray, f: IntArray) -> _Pairs:
+        """Closest point on the straight edges of each facet."""
+        P = x.shape[0]
+        best_d = np.full(P, np.inf)
+        best_u = np.zeros(P)
+        best_k = np.zeros(P, dtype=np.int64)
+        for k, (a, b, _, _) in enumerate(_EDGES[self.kind]):
+            p = self.nodes[f, a]
+            e = self.nodes[f, b] - p
+            u = _segment_params(x, p, e)
+            d = np.linalg.norm(x - p - u[:, None] * e, axis=1)
+            better = d < best_d
+            best_d = np.where(better, d, best_d)
+            best_u = np.where(better, u, best_u)
+            best_k = np.where(better, k, best_k)
+        starts = np.array([s for _, _, s, _ in _EDGES[self.kind]])
+        ends = np.array([e for _, _, _, e in _EDGES[self.kind]])
+        xi = starts[best_k] + best_u[:, None] * (ends[best_k] - starts[best_k])
+        return _Pairs(xi=xi, dist=best_d, edge=best_k, vertex=(best_u == 0.0) | (best_u == 1.0))
+
+    def _triangle_interior(self, x: FloatArray, f: IntArray, pairs: _Pairs) -> None:
+        """Replace the edge result by the projection on the plane where that is inside."""
+        x0 = self.nodes[f, 0]
+        a1 = self.nodes[f, 1] - x0
+        a2 = self.nodes[f, 2] - x0
+        r = x - x0
+        b1, b2 = _dot(r, a1), _dot(r, a2)
+        gi = self.gram_inv[f]
+        xi1 = gi[:, 0] * b1 + gi[:, 1] * b2
+        xi2 = gi[:, 1] * b1 + gi[:, 2] * b2
+        inside = (xi1 > 0.0) & (xi2 > 0.0) & (xi1 + xi2 < 1.0)
+        if not inside.any():
+            return
+        i = np.flatnonzero(inside)
+        xi = np.stack([xi1[i], xi2[i]], axis=1)
+        y = x0[i] + xi[:, :1] * a1[i] + xi[:, 1:] * a2[i]
+        pairs.xi[i] = xi
+        pairs.dist[i] = np.linalg.norm(x[i] - y, axis=1)
+        pairs.edge[i] = -1
+        pairs.vertex[i] = False
+
+    def _quadrilateral_interior(
+        self, x: FloatArray, f: IntArray, pid: IntArray, npts: int, pairs: _Pairs
+    ) -> None:
+        """Replace the edge result by an interior stationary point where that is closer."""
+        # skip the pairs whose facet is farther than a facet point of another pair (upper
+        # bounds: the distances to the centroid and to the edges)
+        dc = np.linalg.norm(x - self.centroid[f], axis=1)
+        upper = np.full(npts, np.inf)
+        np.minimum.at(upper, pid, np.minimum(dc, pairs.dist))
+        lower = self.lower_bound(x, f)
+        todo = np.flatnonzero(lower <= upper[pid] * (1 + 1e-9) + 1e-9 * self.size[f])
+        if todo.size == 0:
+            return
+        X = x[todo]
+        coef = self.bilinear[f[todo]]
+        xi, dist, conv, pd = _quad_newton(X, coef, np.full((todo.size, 2), 0.5))
+        # not converged, or stuck inside at a saddle or maximum: restart from four other points
+        inner = np.all((xi > 0.0) & (xi < 1.0), axis=1)
+        redo = np.flatnonzero(~conv | (inner & ~pd))
+        if redo.size:
+            for start in ((0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)):
+                xi_r, dist_r, _, pd_r = _quad_newton(
+                    X[redo], coef[redo], np.tile(start, (redo.size, 1))
+                )
+                inner_r = np.all((xi_r > 0.0) & (xi_r < 1.0), axis=1)
+                inner = np.all((xi[redo] > 0.0) & (xi[redo] < 1.0), axis=1)
+                better = inner_r & (~inner | (dist_r < dist[redo]))
+                xi[redo[better]] = xi_r[better]
+                dist[redo[better]] = dist_r[better]
+        inner = np.all((xi > 0.0) & (xi < 1.0), axis=1)
+        take = inner & (dist < pairs.dist[todo])
+        i = todo[take]
+        pairs.xi[i] = xi[take]
+        pairs.dist[i] = dist[take]
+        pairs.edge[i] = -1
+        pairs.vertex[i] = False
+
+
+def _quad_newton(
+    x: FloatArray, coef: FloatArray, xi: FloatArray
+) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+    """Minimise ``|x - y(s, t)|^2`` over ``[0, 1]^2`` on bilinear patches by projected Newton.
+
+    ``y = c0 + s c1 + t c2 + s t c3`` with ``coef = [c0, c1, c2, c3]`` (P, 4, 3). The Hessian
+    is replaced by the Gauss-Newton matrix where it is not positive definite; a coordinate on
+    a bound that the gradient pushes outwards is held there; the iterate is clamped to the box
+    after each step, and a step that increases the distance is halved (at most three times).
+
+    Returns the final ``xi`` (P, 2), its distance, whether the step fell below the tolerance,
+    and whether the Hessian is positive definite there.
+    """
+    P = x.shape[0]
+    xi = xi.copy()
+    conv = np.zeros(P, dtype=bool)
+    act = np.arange(P)
+
+    def residual(xi_: FloatArray, c: FloatArray, X: FloatArray) -> FloatArray:
+        s, t = xi_[:, :1], xi_[:, 1:]
+        return X - (c[:, 0] + s * c[:, 1] + t * c[:, 2] + s * t * c[:, 3])
+
+    for _ in range(_NEWTON_ITERATIONS):
+        if act.size == 0:
+            break
+        c, X, z = coef[act], x[act], xi[act]
+        a1 = c[:, 1] + z[:, 1:] * c[:, 3]
+        a2 = c[:, 2] + z[:, :1] * c[:, 3]
+        r = residual(z, c, X)
+        g1, g2 = -_dot(r, a1), -_dot(r, a2)
+        h11, h22, h12gn = _dot(a1, a1), _dot(a2, a2), _dot(a1, a2)
+        h12 = h12gn - _dot(r, c[:, 3])
+        det = h11 * h22 - h12 * h12
+        indefinite = det <= 1e-12 * h11 * h22
+        h12 = np.where(indefinite, h12gn, h12)
+        det = h11 * h22 - h12 * h12
+        det = np.where(det > 0, det, np.inf)  # degenerate patch: no step
+        step = np.stack([-(h22 * g1 - h12 * g2) / det, -(h11 * g2 - h12 * g1) / det], axis=1)
+        # projected Newton: a coordinate on a bound that the gradient pushes out stays there,
+        # the other one takes a one-dimensional Newton step (d2f/dxi_i^2 = |a_i|^2)
+        fix1 = ((z[:, 0] <= 0.0) & (g1 > 0.0)) | ((z[:, 0] >= 1.0) & (g1 < 0.0))
+        fix2 = ((z[:, 1] <= 0.0) & (g2 > 0.0)) | ((z[:, 1] >= 1.0) & (g2 < 0.0))
+        one = fix1 ^ fix2
+        step[one, 0] = np.where(fix1[one], 0.0, -g1[one] / np.where(h11[one] > 0, h11[one], np.inf))
+        step[one, 1] = np.where(fix2[one], 0.0, -g2[one] / np.where(h22[one] > 0, h22[one], np.inf))
+        step[fix1 & fix2] = 0.0
+        f0 = _dot(r, r)
+        new = np.clip(z + step, 0.0, 1.0)
+        for _ in range(3):
+            rn = residual(new, c, X)
+            worse = _dot(rn, rn) > f0 * (1 + 1e-10)  # not rounding noise near the minimum
+            if not worse.any():
+                break
+            step[worse] *= 0.5
+            new[worse] = np.clip(z[worse] + step[worse], 0.0, 1.0)
+        done = np.abs(new - z).max(axis=1) <= _NEWTON_TOL
+        xi[act] = new
+        conv[act[done]] = True
+        act = act[~done]
+
+    s, t = xi[:, :1], xi[:, 1:]
+    a1 = coef[:, 1] + t * coef[:, 3]
+    a2 = coef[:, 2] + s * coef[:, 3]
+    r = residual(xi, coef, x)
+    h11, h22 = _dot(a1, a1), _dot(a2, a2)
+    h12 = _dot(a1, a2) - _dot(r, coef[:, 3])
+    pd = (h11 > 0) & (h11 * h22 - h12 * h12 > 0)
+    return xi, np.linalg.norm(r, axis=1), conv, pd
+
+
+def _candidates(
+    master: _Master, x: FloatArray, bound: FloatArray, active: IntArray
+) -> tuple[IntArray, IntArray]:
+    """All (point, facet) pairs with the facet's centroid within ``bound`` of the point.
+
+    ``cKDTree.query`` takes one scalar ``distance_upper_bound``; it is given the largest bound
+    of the points queried, and every point's own bound is then applied to its neighbours. A
+    point whose K-th neighbour is within its bound may have more: it is queried again with
+    twice as many neighbours, until none is cut off or K reaches the number of facets.
+    """
+    nf = master.nf
+    K = min(_K0, nf)
+    pids, fids = [], []
+    pending = active
+    while pending.size:
+        d, i = master.tree.query(
+            x[pending], k=K, distance_upper_bound=float(bound[pending].max()) * (1 + 1e-12)
+        )
+        d, i = d.reshape(-1, K), i.reshape(-1, K)
+        within = d <= bound[pending, None]
+        cut = within[:, -1] if K < nf else np.zeros(pending.size, dtype=bool)
+        keep = within & ~cut[:, None]
+        rows, cols = np.nonzero(keep)
+        pids.append(pending[rows])
+        fids.append(i[rows, cols])
+        pending = pending[cut]
+        K = min(2 * K, nf)
+    return np.concatenate(pids).astype(np.int64), np.concatenate(fids).astype(np.int64)
+
+
+def _sliding(
+    master: _Master,
+    xi: FloatArray,
+    a: FloatArray,
+    r: FloatArray,
+    d2N: FloatArray,
+    f: IntArray,
+    edge: IntArray,
+    vertex: npt.NDArray[np.bool_],
+) -> FloatArray:
+    """Linearisation matrix ``M`` of the closest points (see the module docstring)."""
+    P, fdim = xi.shape
+    # A_ab = a_a . a_b - (x - y) . d(a_a)/d(xi^b),  d(a_a)/d(xi^b) = sum_n d2N_n x_n
+    curv = np.einsum("pnab,png->pabg", d2N, master.nodes[f])
+    A = np.einsum("pag,pbg->pab", a, a) - np.einsum("pg,pabg->pab", r, curv)
+    M = np.zeros((P, fdim, fdim))
+    if fdim == 1:
+        interior = ~vertex
+        A11 = A[:, 0, 0]
+        ok = interior & (A11 != 0)
+        M[ok, 0, 0] = 1.0 / A11[ok]
+        return M
+    interior = (edge < 0) & ~vertex
+    det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+    ok = interior & (det != 0)
+    inv = 1.0 / det[ok]
+    M[ok, 0, 0] = A[ok, 1, 1] * inv
+    M[ok, 1, 1] = A[ok, 0, 0] * inv
+    M[ok, 0, 1] = -A[ok, 0, 1] * inv
+    M[ok, 1, 0] = -A[ok, 1, 0] * inv
+    on_edge = (edge >= 0) & ~vertex
+    if on_edge.any():
+        tangents = np.array([np.subtract(e, s) for _, _, s, e in _EDGES[master.kind]])
+        t = tangents[edge[on_edge]]
+        tAt = np.einsum("pa,pab,pb->p", t, A[on_edge], t)
+        tAt = np.where(tAt != 0, tAt, np.inf)
+        M[on_edge] = t[:, :, None] * t[:, None, :] / tAt[:, None, None]
+    return M
+
+
+def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projection) -> None:
+    """Fill ``out`` (arrays of this block of points) with the closest points of ``x``."""
+    npts = x.shape[0]
+    d0, nearest = master.tree.query(x, k=1)
+    d0 = np.asarray(d0).reshape(-1)
+    nearest = np.asarray(nearest, dtype=np.int64).reshape(-1)
+    active = np.flatnonzero(d0 <= radius + master.R_max)
+    if active.size == 0:
+        return
+    # tighter than d0: the exact distance to the facet of the nearest centroid (<= d0)
+    d1 = np.full(npts, np.inf)
+    d1[active] = master.project(
+        x[active], nearest[active], np.arange(active.size), active.size
+    ).dist
+    reach = np.minimum(d1, radius)
+    bound = (reach + master.R_max) * (1 + 1e-12)
+    pid, fid = _candidates(master, x, bound, active)
+    lower = master.lower_bound(x[pid], fid)
+    keep = lower <= reach[pid] * (1 + 1e-9) + 1e-9 * master.size[fid]
+    pid, fid = pid[keep], fid[keep]
+    pairs = master.project(x[pid], fid, pid, npts)
+
+    # minimum per point; ties (shared edges and vertices) go to the best-aligned normal
+    dmin = np.full(npts, np.inf)
+    np.minimum.at(dmin, pid, pairs.dist)
+    tie = pairs.dist <= dmin[pid] + _TIE * (dmin[pid] + 2.0 * master.size[fid])
+    e = np.flatnonzero(tie)
+    N, dN, _ = shape_functions(master.nn, master.gdim, pairs.xi[e])
+    X = master.nodes[fid[e]]
+    r = x[pid[e]] - np.einsum("pn,png->pg", N, X)
+    nu = _unit_normal(np.einsum("pna,png->pag", dN, X))
+    rn = np.linalg.norm(r, axis=1)
+    align = np.divide(np.abs(_dot(nu, r)), rn, out=np.zeros_like(rn), where=rn > 0)
+    order = np.lexsort((-align, pid[e]))
+    first = np.ones(order.size, dtype=bool)
+    first[1:] = pid[e][order[1:]] != pid[e][order[:-1]]
+    best = e[order[first]]
+
+    p, f, xi = pid[best], fid[best], pairs.xi[best]
+    N, dN, d2N = shape_functions(master.nn, master.gdim, xi)
+    X = master.nodes[f]
+    y = np.einsum("pn,png->pg", N, X)
+    r = x[p] - y
+    dist = np.linalg.norm(r, axis=1)
+    inside = dist <= radius
+    p, f, xi, y, r, dist = p[inside], f[inside], xi[inside], y[inside], r[inside], dist[inside]
+    dN, d2N, best = dN[inside], d2N[inside], best[inside]
+    a = np.einsum("pna,png->pag", dN, X[inside])
+    nu = _unit_normal(a)
+    out.facet[p] = f
+    out.xi[p] = xi
+    out.y[p] = y
+    out.normal[p] = nu
+    out.gap[p] = -_dot(nu, r)
+    out.distance[p] = dist
+    out.sliding[p] = _sliding(master, xi, a, r, d2N, f, pairs.edge[best], pairs.vertex[best])
+
+
+def closest_points(
+    points: npt.ArrayLike, nodes: npt.ArrayLike, radius: float = np.inf
+) -> Projection:
+    """Closest points of slave points on a master surface, in the current configuration.
+
+    Parameters
+    ----------
+    points : array_like, shape (np, gdim)
+        Current positions of the slave points.
+    nodes : array_like, shape (nf, nn, gdim)
+        Current node positions of the master facets, oriented (see the module docstring for
+        the facet kinds and their normals).
+    radius : float, optional
+        Search radius: a point with no facet point within ``radius`` gets ``facet = -1``.
+
+    Returns
+    -------
+    Projection
+        Closest facet, reference coordinates, closest point, normal, proximity, distance and
+        linearisation matrix of every point; placeholders where ``facet == -1`` (see
+        :class:`Projection`).
+
+    Notes
+    -----
+    Candidate search: a KD-tree of the facet centroids. The centroid of a facet lies on the
+    facet and every facet point is within ``R_f`` (largest node distance from the centroid) of
+    it, ``R_max = max R_f``. With ``d1 <= d0`` the exact distance of ``x`` to the facet of its
+    nearest centroid (``d0`` away), the closest point is within ``r = min(d1, radius)`` of
+    ``x``, so its facet has its centroid within ``r + R_max`` (KD-tree queries with K = 8, 16,
+    ... neighbours until no point is cut off). The facets whose distance lower bound (node
+    sphere and slab along the normal at the centre) exceeds ``r`` are dropped, the others
+    projected exactly. Points with ``d0 > radius + R_max`` get ``facet = -1`` at once.
+
+    When several facets are at the same distance up to ``1e-10 (distance + facet size)``
+    (the point projects onto a shared edge or vertex), the facet whose normal is the most
+    aligned with ``x - y`` wins.
+
+    Quadrilaterals: clamped Newton from the centre (restarted from four other points where it
+    does not converge or stops at a saddle), compared with the projections on the four
+    straight edges. A strongly warped quadrilateral seen from beyond its radius of curvature
+    can have several interior local minima; the one found is then not guaranteed global.
+    """
+    nodes = np.asarray(nodes, dtype=np.float64)
+    if nodes.ndim != 3:
+        raise ValueError(f"nodes must have shape (nf, nn, gdim), got {nodes.shape}")
+    nf, nn, gdim = nodes.shape
+    facet_kind(nn, gdim)
+    points = np.asarray(points, dtype=np.float64)
+    if points.size == 0:
+        points = points.reshape(0, gdim)
+    if points.ndim != 2 or points.shape[1] != gdim:
+        raise ValueError(f"points must have shape (np, {gdim}), got {points.shape}")
+    radius = float(radius)
+    if not radius >= 0.0:
+        raise ValueError(f"radius must be non-negative, got {radius}")
+    npts, fdim = points.shape[0], gdim - 1
+    out = Projection(
+        facet=np.full(npts, -1, dtype=np.int64),
+        xi=np.zeros((npts, fdim)),
+        y=points.copy(),
+        normal=np.zeros((npts, gdim)),
+        gap=np.full(npts, -np.inf),
+        distance=np.full(npts, np.inf),
+        sliding=np.zeros((npts, fdim, fdim)),
+    )
+    if npts == 0 or nf == 0:
+        return out
+    master = _Master(nodes)
+    for start in range(0, npts, _BLOCK):
+        block = slice(start, min(start + _BLOCK, npts))
+        view = Projection(
+            facet=out.facet[block],
+            xi=out.xi[block],
+            y=out.y[block],
+            normal=out.normal[block],
+            gap=out.gap[block],
+            distance=out.distance[block],
+            sliding=out.sliding[block],
+        )
+        _closest_block(master, points[block], radius, view)
+    return out
