@@ -49,7 +49,7 @@ from mpi4py import MPI
 from contact_ufl.errors import check_positive, collective_check
 from contact_ufl.layout import StackedLayout
 from contact_ufl.projection import Projection, closest_points
-from contact_ufl.surfaces import MasterSurface, SlaveSurface
+from contact_ufl.surfaces import MasterSurface, SlaveSurface, global_bounds
 
 
 @dataclass(frozen=True)
@@ -237,9 +237,7 @@ class FrictionlessContact:
     def _default_radius(self) -> float:
         comm = self.V.mesh.comm
         pts = [self.slave.X.reshape(-1, self.gdim), self.master.X_nodes.reshape(-1, self.gdim)]
-        pts = np.vstack(pts)
-        lo = comm.allreduce(pts.min(axis=0) if len(pts) else np.full(self.gdim, np.inf), MPI.MIN)
-        hi = comm.allreduce(pts.max(axis=0) if len(pts) else np.full(self.gdim, -np.inf), MPI.MAX)
+        lo, hi = global_bounds(comm, np.vstack(pts))
         return 0.25 * float(np.linalg.norm(hi - lo))
 
     def _check_facing(self) -> None:
@@ -317,7 +315,7 @@ class FrictionlessContact:
         self._set(self.M, np.where(paired[:, None, None], proj.sliding, 0.0))
         self._set(self.mask, paired.astype(float))
         self.search_time += time.perf_counter() - start
-        return self._unrolled(self.Qx, gather.reshape(npts, -1), fill=-1)
+        return self._unrolled(self.Qx, gather.reshape(npts, nn * gdim), fill=-1)
 
     def multiplier_at_points(self) -> np.ndarray:
         """lambda_N at the owned slave quadrature points, ``(ncells * nq,)``."""

@@ -23,6 +23,7 @@ from contact_ufl.errors import ConvergenceError
 from contact_ufl.layout import StackedLayout, chain_operator
 from contact_ufl.loads import BodyForce, DeadTraction, evaluate, load_constant
 from contact_ufl.scene import Scene
+from contact_ufl.surfaces import global_bounds
 
 DEFAULT_PETSC_OPTIONS = {
     "snes_type": "newtonls",
@@ -195,9 +196,7 @@ class ContactProblem:
 
     def _default_atol(self) -> float:
         """A force scale: 1e-11 of ``E_max L^(d-1)`` with L the scene's diameter."""
-        x = self.V.mesh.geometry.x
-        lo = self.comm.allreduce(x.min(axis=0), MPI.MIN)
-        hi = self.comm.allreduce(x.max(axis=0), MPI.MAX)
+        lo, hi = global_bounds(self.comm, self.V.mesh.geometry.x)
         size = float(np.linalg.norm(hi - lo))
         E = max(b.material.E for b in self.scene.bodies)
         return 1e-11 * E * size ** (self.V.mesh.geometry.dim - 1)

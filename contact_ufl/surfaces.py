@@ -30,7 +30,8 @@ from contact_ufl.errors import collective_check
 
 
 def _basix_cell(mesh: dolfinx.mesh.Mesh, dim: int) -> basix.CellType:
-    cell = mesh.topology.cell_type if dim == mesh.topology.dim else mesh.topology.entity_types[dim][0]
+    topology = mesh.topology
+    cell = topology.cell_type if dim == topology.dim else topology.entity_types[dim][0]
     return getattr(basix.CellType, cell.name)
 
 
@@ -140,7 +141,8 @@ class SlaveSurface:
         nc, nq = len(self.parent_cells), self.num_points
         flat = ref.reshape(-1, tdim)
         cmap = _coordinate_element(mesh)
-        phi_geom = cmap.tabulate(0, flat)[0, :, :, 0].reshape(nc, nq, -1)
+        phi_geom = cmap.tabulate(0, flat)[0, :, :, 0]
+        phi_geom = phi_geom.reshape(nc, nq, phi_geom.shape[-1])
         xg = mesh.geometry.x[mesh.geometry.dofmaps[0][self.parent_cells], : mesh.geometry.dim]
         self.X = np.einsum("cqn,cnd->cqd", phi_geom, xg)
         nv = len(basix.topology(sub_cell)[0])
@@ -148,7 +150,7 @@ class SlaveSurface:
                                            : mesh.geometry.dim]
         self.normals = outward_normals(vertices, xg.mean(axis=1))
         phi_u = _scalar_element(self.V).tabulate(0, flat)[0, :, :, 0]
-        self._phi_u = phi_u.reshape(nc, nq, -1)
+        self._phi_u = phi_u.reshape(nc, nq, phi_u.shape[-1])
         self._cell_dofs = self.V.dofmap.list[self.parent_cells]
 
     def _parent_reference_points(self, sub_cell, parent_local, tdim) -> np.ndarray:
@@ -279,3 +281,14 @@ def outward_normals(vertices: np.ndarray, cell_centres: np.ndarray) -> np.ndarra
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     sign = np.sign(np.einsum("fd,fd->f", n, vertices.mean(axis=1) - cell_centres))
     return n * sign[:, None]
+
+
+def global_bounds(comm: MPI.Comm, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners of the bounding box of ``points`` ``(n, gdim)`` of all ranks."""
+    gdim = points.shape[1]
+    lo = points.min(axis=0) if len(points) else np.full(gdim, np.inf)
+    hi = points.max(axis=0) if len(points) else np.full(gdim, -np.inf)
+    glo, ghi = np.empty(gdim), np.empty(gdim)
+    comm.Allreduce(np.ascontiguousarray(lo, dtype=float), glo, op=MPI.MIN)
+    comm.Allreduce(np.ascontiguousarray(hi, dtype=float), ghi, op=MPI.MAX)
+    return glo, ghi
