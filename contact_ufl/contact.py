@@ -189,6 +189,9 @@ class FrictionlessContact:
         self._check_facing()
         self.search_time = 0.0
         self.projection: Projection | None = None
+        #: Freeze the projected point inside a Newton iteration (drop its variation from the
+        #: tangent, as many codes do): Newton then converges only linearly. For comparisons.
+        self.frozen_projection = False
 
     # -- UFL ----------------------------------------------------------------------------
     def _kinematics(self) -> None:
@@ -312,7 +315,8 @@ class FrictionlessContact:
         self._set(self.xhat0, xhat)
         self._set(self.x0, points)
         self._set(self.xi0, np.where(paired[:, None], proj.xi, 0.0))
-        self._set(self.M, np.where(paired[:, None, None], proj.sliding, 0.0))
+        sliding = paired[:, None, None] & (not self.frozen_projection)
+        self._set(self.M, np.where(sliding, proj.sliding, 0.0))
         self._set(self.mask, paired.astype(float))
         self.search_time += time.perf_counter() - start
         return self._unrolled(self.Qx, gather.reshape(npts, nn * gdim), fill=-1)

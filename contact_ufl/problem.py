@@ -271,6 +271,10 @@ class ContactProblem:
         self._set_state(x)
         self._assemble_jacobian_matrix()
 
+    def forget_state(self) -> None:
+        """Make the next evaluation redo the search even at an unchanged state."""
+        self._state = None
+
     def evaluate_residual(self, x: PETSc.Vec) -> PETSc.Vec:
         """The residual at the unknowns ``x`` (a new vector); sets the state to ``x``."""
         F = self._R.duplicate()

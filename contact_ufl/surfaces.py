@@ -149,8 +149,14 @@ class SlaveSurface:
         vertices = self.submesh.geometry.x[self.submesh.geometry.dofmaps[0][:nc, :nv],
                                            : mesh.geometry.dim]
         self.normals = outward_normals(vertices, xg.mean(axis=1))
-        phi_u = _scalar_element(self.V).tabulate(0, flat)[0, :, :, 0]
-        self._phi_u = phi_u.reshape(nc, nq, phi_u.shape[-1])
+        tab_u = _scalar_element(self.V).tabulate(1, flat)[..., 0]  # (1 + tdim, npts, ndofs)
+        self._phi_u = tab_u[0].reshape(nc, nq, tab_u.shape[-1])
+        # reference gradients of the displacement basis: Grad phi = J^-T grad_xi phi
+        dgeom = cmap.tabulate(1, flat)[1:, :, :, 0]
+        dgeom = dgeom.reshape(tdim, nc, nq, dgeom.shape[-1])
+        jac = np.einsum("kcqn,cnd->cqdk", dgeom, xg)  # dX/dxi, (nc, nq, gdim, tdim)
+        dphi = tab_u[1:].reshape(tdim, nc, nq, tab_u.shape[-1])
+        self._grad_phi_u = np.einsum("cqkd,kcqn->cqnd", np.linalg.inv(jac), dphi)
         self._cell_dofs = self.V.dofmap.list[self.parent_cells]
 
     def _parent_reference_points(self, sub_cell, parent_local, tdim) -> np.ndarray:
@@ -188,6 +194,20 @@ class SlaveSurface:
         bs = self.V.dofmap.index_map_bs
         values = u.x.array.reshape(-1, bs)[self._cell_dofs]  # (nc, ndofs, gdim)
         return np.einsum("cqn,cnd->cqd", self._phi_u, values)
+
+    def deformation_gradient(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Deformation gradient at the quadrature points, ``(ncells, nq, gdim, gdim)``."""
+        bs = self.V.dofmap.index_map_bs
+        values = u.x.array.reshape(-1, bs)[self._cell_dofs]
+        grad_u = np.einsum("cnd,cqnk->cqdk", values, self._grad_phi_u)
+        return grad_u + np.eye(bs)
+
+    def area_ratio(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Current over reference area ``da/dA = J |F^-T N|`` at the points, ``(ncells, nq)``."""
+        F = self.deformation_gradient(u)
+        N = np.broadcast_to(self.normals[:, None, :], F.shape[:-1])
+        FinvT_N = np.linalg.solve(np.swapaxes(F, -1, -2), N[..., None])[..., 0]
+        return np.linalg.det(F) * np.linalg.norm(FinvT_N, axis=-1)
 
     def positions(self, u: dolfinx.fem.Function) -> np.ndarray:
         """Current positions x = X + u of the quadrature points, ``(ncells, nq, gdim)``."""

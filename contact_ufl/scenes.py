@@ -1,0 +1,118 @@
+"""Ready-made scenes of the verification problems, shared by tests, demos and benchmarks.
+
+Each function meshes its geometry (:mod:`contact_ufl.meshes`) and returns a
+:class:`~contact_ufl.scene.Scene` with the bodies, supports, loads and contact pair, plus the
+data needed to compare with the analytic solution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mpi4py import MPI
+
+from contact_ufl import meshes
+from contact_ufl.analytic import plane_strain_modulus
+from contact_ufl.contact import ContactPair
+from contact_ufl.loads import DeadTraction, Dirichlet
+from contact_ufl.materials import NeoHookean
+from contact_ufl.scene import Body, Scene
+
+
+@dataclass
+class HertzScene:
+    """The 2D Hertz scene and its analytic data."""
+
+    scene: Scene
+    radius: float
+    E_star: float
+    h_contact: float
+
+
+def hertz_2d(h_contact: float = 0.005, depth: float = 0.02, E: float = 1.0, nu: float = 0.3,
+             E_flat: float | None = None, nu_flat: float = 0.3, eps_factor: float = 1.0,
+             quadrature_degree: int | None = None, h_far: float = 0.2,
+             comm: MPI.Comm = MPI.COMM_WORLD) -> HertzScene:
+    """Plane-strain Hertz problem: an elastic half disc (R = 1) pressed onto an elastic block.
+
+    The flat top of the half disc is moved down by ``depth``; the bottom of the block is
+    clamped. The slave surface is the disc's arc (the finer mesh), the master the block top.
+
+    Parameters
+    ----------
+    h_contact
+        Element size near the contact (the block is 1.3 times coarser).
+    depth
+        Prescribed displacement of the top of the disc at t = 1.
+    E, nu
+        Material of the disc (Neo-Hookean).
+    E_flat, nu_flat
+        Material of the block (default: the disc's E; a large value gives a rigid-like flat).
+    eps_factor
+        ``eps_N = eps_factor * E / h_contact``.
+    quadrature_degree
+        Quadrature degree of the contact integrals (default of :class:`ContactPair`).
+    h_far
+        Element size far from the contact.
+    """
+    E_flat = E if E_flat is None else E_flat
+    sm = meshes.hertz_2d(h_contact=h_contact, h_far=h_far, comm=comm)
+    tags = sm.tags
+    scene = Scene(
+        sm.mesh, sm.cell_tags, sm.facet_tags,
+        bodies=[Body(tags["cylinder"], NeoHookean(E, nu), "cylinder"),
+                Body(tags["block"], NeoHookean(E_flat, nu_flat), "block")],
+        contacts=[ContactPair(tags["cylinder_contact"], tags["block_contact"],
+                              eps_N=eps_factor * E / h_contact,
+                              quadrature_degree=quadrature_degree)],
+        dirichlet=[Dirichlet(tags["block_bottom"], (0.0, 0.0)),
+                   Dirichlet(tags["cylinder_top"], lambda t: (0.0, -depth * t))],
+    )
+    return HertzScene(scene, 1.0, plane_strain_modulus(E, nu, E_flat, nu_flat), h_contact)
+
+
+def patch_2d(pressure: float = 0.01, E: float = 1.0, nu: float = 0.3,
+             quadrature_degree: int | None = None, h_upper: float = 0.1, h_lower: float = 1 / 7,
+             cell: str = "triangle", comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """Contact patch test: a uniform dead pressure through a flat non-matching interface.
+
+    Two identical Neo-Hookean blocks stacked (the upper one the slave); the top of the upper
+    block carries the nominal traction ``(0, -pressure)``; the lower block is supported
+    vertically at its bottom; both left sides are held horizontally. The exact solution is a
+    homogeneous deformation with ``lambda_N = pressure`` everywhere on the interface.
+    """
+    sm = meshes.patch_2d(h_upper=h_upper, h_lower=h_lower, cell=cell, comm=comm)
+    tags = sm.tags
+    material = NeoHookean(E, nu)
+    return Scene(
+        sm.mesh, sm.cell_tags, sm.facet_tags,
+        bodies=[Body(tags["upper"], material, "upper"), Body(tags["lower"], material, "lower")],
+        contacts=[ContactPair(tags["upper_contact"], tags["lower_contact"], eps_N=10.0 * E / h_upper,
+                              quadrature_degree=quadrature_degree)],
+        dirichlet=[Dirichlet(tags["lower_bottom"], 0.0, component=1),
+                   Dirichlet(tags["lower_left"], 0.0, component=0),
+                   Dirichlet(tags["upper_left"], 0.0, component=0)],
+        loads=[DeadTraction(tags["upper_top"], lambda t: (0.0, -pressure * t))],
+    )
+
+
+def curved_pair(dim: int, comm: MPI.Comm = MPI.COMM_WORLD, E: float = 1.0, nu: float = 0.3,
+                eps_N: float = 10.0) -> Scene:
+    """Two bodies with curved contact surfaces and no supports (for Taylor tests).
+
+    ``dim = 2``: a half disc above a block with a circular top; ``dim = 3``: a half cylinder
+    above a block with a cylindrical top of crossed axis.
+    """
+    if dim == 2:
+        sm = meshes.curved_2d(h_contact=0.05, h_far=0.3, comm=comm)
+        names = ("cylinder", "block", "cylinder_contact", "block_contact")
+    else:
+        sm = meshes.cylinders_3d(h_contact=0.15, h_far=0.4, comm=comm)
+        names = ("upper", "lower", "upper_contact", "lower_contact")
+    tags = sm.tags
+    return Scene(
+        sm.mesh, sm.cell_tags, sm.facet_tags,
+        bodies=[Body(tags[names[0]], NeoHookean(E, nu), "upper"),
+                Body(tags[names[1]], NeoHookean(E, nu), "lower")],
+        contacts=[ContactPair(tags[names[2]], tags[names[3]], eps_N=eps_N)],
+    )
