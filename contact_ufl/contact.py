@@ -74,8 +74,11 @@ class ContactPair:
         iteration; only master facets within it are searched. Defaults to a quarter of the
         diagonal of the bounding box of the two surfaces.
     quadrature_degree
-        Degree of the quadrature rule of the contact integrals (defaults to ``2 p + 1`` for
+        Degree of the Gauss rule of the contact integrals (defaults to ``2 p + 1`` for
         displacement degree ``p``).
+    quadrature_subdivisions
+        Repeat that rule on a uniform split of every slave facet (composite rule): the master
+        facet edges put kinks into the integrand that one Gauss rule resolves poorly.
     """
 
     slave: int
@@ -85,6 +88,7 @@ class ContactPair:
     eps_T: float | None = None
     search_radius: float | None = None
     quadrature_degree: int | None = None
+    quadrature_subdivisions: int = 1
 
     def validate(self, comm: MPI.Comm) -> None:
         """Raise a clear error (on every rank) for invalid parameters."""
@@ -94,6 +98,8 @@ class ContactPair:
             check_positive(comm, eps_T=self.eps_T)
         if self.search_radius is not None:
             check_positive(comm, search_radius=self.search_radius)
+        collective_check(comm, int(self.quadrature_subdivisions) >= 1,
+                         f"quadrature_subdivisions must be >= 1, got {self.quadrature_subdivisions}")
         collective_check(comm, self.slave != self.master,
                          f"slave and master tags must differ (both {self.slave})")
 
@@ -160,14 +166,15 @@ class FrictionlessContact:
         self.fdim = fdim = mesh.topology.dim - 1
         degree = V.ufl_element().embedded_superdegree
         qdeg = pair.quadrature_degree or 2 * degree + 1
-        self.slave = SlaveSurface(V, facet_tags, pair.slave, qdeg)
+        self.slave = SlaveSurface(V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions)
         self.master = MasterSurface(V, facet_tags, pair.master)
         self.nn = nn = comm_max(mesh.comm, self.master.nodes.shape[1])
         sub = self.slave.submesh
 
         def space(shape):
-            element = basix.ufl.quadrature_element(sub.basix_cell(), value_shape=shape,
-                                                   degree=qdeg)
+            element = basix.ufl.quadrature_element(
+                sub.basix_cell(), value_shape=shape, points=self.slave.points_ref,
+                weights=self.slave.weights_ref)
             return dolfinx.fem.functionspace(sub, element)
 
         self.Qx = space((nn * gdim,))

@@ -124,12 +124,15 @@ class ContactProblem:
             measure = self.dx if isinstance(load, BodyForce) else self.ds
             F_u -= load.virtual_work(u, v, measure, c)
         residuals = [F_u]
+        contact_residuals = [0]
         fields, unknowns = [u], [u]
         for c in self.contacts:
             vhat, mu = ufl.TestFunction(c.Qx), ufl.TestFunction(c.L)
             Fu_c, Fx_c, Fl_c = c.residuals(v, vhat, mu)
             residuals[0] = residuals[0] + Fu_c
+            contact_residuals[0] = contact_residuals[0] + Fu_c
             residuals += [Fx_c, Fl_c]
+            contact_residuals += [Fx_c, Fl_c]
             fields += [c.xhat, c.lambda_N]
             unknowns.append(c.lambda_N)
         self.fields, self.unknowns = fields, unknowns
@@ -137,6 +140,8 @@ class ContactProblem:
                      for f in fields] for Fi in residuals]
         entity_maps = [c.slave.entity_map for c in self.contacts]
         self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
+        self._contact_residual_ufl = contact_residuals
+        self._contact_residual_form = None
         self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
         spaces = [f.function_space for f in fields]
         self.full_layout = StackedLayout(spaces)
@@ -235,6 +240,22 @@ class ContactProblem:
         if len(self._bc_rows):
             u = self.u.x.array[self._bc_rows]
             F.array[self._bc_rows] = u - self._prescribed(self.t)
+
+    def contact_residual(self) -> PETSc.Vec:
+        """The contact terms alone of the residual at the current state, as a vector of the
+        unknowns (master parts gathered through the chain-rule operator)."""
+        if self._contact_residual_form is None:
+            self._contact_residual_form = dolfinx.fem.form(
+                self._contact_residual_ufl,
+                entity_maps=[c.slave.entity_map for c in self.contacts])
+        r = self._r
+        with r.localForm() as r_local:
+            r_local.set(0.0)
+        fem_petsc.assemble_vector(r, self._contact_residual_form)
+        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        out = self._R.duplicate()
+        self._T.multTranspose(r, out)
+        return out
 
     def _assemble_jacobian_matrix(self, first: bool = False) -> PETSc.Mat:
         K = self._K

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import dolfinx
 import numpy as np
+import ufl
+from mpi4py import MPI
 
 
 @dataclass
@@ -44,3 +47,89 @@ def contact_samples(problem, pair: int = 0) -> ContactSamples:
 
     return ContactSamples(gather(x).reshape(-1, gdim), gather(lam), gather(lam / ratio),
                           gather(gap))
+
+
+def slave_body(problem, pair: int = 0):
+    """The body that owns the slave facets of contact pair ``pair``."""
+    c = problem.contacts[pair]
+    tags = problem.scene.cell_tags
+    order = np.argsort(tags.indices)
+    pos = np.searchsorted(tags.indices, c.slave.parent_cells, sorter=order)
+    local = set(tags.values[order[pos]].tolist()) if len(pos) else set()
+    found = problem.comm.allreduce(local, MPI.BOR)
+    bodies = [b for b in problem.scene.bodies if b.tag in found]
+    if len(bodies) != 1:
+        raise ValueError(f"slave facets of pair {pair} belong to {len(bodies)} bodies")
+    return bodies[0]
+
+
+def traction_mismatch(problem, pair: int = 0) -> float:
+    """Relative L2 distance on the slave surface between the bulk traction ``Pi N`` and the
+    contact traction of the multipliers ``lambda_N nu`` (property (c) of the formulation)."""
+    c = problem.contacts[pair]
+    Pi = problem.first_piola(slave_body(problem, pair))
+    N = ufl.FacetNormal(problem.V.mesh)
+    diff = Pi * N - c.lambda_N * c.nu
+    forms = [ufl.dot(diff, diff) * c.ds, c.lambda_N**2 * c.ds]
+    values = [problem.comm.allreduce(
+        dolfinx.fem.assemble_scalar(dolfinx.fem.form(f, entity_maps=[c.slave.entity_map])),
+        MPI.SUM) for f in forms]
+    return float(np.sqrt(values[0] / values[1]))
+
+
+def body_resultants(problem, vector) -> dict[int, np.ndarray]:
+    """Sum of the displacement components of a vector over the dofs of each body.
+
+    ``vector`` is a vector of the unknowns (for instance a residual); the result maps each
+    body's cell tag to its resultant ``(gdim,)``.
+    """
+    V = problem.V
+    bs = V.dofmap.index_map_bs
+    owned = V.dofmap.index_map.size_local
+    values = vector.array[: owned * bs].reshape(-1, bs)
+    out = {}
+    for body in problem.scene.bodies:
+        blocks = np.unique(V.dofmap.list[problem.scene.cell_tags.find(body.tag)])
+        blocks = blocks[blocks < owned]
+        local = values[blocks].sum(axis=0) if len(blocks) else np.zeros(bs)
+        out[body.tag] = problem.comm.allreduce(local, MPI.SUM)
+    return out
+
+
+def weak_contact_law(problem, pair: int = 0) -> tuple[float, float]:
+    """The contact law as the multiplier equation imposes it, node by node.
+
+    For a multiplier node whose whole support is in contact the equation reads
+    ``int g phi_i = 0`` (the gap is closed in the weak sense); where the whole support is
+    open it reads ``int lambda_N phi_i = 0``. Returns the largest ``|int g phi_i| / int
+    phi_i`` over the first kind of nodes and ``|int lambda_N phi_i| / int phi_i`` over the
+    second (both zero up to solver tolerance).
+    """
+    c = problem.contacts[pair]
+    mu = ufl.TestFunction(c.L)
+
+    def nodal(expr):
+        form = dolfinx.fem.form(expr * mu * c.ds, entity_maps=[c.slave.entity_map])
+        f = dolfinx.fem.Function(c.L)
+        dolfinx.fem.assemble_vector(f.x.array, form)
+        f.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        return f.x.array
+
+    active = c.active().reshape(c.slave.num_cells, c.slave.num_points)
+    dofs = c.L.dofmap.list[: c.slave.num_cells]
+    touches = dolfinx.fem.Function(c.L)  # number of open (resp. closed) points next to a node
+    counts = []
+    for mask in (~active, active):
+        touches.x.array[:] = 0.0
+        np.add.at(touches.x.array, dofs, mask.sum(axis=1)[:, None].astype(float))
+        touches.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        counts.append(touches.x.array.copy())
+    mass = nodal(1.0)
+    owned = c.L.dofmap.index_map.size_local
+    closed = (counts[0] == 0) & (counts[1] > 0)
+    open_ = (counts[1] == 0) & (counts[0] > 0)
+    gap = np.abs(nodal(c.gap) / mass)[:owned][closed[:owned]]
+    lam = np.abs(nodal(c.lambda_N) / mass)[:owned][open_[:owned]]
+    comm = problem.comm
+    return (comm.allreduce(gap.max(initial=0.0), MPI.MAX),
+            comm.allreduce(lam.max(initial=0.0), MPI.MAX))

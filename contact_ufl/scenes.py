@@ -72,7 +72,7 @@ def hertz_2d(h_contact: float = 0.005, depth: float = 0.02, E: float = 1.0, nu: 
 
 
 def patch_2d(pressure: float = 0.01, E: float = 1.0, nu: float = 0.3,
-             quadrature_degree: int | None = None, h_upper: float = 0.1, h_lower: float = 1 / 7,
+             quadrature_degree: int | None = None, subdivisions: int = 1, h_upper: float = 0.1, h_lower: float = 1 / 7,
              cell: str = "triangle", comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
     """Contact patch test: a uniform dead pressure through a flat non-matching interface.
 
@@ -88,7 +88,8 @@ def patch_2d(pressure: float = 0.01, E: float = 1.0, nu: float = 0.3,
         sm.mesh, sm.cell_tags, sm.facet_tags,
         bodies=[Body(tags["upper"], material, "upper"), Body(tags["lower"], material, "lower")],
         contacts=[ContactPair(tags["upper_contact"], tags["lower_contact"], eps_N=10.0 * E / h_upper,
-                              quadrature_degree=quadrature_degree)],
+                              quadrature_degree=quadrature_degree,
+                              quadrature_subdivisions=subdivisions)],
         dirichlet=[Dirichlet(tags["lower_bottom"], 0.0, component=1),
                    Dirichlet(tags["lower_left"], 0.0, component=0),
                    Dirichlet(tags["upper_left"], 0.0, component=0)],

@@ -1,0 +1,62 @@
+"""2D Hertz: the multiplier against p(x) = p0 sqrt(1 - x^2/a^2) (Johnson 1985, 4.2)."""
+
+import numpy as np
+
+from contact_ufl.analytic import Hertz2D, fit_elliptic_profile
+from contact_ufl.results import contact_samples, weak_contact_law
+
+
+def hertz_errors(problem, hertz):
+    """Relative errors of a and p0 (fitted to the Cauchy pressure), and the RMS error of the
+    pressure profile inside the contact zone (|x| < 0.8 a, away from the edges where a finite
+    element profile is smeared over an element), relative to p0."""
+    samples = contact_samples(problem)
+    P = problem.contact_force()[1]
+    exact = Hertz2D(P, hertz.radius, hertz.E_star)
+    a, p0, xc = fit_elliptic_profile(samples.x[:, 0], samples.pressure)
+    near = np.abs(samples.x[:, 0] - xc) < 0.8 * exact.a
+    profile = samples.pressure[near] - exact.pressure(samples.x[near, 0] - xc)
+    return (a / exact.a - 1.0, p0 / exact.p0 - 1.0,
+            np.sqrt(np.mean(profile**2)) / exact.p0, exact)
+
+
+def test_hertz_half_width_and_peak_pressure(hertz_moderate):
+    problem, hertz = hertz_moderate
+    a_err, p0_err, profile_err, exact = hertz_errors(problem, hertz)
+    assert exact.a / hertz.h_contact > 8  # the contact zone is resolved
+    assert abs(a_err) < 0.02
+    assert abs(p0_err) < 0.02
+    assert profile_err < 0.03
+
+
+def test_hertz_errors_fall_under_refinement(hertz_sequence):
+    errors = np.array([np.abs(hertz_errors(p, h)[:2]) for p, h in hertz_sequence])
+    assert np.all(np.diff(errors, axis=0) < 0), errors
+
+
+def test_hertz_contact_law(hertz_moderate):
+    """(d): closed gap where the pressure is positive, zero pressure where the gap is open.
+
+    The multiplier equation imposes the law node by node in the weak sense: int g phi_i = 0
+    where the whole support of phi_i is in contact, int lambda_N phi_i = 0 where it is open;
+    both hold to solver tolerance. Pointwise, the continuous P1 multiplier has a tail next to
+    the contact edge that alternates in sign and decays by ~0.27 per element (the consistent
+    mass matrix): zero pressure is checked pointwise beyond 20 elements from the edge.
+    """
+    problem, hertz = hertz_moderate
+    s = contact_samples(problem)
+    P = problem.contact_force()[1]
+    exact = Hertz2D(P, hertz.radius, hertz.E_star)
+    a, p0, xc = fit_elliptic_profile(s.x[:, 0], s.pressure)
+    eps_N = float(problem.contacts[0].eps_N.value)
+    weak_gap, weak_lambda = weak_contact_law(problem)
+    assert weak_gap < 1e-8 * p0 / eps_N
+    assert weak_lambda < 1e-8 * p0
+    pressed = s.lambda_N > 0.05 * p0
+    far = (s.gap < 0.0) & (np.abs(s.x[:, 0] - xc) > exact.a + 20 * hertz.h_contact)
+    assert np.all(s.lambda_N > -0.05 * p0)
+    assert np.abs(s.lambda_N[far]).max() < 1e-8 * p0
+    # pointwise, the closed gap is the O(h^2) mismatch of the two discrete surfaces, far
+    # below the lambda / eps_N a penalty method would penetrate
+    assert np.abs(s.gap[pressed]).max() < 0.05 * s.lambda_N.max() / eps_N
+    assert pressed.sum() > 20 and far.sum() > 20
