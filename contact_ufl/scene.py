@@ -41,6 +41,8 @@ class Scene:
         Prescribed displacements.
     loads
         Dead tractions and body forces.
+    tags
+        Names of the tags (for look-up and messages), e.g. from :mod:`contact_ufl.meshes`.
     """
 
     mesh: dolfinx.mesh.Mesh
@@ -50,6 +52,7 @@ class Scene:
     contacts: list[ContactPair] = field(default_factory=list)
     dirichlet: list[Dirichlet] = field(default_factory=list)
     loads: list[DeadTraction | BodyForce] = field(default_factory=list)
+    tags: dict[str, int] = field(default_factory=dict)
 
     def validate(self) -> None:
         """Check the scene against its mesh; raise a clear error on every rank."""

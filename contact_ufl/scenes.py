@@ -67,6 +67,7 @@ def hertz_2d(h_contact: float = 0.005, depth: float = 0.02, E: float = 1.0, nu: 
                               quadrature_degree=quadrature_degree)],
         dirichlet=[Dirichlet(tags["block_bottom"], (0.0, 0.0)),
                    Dirichlet(tags["cylinder_top"], lambda t: (0.0, -depth * t))],
+        tags=tags,
     )
     return HertzScene(scene, 1.0, plane_strain_modulus(E, nu, E_flat, nu_flat), h_contact)
 
@@ -94,6 +95,7 @@ def patch_2d(pressure: float = 0.01, E: float = 1.0, nu: float = 0.3,
                    Dirichlet(tags["lower_left"], 0.0, component=0),
                    Dirichlet(tags["upper_left"], 0.0, component=0)],
         loads=[DeadTraction(tags["upper_top"], lambda t: (0.0, -pressure * t))],
+        tags=tags,
     )
 
 
@@ -116,4 +118,5 @@ def curved_pair(dim: int, comm: MPI.Comm = MPI.COMM_WORLD, E: float = 1.0, nu: f
         bodies=[Body(tags[names[0]], NeoHookean(E, nu), "upper"),
                 Body(tags[names[1]], NeoHookean(E, nu), "lower")],
         contacts=[ContactPair(tags[names[2]], tags[names[3]], eps_N=eps_N)],
+        tags=tags,
     )

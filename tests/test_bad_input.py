@@ -1,0 +1,64 @@
+"""Bad input gets a clear error naming the problem, on every rank (no MPI hang)."""
+
+import dataclasses
+
+import pytest
+
+from contact_ufl.errors import ContactInputError
+from contact_ufl.loads import Dirichlet
+from contact_ufl.materials import NeoHookean
+from contact_ufl.problem import ContactProblem
+from contact_ufl.scene import Body
+from contact_ufl.scenes import curved_pair
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return curved_pair(2)
+
+
+def with_pair(scene, **changes):
+    pair = dataclasses.replace(scene.contacts[0], **changes)
+    return dataclasses.replace(scene, contacts=[pair])
+
+
+@pytest.mark.parametrize("changes, message", [
+    (dict(slave=99), "facet tag 99 is empty or does not exist"),
+    (dict(master=98), "facet tag 98 is empty or does not exist"),
+    (dict(eps_N=0.0), "eps_N must be positive"),
+    (dict(eps_N=-1.0), "eps_N must be positive"),
+    (dict(mu=-0.1), "mu must be >= 0"),
+    (dict(search_radius=-1.0), "search_radius must be positive"),
+    (dict(quadrature_subdivisions=0), "quadrature_subdivisions must be >= 1"),
+])
+def test_bad_contact_pair(scene, changes, message):
+    with pytest.raises(ContactInputError, match=message):
+        ContactProblem(with_pair(scene, **changes), verbose=False)
+
+
+def test_slave_not_facing_master(scene):
+    """The flat top of the half disc faces away from the block."""
+    pair = scene.contacts[0]
+    swapped = with_pair(scene, slave=pair.master, master=pair.slave)
+    ContactProblem(swapped, verbose=False)  # swapped roles face each other: fine
+    with pytest.raises(ContactInputError, match="never faces"):
+        ContactProblem(with_pair(scene, slave=scene.tags["cylinder_top"]), verbose=False)
+
+
+def test_empty_body_tag(scene):
+    bad = dataclasses.replace(scene, bodies=[Body(42, NeoHookean(1.0, 0.3), "ghost"),
+                                             *scene.bodies])
+    with pytest.raises(ContactInputError, match="cell tag 42 has no cells"):
+        ContactProblem(bad, verbose=False)
+
+
+def test_dirichlet_on_missing_tag(scene):
+    bad = dataclasses.replace(scene, dirichlet=[Dirichlet(77, (0.0, 0.0))])
+    with pytest.raises(ContactInputError, match="facet tag 77 does not exist"):
+        ContactProblem(bad, verbose=False)
+
+
+@pytest.mark.parametrize("E, nu, message", [(-1.0, 0.3, "Young"), (1.0, 0.5, "Poisson")])
+def test_bad_material(E, nu, message):
+    with pytest.raises(ValueError, match=message):
+        NeoHookean(E, nu)

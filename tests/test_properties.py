@@ -1,0 +1,37 @@
+"""Properties (c) and (e) of the formulation, and independence of the number of ranks."""
+
+import numpy as np
+from conftest import solve_hertz
+from mpi4py import MPI
+
+from contact_ufl.results import body_resultants, contact_samples, traction_mismatch
+
+
+def test_multipliers_are_the_tractions(hertz_sequence):
+    """(c): lambda_N nu equals the bulk traction Pi N, up to an error that falls with h."""
+    errors = np.array([traction_mismatch(p) for p, _ in hertz_sequence])
+    assert errors[-1] < 0.2
+    assert np.all(np.diff(errors) < 0), errors
+
+
+def test_action_equals_reaction(hertz_moderate):
+    """(e): the contact forces on the two bodies are opposite to round-off."""
+    problem, _ = hertz_moderate
+    resultants = body_resultants(problem, problem.contact_residual())
+    slave, master = (resultants[b.tag] for b in problem.scene.bodies)
+    assert np.linalg.norm(slave) > 0.5 * np.linalg.norm(problem.contact_force())
+    assert np.linalg.norm(slave + master) < 1e-13 * np.linalg.norm(slave)
+
+
+def test_same_result_on_any_number_of_ranks():
+    """The distributed solve equals a solve on one rank (each rank redoes it alone)."""
+    world, _ = solve_hertz(0.01)
+    alone, _ = solve_hertz(0.01, comm=MPI.COMM_SELF)
+    assert np.allclose(world.contact_force(), alone.contact_force(), rtol=1e-7, atol=0)
+    sw, sa = contact_samples(world), contact_samples(alone)
+    ow, oa = np.lexsort(sw.x.T), np.lexsort(sa.x.T)
+    assert np.allclose(sw.x[ow], sa.x[oa], rtol=0, atol=1e-10)
+    scale = sa.lambda_N.max()
+    assert np.allclose(sw.lambda_N[ow], sa.lambda_N[oa], rtol=0, atol=1e-7 * scale)
+    assert [r.newton_iterations for r in world.history.steps] == [
+        r.newton_iterations for r in alone.history.steps]
