@@ -120,3 +120,28 @@ def sliding_direction(problem, body_tag: int, slide: np.ndarray, amplitude: floa
     dz = problem.x.duplicate()
     dolfinx.fem.petsc.assign(fields, dz)
     return dz
+
+
+#: Generic contact states of :func:`contact_ufl.scenes.curved_pair`: the translation of the
+#: upper body into the lower, the sliding of the test direction, the largest step h.
+CURVED_STATES = {
+    2: dict(shift=(0.03, -0.04), slide=(0.05, 0.0), h0=1e-3),
+    3: dict(shift=(0.03, 0.02, -0.04), slide=(0.05, 0.03, 0.0), h0=1e-4),
+}
+
+
+def curved_case(dim: int, num_steps: int = 4):
+    """The Taylor test case on curved surfaces: problem at its state, direction, steps.
+
+    Over the steps no slave point changes master facet or contact status.
+    """
+    from contact_ufl.problem import ContactProblem
+    from contact_ufl.scenes import curved_pair
+
+    scene = curved_pair(dim)
+    problem = ContactProblem(scene, verbose=False)
+    state = CURVED_STATES[dim]
+    tag = scene.bodies[0].tag
+    contact_state(problem, tag, np.array(state["shift"]))
+    direction = sliding_direction(problem, tag, np.array(state["slide"]))
+    return problem, direction, [state["h0"] * 2.0**-k for k in range(num_steps)]
