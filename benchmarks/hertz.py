@@ -53,17 +53,22 @@ def main() -> None:
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
     records = []
-    header = f"{'h':>8} {'dofs':>8} {'a/h':>6} {'a err':>9} {'p0 err':>9} {'newton':>6} " \
-             f"{'wall s':>8} {'search s':>8}"
+    header = (
+        f"{'h':>8} {'dofs':>8} {'a/h':>6} {'a err':>9} {'p0 err':>9} {'newton':>6} "
+        f"{'wall s':>8} {'search s':>8}"
+    )
     if comm.rank == 0:
         print(header)
     for h in QUICK if args.quick else FULL:
         r = run(h, args.depth, args.steps)
         records.append(r)
         if comm.rank == 0:
-            print(f"{r['h']:8.5f} {r['dofs']:8d} {r['a_over_h']:6.1f} {r['a_error']:+9.4f} "
-                  f"{r['p0_error']:+9.4f} {r['newton_iterations']:6d} {r['wall_s']:8.2f} "
-                  f"{r['search_s']:8.3f}", flush=True)
+            print(
+                f"{r['h']:8.5f} {r['dofs']:8d} {r['a_over_h']:6.1f} {r['a_error']:+9.4f} "
+                f"{r['p0_error']:+9.4f} {r['newton_iterations']:6d} {r['wall_s']:8.2f} "
+                f"{r['search_s']:8.3f}",
+                flush=True,
+            )
     if comm.rank == 0:
         with open(args.json, "w") as f:
             json.dump(records, f, indent=2)

@@ -17,10 +17,16 @@ def run(dim: int, frozen: bool) -> dict:
     problem, dz, steps = curved_case(dim, num_steps=5)
     problem.contacts[0].frozen_projection = frozen
     result = taylor_test(problem, dz, steps)
-    return {"dim": dim, "frozen_projection": frozen, "h": result.h.tolist(),
-            "remainder": result.first.tolist(), "slopes": result.slopes.tolist(),
-            "active_points": problem.active_points(),
-            "facets_changed": result.facets_changed, "active_changed": result.active_changed}
+    return {
+        "dim": dim,
+        "frozen_projection": frozen,
+        "h": result.h.tolist(),
+        "remainder": result.first.tolist(),
+        "slopes": result.slopes.tolist(),
+        "active_points": problem.active_points(),
+        "facets_changed": result.facets_changed,
+        "active_changed": result.active_changed,
+    }
 
 
 def main() -> None:
@@ -34,8 +40,10 @@ def main() -> None:
     if MPI.COMM_WORLD.rank == 0:
         for r in records:
             slopes = " ".join(f"{s:.4f}" for s in r["slopes"])
-            print(f"{r['dim']}D frozen={r['frozen_projection']!s:5} active={r['active_points']:5d}"
-                  f" slopes: {slopes}  (facets changed: {r['facets_changed']})")
+            print(
+                f"{r['dim']}D frozen={r['frozen_projection']!s:5} active={r['active_points']:5d}"
+                f" slopes: {slopes}  (facets changed: {r['facets_changed']})"
+            )
         with open(args.json, "w") as f:
             json.dump(records, f, indent=2)
 

@@ -98,10 +98,16 @@ class ContactPair:
             check_positive(comm, eps_T=self.eps_T)
         if self.search_radius is not None:
             check_positive(comm, search_radius=self.search_radius)
-        collective_check(comm, int(self.quadrature_subdivisions) >= 1,
-                         f"quadrature_subdivisions must be >= 1, got {self.quadrature_subdivisions}")
-        collective_check(comm, self.slave != self.master,
-                         f"slave and master tags must differ (both {self.slave})")
+        collective_check(
+            comm,
+            int(self.quadrature_subdivisions) >= 1,
+            f"quadrature_subdivisions must be >= 1, got {self.quadrature_subdivisions}",
+        )
+        collective_check(
+            comm,
+            self.slave != self.master,
+            f"slave and master tags must differ (both {self.slave})",
+        )
 
 
 def macaulay(a: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
@@ -156,8 +162,9 @@ class FrictionlessContact:
         The contact pair.
     """
 
-    def __init__(self, u: dolfinx.fem.Function, facet_tags: dolfinx.mesh.MeshTags,
-                 pair: ContactPair):
+    def __init__(
+        self, u: dolfinx.fem.Function, facet_tags: dolfinx.mesh.MeshTags, pair: ContactPair
+    ):
         V = u.function_space
         mesh = V.mesh
         pair.validate(mesh.comm)
@@ -173,8 +180,11 @@ class FrictionlessContact:
 
         def space(shape):
             element = basix.ufl.quadrature_element(
-                sub.basix_cell(), value_shape=shape, points=self.slave.points_ref,
-                weights=self.slave.weights_ref)
+                sub.basix_cell(),
+                value_shape=shape,
+                points=self.slave.points_ref,
+                weights=self.slave.weights_ref,
+            )
             return dolfinx.fem.functionspace(sub, element)
 
         self.Qx = space((nn * gdim,))
@@ -189,8 +199,13 @@ class FrictionlessContact:
         p1 = self.L.ufl_element().basix_element
         self._phi_lambda = p1.tabulate(0, self.slave.points_ref)[0, :, :, 0]
         self.eps_N = dolfinx.fem.Constant(mesh, float(pair.eps_N))
-        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags,
-                              subdomain_id=pair.slave, metadata={"quadrature_degree": qdeg})
+        self.ds = ufl.Measure(
+            "ds",
+            domain=mesh,
+            subdomain_data=facet_tags,
+            subdomain_id=pair.slave,
+            metadata={"quadrature_degree": qdeg},
+        )
         self._kinematics()
         self.radius = pair.search_radius or self._default_radius()
         self._check_facing()
@@ -218,9 +233,10 @@ class FrictionlessContact:
         for al in range(fdim):
             a0 = _interpolate([dN0[a][al] for a in range(nn)], xh0, gdim)
             slide = dx - _interpolate(N0, dxh, gdim)
-            b.append(ufl.dot(a0, slide)
-                     + ufl.dot(self.x0 - y0, _interpolate([dN0[a][al] for a in range(nn)],
-                                                            dxh, gdim)))
+            b.append(
+                ufl.dot(a0, slide)
+                + ufl.dot(self.x0 - y0, _interpolate([dN0[a][al] for a in range(nn)], dxh, gdim))
+            )
         self.xi = xi = self.xi0 + self.M * ufl.as_vector(b)
         self.N, dN = master_shape_functions(nn, xi)
         self.y = _interpolate(self.N, xh, gdim)
@@ -263,10 +279,12 @@ class FrictionlessContact:
         facing = np.count_nonzero((proj.facet >= 0) & outside & opposed)
         total = self.V.mesh.comm.allreduce(facing, MPI.SUM)
         collective_check(
-            self.V.mesh.comm, total > 0,
+            self.V.mesh.comm,
+            total > 0,
             f"slave surface (tag {self.pair.slave}) never faces master surface "
             f"(tag {self.pair.master}): no slave point lies on the outer side of the master "
-            "facets (wrong tags or swapped bodies?)")
+            "facets (wrong tags or swapped bodies?)",
+        )
 
     def _candidates(self, master_nodes: np.ndarray, points: np.ndarray, payload=None):
         """Master facets of all ranks near this rank's slave points (bounding-box filter)."""
@@ -282,8 +300,7 @@ class FrictionlessContact:
             if n == 0:
                 sends.append((master_nodes, payload))
                 continue
-            near = np.all((lo <= b[1] + self.radius) & (hi >= b[0] - self.radius),
-                          axis=1)
+            near = np.all((lo <= b[1] + self.radius) & (hi >= b[0] - self.radius), axis=1)
             sends.append((master_nodes[near], payload[near]))
         received = comm.alltoall(sends) if comm.size > 1 else sends
         nodes = np.concatenate([r[0] for r in received]).reshape(-1, *master_nodes.shape[1:])
@@ -345,8 +362,7 @@ class FrictionlessContact:
 
     def _set(self, f: dolfinx.fem.Function, values: np.ndarray) -> None:
         bs = f.function_space.dofmap.index_map_bs
-        f.x.array.reshape(-1, bs)[self._owned_blocks(f.function_space)] = values.reshape(
-            -1, bs)
+        f.x.array.reshape(-1, bs)[self._owned_blocks(f.function_space)] = values.reshape(-1, bs)
         f.x.scatter_forward()
 
     def _unrolled(self, Q, values: np.ndarray, fill) -> np.ndarray:

@@ -29,5 +29,8 @@ def collective_check(
 def check_positive(comm: MPI.Comm, **values: float) -> None:
     """Raise on every rank unless every named value is a finite positive number."""
     for name, value in values.items():
-        collective_check(comm, bool(value > 0.0 and value < float("inf")),
-                         f"{name} must be positive, got {name} = {value}")
+        collective_check(
+            comm,
+            bool(value > 0.0 and value < float("inf")),
+            f"{name} must be positive, got {name} = {value}",
+        )

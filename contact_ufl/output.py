@@ -32,8 +32,9 @@ class ResultWriter:
         comm = problem.comm
         self.writers = [dolfinx.io.VTXWriter(comm, folder / "displacement.bp", [problem.u])]
         for k, c in enumerate(problem.contacts):
-            self.writers.append(dolfinx.io.VTXWriter(comm, folder / f"contact_{k}.bp",
-                                                     [c.lambda_N]))
+            self.writers.append(
+                dolfinx.io.VTXWriter(comm, folder / f"contact_{k}.bp", [c.lambda_N])
+            )
 
     def write(self, t: float) -> None:
         """Write the current state at pseudo-time ``t``."""
@@ -70,9 +71,13 @@ def deformed_grid(problem):
     return grid.warp_by_vector("displacement")
 
 
-def plot_pressure_profile(x: np.ndarray, pressure: np.ndarray, path: str | Path,
-                          exact: tuple[np.ndarray, np.ndarray] | None = None,
-                          title: str = "contact pressure") -> None:
+def plot_pressure_profile(
+    x: np.ndarray,
+    pressure: np.ndarray,
+    path: str | Path,
+    exact: tuple[np.ndarray, np.ndarray] | None = None,
+    title: str = "contact pressure",
+) -> None:
     """A line chart of the contact pressure along x, with an optional exact curve."""
     pv = _pyvista()
     order = np.argsort(x)
@@ -87,16 +92,22 @@ def plot_pressure_profile(x: np.ndarray, pressure: np.ndarray, path: str | Path,
     plotter.close()
 
 
-def plot_deformed(problem, path: str | Path, zoom: float = 1.0,
-                  focus: tuple[float, float, float] | None = None) -> None:
+def plot_deformed(
+    problem, path: str | Path, zoom: float = 1.0, focus: tuple[float, float, float] | None = None
+) -> None:
     """The deformed bodies coloured by the displacement magnitude (2D: seen from +z)."""
     if problem.comm.size > 1:
         raise NotImplementedError("pictures are drawn from a serial run")
     pv = _pyvista()
     grid = deformed_grid(problem)
     plotter = pv.Plotter(off_screen=True, window_size=(1000, 700))
-    plotter.add_mesh(grid, scalars="displacement", show_edges=True, cmap="viridis",
-                     scalar_bar_args={"title": "|u|"})
+    plotter.add_mesh(
+        grid,
+        scalars="displacement",
+        show_edges=True,
+        cmap="viridis",
+        scalar_bar_args={"title": "|u|"},
+    )
     if problem.V.mesh.geometry.dim == 2:
         plotter.view_xy()
     if focus is not None:

@@ -21,7 +21,7 @@ from petsc4py import PETSc
 from contact_ufl.contact import FrictionlessContact
 from contact_ufl.errors import ConvergenceError
 from contact_ufl.layout import StackedLayout, chain_operator
-from contact_ufl.loads import BodyForce, DeadTraction, evaluate, load_constant
+from contact_ufl.loads import BodyForce, evaluate, load_constant
 from contact_ufl.scene import Scene
 from contact_ufl.surfaces import global_bounds
 
@@ -83,9 +83,15 @@ class ContactProblem:
         Print one line per load step (rank 0).
     """
 
-    def __init__(self, scene: Scene, degree: int = 1, quadrature_degree: int | None = None,
-                 petsc_options: dict | None = None, petsc_options_prefix: str = "contact_",
-                 verbose: bool = True):
+    def __init__(
+        self,
+        scene: Scene,
+        degree: int = 1,
+        quadrature_degree: int | None = None,
+        petsc_options: dict | None = None,
+        petsc_options_prefix: str = "contact_",
+        verbose: bool = True,
+    ):
         scene.validate()
         self.scene = scene
         mesh = scene.mesh
@@ -94,11 +100,14 @@ class ContactProblem:
         gdim = mesh.geometry.dim
         self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (gdim,)))
         self.u = dolfinx.fem.Function(self.V, name="displacement")
-        simplex = mesh.topology.cell_type in (dolfinx.mesh.CellType.triangle,
-                                              dolfinx.mesh.CellType.tetrahedron)
+        simplex = mesh.topology.cell_type in (
+            dolfinx.mesh.CellType.triangle,
+            dolfinx.mesh.CellType.tetrahedron,
+        )
         qdeg = quadrature_degree or (2 * degree - 1 if simplex else 2 * degree)
-        self.dx = ufl.Measure("dx", domain=mesh, subdomain_data=scene.cell_tags,
-                              metadata={"quadrature_degree": qdeg})
+        self.dx = ufl.Measure(
+            "dx", domain=mesh, subdomain_data=scene.cell_tags, metadata={"quadrature_degree": qdeg}
+        )
         self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=scene.facet_tags)
         self.t = 0.0
         self.contacts = [FrictionlessContact(self.u, scene.facet_tags, p) for p in scene.contacts]
@@ -115,8 +124,9 @@ class ContactProblem:
 
     def _build_forms(self) -> None:
         u, v = self.u, ufl.TestFunction(self.V)
-        F_u = sum(ufl.inner(self.first_piola(b), ufl.grad(v)) * self.dx(b.tag)
-                  for b in self.scene.bodies)
+        F_u = sum(
+            ufl.inner(self.first_piola(b), ufl.grad(v)) * self.dx(b.tag) for b in self.scene.bodies
+        )
         self._load_constants = []
         for load in self.scene.loads:
             c = load_constant(self.V.mesh, load)
@@ -136,8 +146,10 @@ class ContactProblem:
             fields += [c.xhat, c.lambda_N]
             unknowns.append(c.lambda_N)
         self.fields, self.unknowns = fields, unknowns
-        jacobian = [[_nonempty(ufl.derivative(Fi, f, ufl.TrialFunction(f.function_space)))
-                     for f in fields] for Fi in residuals]
+        jacobian = [
+            [_nonempty(ufl.derivative(Fi, f, ufl.TrialFunction(f.function_space))) for f in fields]
+            for Fi in residuals
+        ]
         entity_maps = [c.slave.entity_map for c in self.contacts]
         self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
         self._contact_residual_ufl = contact_residuals
@@ -149,8 +161,12 @@ class ContactProblem:
         self._r = fem_petsc.create_vector(spaces, kind="mpi")
         self._K = fem_petsc.create_matrix(self.jacobian_form, kind="mpi")
         self._contact_force_forms = [
-            [dolfinx.fem.form(c.t_N * c.nu[i] * c.ds, entity_maps=[c.slave.entity_map])
-             for i in range(self.V.mesh.geometry.dim)] for c in self.contacts]
+            [
+                dolfinx.fem.form(c.t_N * c.nu[i] * c.ds, entity_maps=[c.slave.entity_map])
+                for i in range(self.V.mesh.geometry.dim)
+            ]
+            for c in self.contacts
+        ]
 
     def _build_dirichlet(self) -> None:
         mesh, fdim = self.V.mesh, self.V.mesh.topology.dim - 1
@@ -165,8 +181,11 @@ class ContactProblem:
                 dofs = blocks[blocks < owned]
                 self._bc_dofs.append(dofs)
                 self._bc_values.append((bc, i))
-        self._bc_rows = (np.concatenate(self._bc_dofs).astype(np.int64)
-                         if self._bc_dofs else np.zeros(0, np.int64))
+        self._bc_rows = (
+            np.concatenate(self._bc_dofs).astype(np.int64)
+            if self._bc_dofs
+            else np.zeros(0, np.int64)
+        )
 
     def _prescribed(self, t: float) -> np.ndarray:
         values = []
@@ -191,8 +210,11 @@ class ContactProblem:
         self.snes = PETSc.SNES().create(self.comm)
         self.snes.setOptionsPrefix(prefix)
         opts = PETSc.Options()
-        for key, value in {**DEFAULT_PETSC_OPTIONS, "snes_atol": self._default_atol(),
-                           **options}.items():
+        for key, value in {
+            **DEFAULT_PETSC_OPTIONS,
+            "snes_atol": self._default_atol(),
+            **options,
+        }.items():
             opts[f"{prefix}{key}"] = value
         self.snes.setFunction(self._residual, self._R)
         self.snes.setJacobian(self._jacobian, self._J)
@@ -225,8 +247,13 @@ class ContactProblem:
         if changed:
             self._pattern = pattern
             blocks = [(0, 0)] + [(2 + 2 * k, 1 + k) for k in range(len(self.contacts))]
-            self._T = chain_operator(self.full_layout, self.layout, blocks,
-                                     [1 + 2 * k for k in range(len(self.contacts))], gathers)
+            self._T = chain_operator(
+                self.full_layout,
+                self.layout,
+                blocks,
+                [1 + 2 * k for k in range(len(self.contacts))],
+                gathers,
+            )
             self._JT = None
 
     def _residual(self, snes, x, F) -> None:
@@ -246,8 +273,8 @@ class ContactProblem:
         unknowns (master parts gathered through the chain-rule operator)."""
         if self._contact_residual_form is None:
             self._contact_residual_form = dolfinx.fem.form(
-                self._contact_residual_ufl,
-                entity_maps=[c.slave.entity_map for c in self.contacts])
+                self._contact_residual_ufl, entity_maps=[c.slave.entity_map for c in self.contacts]
+            )
         r = self._r
         with r.localForm() as r_local:
             r_local.set(0.0)
@@ -275,8 +302,11 @@ class ContactProblem:
             return J
         J = self._J
         J.zeroEntries()
-        structure = (PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN if new_pattern
-                     else PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        structure = (
+            PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+            if new_pattern
+            else PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
+        )
         J.axpy(1.0, self._JT, structure=structure)
         if new_pattern:
             J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
@@ -331,8 +361,13 @@ class ContactProblem:
         names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
         return reason > 0, self.snes.getIterationNumber(), names.get(reason, str(reason))
 
-    def solve(self, num_steps: int = 10, t_end: float = 1.0, max_cutbacks: int = 8,
-              callback: Callable[[ContactProblem, StepRecord], None] | None = None) -> History:
+    def solve(
+        self,
+        num_steps: int = 10,
+        t_end: float = 1.0,
+        max_cutbacks: int = 8,
+        callback: Callable[[ContactProblem, StepRecord], None] | None = None,
+    ) -> History:
         """Load stepping from the current pseudo-time to ``t_end`` with cut-backs.
 
         A step whose Newton solve diverges is restored and halved, at most ``max_cutbacks``
@@ -359,13 +394,20 @@ class ContactProblem:
                 if failures > max_cutbacks:
                     raise ConvergenceError(
                         f"load step from t = {t_prev:.6g} to t = {t_new:.6g} did not converge "
-                        f"({reason}) after {max_cutbacks} cut-backs")
+                        f"({reason}) after {max_cutbacks} cut-backs"
+                    )
                 dt *= 0.5
                 continue
             failures = 0
-            record = StepRecord(len(self.history.steps) + 1, t_new, its, self.snes.getFunctionNorm(),
-                                self.active_points(), self.contact_force(),
-                                time.perf_counter() - start)
+            record = StepRecord(
+                len(self.history.steps) + 1,
+                t_new,
+                its,
+                self.snes.getFunctionNorm(),
+                self.active_points(),
+                self.contact_force(),
+                time.perf_counter() - start,
+            )
             self.history.steps.append(record)
             self._print(self._format(record))
             if callback is not None:
@@ -378,8 +420,10 @@ class ContactProblem:
         pairs = range(len(self.contacts)) if k is None else [k]
         total = np.zeros(self.V.mesh.geometry.dim)
         for j in pairs:
-            total += [self.comm.allreduce(dolfinx.fem.assemble_scalar(f), MPI.SUM)
-                      for f in self._contact_force_forms[j]]
+            total += [
+                self.comm.allreduce(dolfinx.fem.assemble_scalar(f), MPI.SUM)
+                for f in self._contact_force_forms[j]
+            ]
         return total
 
     def active_points(self) -> int:
@@ -393,8 +437,10 @@ class ContactProblem:
 
     def _format(self, r: StepRecord) -> str:
         force = " ".join(f"{f: .4e}" for f in r.contact_force)
-        return (f"step {r.step:3d}  t = {r.t:.4f}  newton {r.newton_iterations:2d}  "
-                f"|R| = {r.residual:.2e}  active {r.active_points:5d}  contact force [{force}]")
+        return (
+            f"step {r.step:3d}  t = {r.t:.4f}  newton {r.newton_iterations:2d}  "
+            f"|R| = {r.residual:.2e}  active {r.active_points:5d}  contact force [{force}]"
+        )
 
     def _print(self, text: str) -> None:
         if self.verbose and self.comm.rank == 0:

@@ -45,8 +45,9 @@ def contact_samples(problem, pair: int = 0) -> ContactSamples:
     def gather(a):
         return np.concatenate(comm.allgather(a))
 
-    return ContactSamples(gather(x).reshape(-1, gdim), gather(lam), gather(lam / ratio),
-                          gather(gap))
+    return ContactSamples(
+        gather(x).reshape(-1, gdim), gather(lam), gather(lam / ratio), gather(gap)
+    )
 
 
 def slave_body(problem, pair: int = 0):
@@ -71,9 +72,13 @@ def traction_mismatch(problem, pair: int = 0) -> float:
     N = ufl.FacetNormal(problem.V.mesh)
     diff = Pi * N - c.lambda_N * c.nu
     forms = [ufl.dot(diff, diff) * c.ds, c.lambda_N**2 * c.ds]
-    values = [problem.comm.allreduce(
-        dolfinx.fem.assemble_scalar(dolfinx.fem.form(f, entity_maps=[c.slave.entity_map])),
-        MPI.SUM) for f in forms]
+    values = [
+        problem.comm.allreduce(
+            dolfinx.fem.assemble_scalar(dolfinx.fem.form(f, entity_maps=[c.slave.entity_map])),
+            MPI.SUM,
+        )
+        for f in forms
+    ]
     return float(np.sqrt(values[0] / values[1]))
 
 
@@ -124,12 +129,14 @@ def weak_contact_law(problem, pair: int = 0) -> tuple[float, float]:
         np.add.at(touches.x.array, dofs, mask.sum(axis=1)[:, None].astype(float))
         touches.x.scatter_reverse(dolfinx.la.InsertMode.add)
         counts.append(touches.x.array.copy())
-    mass = nodal(1.0)
     owned = c.L.dofmap.index_map.size_local
-    closed = (counts[0] == 0) & (counts[1] > 0)
-    open_ = (counts[1] == 0) & (counts[0] > 0)
-    gap = np.abs(nodal(c.gap) / mass)[:owned][closed[:owned]]
-    lam = np.abs(nodal(c.lambda_N) / mass)[:owned][open_[:owned]]
+    mass = nodal(1.0)[:owned]
+    closed = ((counts[0] == 0) & (counts[1] > 0))[:owned]
+    open_ = ((counts[1] == 0) & (counts[0] > 0))[:owned]
+    gap = np.abs(nodal(c.gap)[:owned][closed] / mass[closed])
+    lam = np.abs(nodal(c.lambda_N)[:owned][open_] / mass[open_])
     comm = problem.comm
-    return (comm.allreduce(gap.max(initial=0.0), MPI.MAX),
-            comm.allreduce(lam.max(initial=0.0), MPI.MAX))
+    return (
+        comm.allreduce(gap.max(initial=0.0), MPI.MAX),
+        comm.allreduce(lam.max(initial=0.0), MPI.MAX),
+    )

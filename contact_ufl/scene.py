@@ -58,20 +58,33 @@ class Scene:
         """Check the scene against its mesh; raise a clear error on every rank."""
         comm = self.mesh.comm
         gdim, tdim = self.mesh.geometry.dim, self.mesh.topology.dim
-        collective_check(comm, gdim == tdim and gdim in (2, 3),
-                         f"solid bodies need a 2D (plane strain) or 3D mesh of full dimension; "
-                         f"got topological dimension {tdim} in {gdim}D")
-        collective_check(comm, self.cell_tags.dim == tdim,
-                         f"cell_tags have dimension {self.cell_tags.dim}, the mesh {tdim}")
-        collective_check(comm, self.facet_tags.dim == tdim - 1,
-                         f"facet_tags have dimension {self.facet_tags.dim}, expected {tdim - 1}")
+        collective_check(
+            comm,
+            gdim == tdim and gdim in (2, 3),
+            f"solid bodies need a 2D (plane strain) or 3D mesh of full dimension; "
+            f"got topological dimension {tdim} in {gdim}D",
+        )
+        collective_check(
+            comm,
+            self.cell_tags.dim == tdim,
+            f"cell_tags have dimension {self.cell_tags.dim}, the mesh {tdim}",
+        )
+        collective_check(
+            comm,
+            self.facet_tags.dim == tdim - 1,
+            f"facet_tags have dimension {self.facet_tags.dim}, expected {tdim - 1}",
+        )
         collective_check(comm, len(self.bodies) > 0, "a scene needs at least one body")
         for body in self.bodies:
             count = comm.allreduce(len(self.cell_tags.find(body.tag)), MPI.SUM)
-            collective_check(comm, count > 0,
-                             f"body {body.name or body.tag}: cell tag {body.tag} has no cells")
+            collective_check(
+                comm, count > 0, f"body {body.name or body.tag}: cell tag {body.tag} has no cells"
+            )
         facet_values = comm.allreduce(set(np.unique(self.facet_tags.values).tolist()), MPI.BOR)
         for item in [*self.dirichlet, *[ld for ld in self.loads if isinstance(ld, DeadTraction)]]:
-            collective_check(comm, item.tag in facet_values,
-                             f"{type(item).__name__}: facet tag {item.tag} does not exist "
-                             f"(facet tags: {sorted(facet_values)})")
+            collective_check(
+                comm,
+                item.tag in facet_values,
+                f"{type(item).__name__}: facet tag {item.tag} does not exist "
+                f"(facet tags: {sorted(facet_values)})",
+            )

@@ -29,10 +29,18 @@ class HertzScene:
     h_contact: float
 
 
-def hertz_2d(h_contact: float = 0.005, depth: float = 0.02, E: float = 1.0, nu: float = 0.3,
-             E_flat: float | None = None, nu_flat: float = 0.3, eps_factor: float = 1.0,
-             quadrature_degree: int | None = None, h_far: float = 0.2,
-             comm: MPI.Comm = MPI.COMM_WORLD) -> HertzScene:
+def hertz_2d(
+    h_contact: float = 0.005,
+    depth: float = 0.02,
+    E: float = 1.0,
+    nu: float = 0.3,
+    E_flat: float | None = None,
+    nu_flat: float = 0.3,
+    eps_factor: float = 1.0,
+    quadrature_degree: int | None = None,
+    h_far: float = 0.2,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> HertzScene:
     """Plane-strain Hertz problem: an elastic half disc (R = 1) pressed onto an elastic block.
 
     The flat top of the half disc is moved down by ``depth``; the bottom of the block is
@@ -59,22 +67,41 @@ def hertz_2d(h_contact: float = 0.005, depth: float = 0.02, E: float = 1.0, nu: 
     sm = meshes.hertz_2d(h_contact=h_contact, h_far=h_far, comm=comm)
     tags = sm.tags
     scene = Scene(
-        sm.mesh, sm.cell_tags, sm.facet_tags,
-        bodies=[Body(tags["cylinder"], NeoHookean(E, nu), "cylinder"),
-                Body(tags["block"], NeoHookean(E_flat, nu_flat), "block")],
-        contacts=[ContactPair(tags["cylinder_contact"], tags["block_contact"],
-                              eps_N=eps_factor * E / h_contact,
-                              quadrature_degree=quadrature_degree)],
-        dirichlet=[Dirichlet(tags["block_bottom"], (0.0, 0.0)),
-                   Dirichlet(tags["cylinder_top"], lambda t: (0.0, -depth * t))],
+        sm.mesh,
+        sm.cell_tags,
+        sm.facet_tags,
+        bodies=[
+            Body(tags["cylinder"], NeoHookean(E, nu), "cylinder"),
+            Body(tags["block"], NeoHookean(E_flat, nu_flat), "block"),
+        ],
+        contacts=[
+            ContactPair(
+                tags["cylinder_contact"],
+                tags["block_contact"],
+                eps_N=eps_factor * E / h_contact,
+                quadrature_degree=quadrature_degree,
+            )
+        ],
+        dirichlet=[
+            Dirichlet(tags["block_bottom"], (0.0, 0.0)),
+            Dirichlet(tags["cylinder_top"], lambda t: (0.0, -depth * t)),
+        ],
         tags=tags,
     )
     return HertzScene(scene, 1.0, plane_strain_modulus(E, nu, E_flat, nu_flat), h_contact)
 
 
-def patch_2d(pressure: float = 0.01, E: float = 1.0, nu: float = 0.3,
-             quadrature_degree: int | None = None, subdivisions: int = 1, h_upper: float = 0.1, h_lower: float = 1 / 7,
-             cell: str = "triangle", comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+def patch_2d(
+    pressure: float = 0.01,
+    E: float = 1.0,
+    nu: float = 0.3,
+    quadrature_degree: int | None = None,
+    subdivisions: int = 1,
+    h_upper: float = 0.1,
+    h_lower: float = 1 / 7,
+    cell: str = "triangle",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
     """Contact patch test: a uniform dead pressure through a flat non-matching interface.
 
     Two identical Neo-Hookean blocks stacked (the upper one the slave); the top of the upper
@@ -86,21 +113,32 @@ def patch_2d(pressure: float = 0.01, E: float = 1.0, nu: float = 0.3,
     tags = sm.tags
     material = NeoHookean(E, nu)
     return Scene(
-        sm.mesh, sm.cell_tags, sm.facet_tags,
+        sm.mesh,
+        sm.cell_tags,
+        sm.facet_tags,
         bodies=[Body(tags["upper"], material, "upper"), Body(tags["lower"], material, "lower")],
-        contacts=[ContactPair(tags["upper_contact"], tags["lower_contact"], eps_N=10.0 * E / h_upper,
-                              quadrature_degree=quadrature_degree,
-                              quadrature_subdivisions=subdivisions)],
-        dirichlet=[Dirichlet(tags["lower_bottom"], 0.0, component=1),
-                   Dirichlet(tags["lower_left"], 0.0, component=0),
-                   Dirichlet(tags["upper_left"], 0.0, component=0)],
+        contacts=[
+            ContactPair(
+                tags["upper_contact"],
+                tags["lower_contact"],
+                eps_N=10.0 * E / h_upper,
+                quadrature_degree=quadrature_degree,
+                quadrature_subdivisions=subdivisions,
+            )
+        ],
+        dirichlet=[
+            Dirichlet(tags["lower_bottom"], 0.0, component=1),
+            Dirichlet(tags["lower_left"], 0.0, component=0),
+            Dirichlet(tags["upper_left"], 0.0, component=0),
+        ],
         loads=[DeadTraction(tags["upper_top"], lambda t: (0.0, -pressure * t))],
         tags=tags,
     )
 
 
-def curved_pair(dim: int, comm: MPI.Comm = MPI.COMM_WORLD, E: float = 1.0, nu: float = 0.3,
-                eps_N: float = 10.0) -> Scene:
+def curved_pair(
+    dim: int, comm: MPI.Comm = MPI.COMM_WORLD, E: float = 1.0, nu: float = 0.3, eps_N: float = 10.0
+) -> Scene:
     """Two bodies with curved contact surfaces and no supports (for Taylor tests).
 
     ``dim = 2``: a half disc above a block with a circular top; ``dim = 3``: a half cylinder
@@ -114,9 +152,13 @@ def curved_pair(dim: int, comm: MPI.Comm = MPI.COMM_WORLD, E: float = 1.0, nu: f
         names = ("upper", "lower", "upper_contact", "lower_contact")
     tags = sm.tags
     return Scene(
-        sm.mesh, sm.cell_tags, sm.facet_tags,
-        bodies=[Body(tags[names[0]], NeoHookean(E, nu), "upper"),
-                Body(tags[names[1]], NeoHookean(E, nu), "lower")],
+        sm.mesh,
+        sm.cell_tags,
+        sm.facet_tags,
+        bodies=[
+            Body(tags[names[0]], NeoHookean(E, nu), "upper"),
+            Body(tags[names[1]], NeoHookean(E, nu), "lower"),
+        ],
         contacts=[ContactPair(tags[names[2]], tags[names[3]], eps_N=eps_N)],
         tags=tags,
     )

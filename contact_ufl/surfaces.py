@@ -85,8 +85,9 @@ def exterior_facet_cells(
     return cells.astype(np.int32), local
 
 
-def composite_quadrature(cell: basix.CellType, degree: int,
-                         subdivisions: int = 1) -> tuple[np.ndarray, np.ndarray]:
+def composite_quadrature(
+    cell: basix.CellType, degree: int, subdivisions: int = 1
+) -> tuple[np.ndarray, np.ndarray]:
     """Gauss rule of ``degree`` repeated on a uniform ``subdivisions``-fold split of ``cell``.
 
     A master facet edge inside a slave facet puts a kink into the contact integrand, which
@@ -113,8 +114,11 @@ def composite_quadrature(cell: basix.CellType, degree: int,
         v_up = [ij[up], ij[up] + e0, ij[up] + e1]
         v_down = [ij[down] + e0 + e1, ij[down] + e1, ij[down] + e0]
         v = [np.vstack([a, b]) / m for a, b in zip(v_up, v_down, strict=True)]
-        sub = (v[0][:, None, :] + points[None, :, :1] * (v[1] - v[0])[:, None, :]
-               + points[None, :, 1:] * (v[2] - v[0])[:, None, :])
+        sub = (
+            v[0][:, None, :]
+            + points[None, :, :1] * (v[1] - v[0])[:, None, :]
+            + points[None, :, 1:] * (v[2] - v[0])[:, None, :]
+        )
     else:
         raise ValueError(f"no composite rule on {cell}")
     nsub = sub.shape[0]
@@ -174,7 +178,8 @@ class SlaveSurface:
 
         sub_cell = _basix_cell(self.submesh, fdim)
         self.points_ref, self.weights_ref = composite_quadrature(
-            sub_cell, self.quadrature_degree, self.subdivisions)
+            sub_cell, self.quadrature_degree, self.subdivisions
+        )
         self.num_points = len(self.weights_ref)
         ref = self._parent_reference_points(sub_cell, parent_local, tdim)
         self._ref = ref
@@ -186,8 +191,9 @@ class SlaveSurface:
         xg = mesh.geometry.x[mesh.geometry.dofmaps[0][self.parent_cells], : mesh.geometry.dim]
         self.X = np.einsum("cqn,cnd->cqd", phi_geom, xg)
         nv = len(basix.topology(sub_cell)[0])
-        vertices = self.submesh.geometry.x[self.submesh.geometry.dofmaps[0][:nc, :nv],
-                                           : mesh.geometry.dim]
+        vertices = self.submesh.geometry.x[
+            self.submesh.geometry.dofmaps[0][:nc, :nv], : mesh.geometry.dim
+        ]
         self.normals = outward_normals(vertices, xg.mean(axis=1))
         tab_u = _scalar_element(self.V).tabulate(1, flat)[..., 0]  # (1 + tdim, npts, ndofs)
         self._phi_u = tab_u[0].reshape(nc, nq, tab_u.shape[-1])
@@ -296,8 +302,12 @@ class MasterSurface:
         cells, local = exterior_facet_cells(mesh, facets, "master")
         layout = self.V.dofmap.dof_layout
         nv = basix.topology(_basix_cell(mesh, tdim))[fdim][0].__len__()
-        closure = np.array([layout.entity_closure_dofs(fdim, f)[:nv] for f in range(len(
-            basix.topology(_basix_cell(mesh, tdim))[fdim]))])
+        closure = np.array(
+            [
+                layout.entity_closure_dofs(fdim, f)[:nv]
+                for f in range(len(basix.topology(_basix_cell(mesh, tdim))[fdim]))
+            ]
+        )
         cell_dofs = self.V.dofmap.list[cells]
         nodes = np.take_along_axis(cell_dofs, closure[local], axis=1)
         coords = self.V.tabulate_dof_coordinates()[:, : mesh.geometry.dim]

@@ -69,19 +69,27 @@ def taylor_test(problem, direction: PETSc.Vec, steps: Sequence[float]) -> Taylor
         Rh.axpy(-h, Jdz)
         first.append(Rh.norm())
     problem.evaluate_residual(z)
-    return TaylorResult(np.asarray(steps, float), np.array(zeroth), np.array(first),
-                        facets_changed, active_changed)
+    return TaylorResult(
+        np.asarray(steps, float), np.array(zeroth), np.array(first), facets_changed, active_changed
+    )
 
 
 def smooth_field(x: np.ndarray, amplitude: float, gdim: int, phase: float = 0.0) -> np.ndarray:
     """A smooth vector field (values ``(gdim, n)``), the same on any number of ranks."""
-    return np.vstack([amplitude * np.sin(2.0 * x[0] + 1.0 + k + phase)
-                      * np.cos(3.0 * x[1] + k - phase) * (1.0 + 0.5 * x[gdim - 1])
-                      for k in range(gdim)])
+    return np.vstack(
+        [
+            amplitude
+            * np.sin(2.0 * x[0] + 1.0 + k + phase)
+            * np.cos(3.0 * x[1] + k - phase)
+            * (1.0 + 0.5 * x[gdim - 1])
+            for k in range(gdim)
+        ]
+    )
 
 
-def contact_state(problem, body_tag: int, shift: np.ndarray, amplitude: float = 0.01,
-                  multiplier: float = 0.05) -> None:
+def contact_state(
+    problem, body_tag: int, shift: np.ndarray, amplitude: float = 0.01, multiplier: float = 0.05
+) -> None:
     """Put ``problem`` in a generic state of contact: every body deformed by a smooth field,
     the body ``body_tag`` also translated by ``shift`` (into the other), smooth positive
     multipliers. Sets the unknowns (not a solution: a point to test the tangent at)."""
@@ -91,16 +99,18 @@ def contact_state(problem, body_tag: int, shift: np.ndarray, amplitude: float = 
     cells = problem.scene.cell_tags.find(body_tag)
     u = problem.u
     u.interpolate(lambda x: smooth_field(x, amplitude, gdim))
-    u.interpolate(lambda x: smooth_field(x, amplitude, gdim) + np.asarray(shift)[:, None],
-                  cells0=cells)
+    u.interpolate(
+        lambda x: smooth_field(x, amplitude, gdim) + np.asarray(shift)[:, None], cells0=cells
+    )
     for c in problem.contacts:
         c.lambda_N.interpolate(lambda x: multiplier * (1.0 + 0.2 * np.sin(5.0 * x[0])))
     dolfinx.fem.petsc.assign(problem.unknowns, problem.x)
     problem.evaluate_residual(problem.x)
 
 
-def sliding_direction(problem, body_tag: int, slide: np.ndarray, amplitude: float = 0.02,
-                      multiplier: float = 0.01) -> PETSc.Vec:
+def sliding_direction(
+    problem, body_tag: int, slide: np.ndarray, amplitude: float = 0.02, multiplier: float = 0.01
+) -> PETSc.Vec:
     """A direction dz that slides body ``body_tag`` by ``slide`` over the other, deforms both
     bodies (rotating the master normals) and changes the multipliers; rank independent."""
     import dolfinx.fem.petsc
@@ -110,8 +120,10 @@ def sliding_direction(problem, body_tag: int, slide: np.ndarray, amplitude: floa
     fields = []
     du = dolfinx.fem.Function(problem.V)
     du.interpolate(lambda x: smooth_field(x, amplitude, gdim, phase=0.7))
-    du.interpolate(lambda x: smooth_field(x, amplitude, gdim, phase=0.7)
-                   + np.asarray(slide)[:, None], cells0=cells)
+    du.interpolate(
+        lambda x: smooth_field(x, amplitude, gdim, phase=0.7) + np.asarray(slide)[:, None],
+        cells0=cells,
+    )
     fields.append(du)
     for c in problem.contacts:
         dl = dolfinx.fem.Function(c.L)

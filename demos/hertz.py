@@ -93,9 +93,13 @@ if comm.rank == 0:
 if comm.rank == 0:
     near = np.abs(samples.x[:, 0] - xc) < 2.0 * exact.a
     xs = np.linspace(-1.2 * exact.a, 1.2 * exact.a, 200)
-    output.plot_pressure_profile(samples.x[near, 0], samples.pressure[near],
-                                 out / "hertz_pressure.png", exact=(xs + xc, exact.pressure(xs)),
-                                 title="Hertz: contact pressure")
+    output.plot_pressure_profile(
+        samples.x[near, 0],
+        samples.pressure[near],
+        out / "hertz_pressure.png",
+        exact=(xs + xc, exact.pressure(xs)),
+        title="Hertz: contact pressure",
+    )
     print(f"wrote {out / 'hertz_pressure.png'}")
 if comm.size == 1:
     output.plot_deformed(problem, out / "hertz_deformed.png", zoom=4.0, focus=(0.0, 0.0, 0.0))

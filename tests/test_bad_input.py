@@ -22,15 +22,18 @@ def with_pair(scene, **changes):
     return dataclasses.replace(scene, contacts=[pair])
 
 
-@pytest.mark.parametrize("changes, message", [
-    (dict(slave=99), "facet tag 99 is empty or does not exist"),
-    (dict(master=98), "facet tag 98 is empty or does not exist"),
-    (dict(eps_N=0.0), "eps_N must be positive"),
-    (dict(eps_N=-1.0), "eps_N must be positive"),
-    (dict(mu=-0.1), "mu must be >= 0"),
-    (dict(search_radius=-1.0), "search_radius must be positive"),
-    (dict(quadrature_subdivisions=0), "quadrature_subdivisions must be >= 1"),
-])
+@pytest.mark.parametrize(
+    "changes, message",
+    [
+        (dict(slave=99), "facet tag 99 is empty or does not exist"),
+        (dict(master=98), "facet tag 98 is empty or does not exist"),
+        (dict(eps_N=0.0), "eps_N must be positive"),
+        (dict(eps_N=-1.0), "eps_N must be positive"),
+        (dict(mu=-0.1), "mu must be >= 0"),
+        (dict(search_radius=-1.0), "search_radius must be positive"),
+        (dict(quadrature_subdivisions=0), "quadrature_subdivisions must be >= 1"),
+    ],
+)
 def test_bad_contact_pair(scene, changes, message):
     with pytest.raises(ContactInputError, match=message):
         ContactProblem(with_pair(scene, **changes), verbose=False)
@@ -46,8 +49,9 @@ def test_slave_not_facing_master(scene):
 
 
 def test_empty_body_tag(scene):
-    bad = dataclasses.replace(scene, bodies=[Body(42, NeoHookean(1.0, 0.3), "ghost"),
-                                             *scene.bodies])
+    bad = dataclasses.replace(
+        scene, bodies=[Body(42, NeoHookean(1.0, 0.3), "ghost"), *scene.bodies]
+    )
     with pytest.raises(ContactInputError, match="cell tag 42 has no cells"):
         ContactProblem(bad, verbose=False)
 

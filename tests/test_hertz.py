@@ -16,8 +16,7 @@ def hertz_errors(problem, hertz):
     a, p0, xc = fit_elliptic_profile(samples.x[:, 0], samples.pressure)
     near = np.abs(samples.x[:, 0] - xc) < 0.8 * exact.a
     profile = samples.pressure[near] - exact.pressure(samples.x[near, 0] - xc)
-    return (a / exact.a - 1.0, p0 / exact.p0 - 1.0,
-            np.sqrt(np.mean(profile**2)) / exact.p0, exact)
+    return (a / exact.a - 1.0, p0 / exact.p0 - 1.0, np.sqrt(np.mean(profile**2)) / exact.p0, exact)
 
 
 def test_hertz_half_width_and_peak_pressure(hertz_moderate):

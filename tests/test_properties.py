@@ -34,4 +34,5 @@ def test_same_result_on_any_number_of_ranks():
     scale = sa.lambda_N.max()
     assert np.allclose(sw.lambda_N[ow], sa.lambda_N[oa], rtol=0, atol=1e-7 * scale)
     assert [r.newton_iterations for r in world.history.steps] == [
-        r.newton_iterations for r in alone.history.steps]
+        r.newton_iterations for r in alone.history.steps
+    ]
