@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 from mpi4py import MPI
 
 from contact_ufl import meshes
@@ -91,27 +92,48 @@ def hertz_2d(
     return HertzScene(scene, 1.0, plane_strain_modulus(E, nu, E_flat, nu_flat), h_contact)
 
 
-def patch_2d(
+def patch(
+    dim: int = 2,
     pressure: float = 0.01,
     E: float = 1.0,
     nu: float = 0.3,
     quadrature_degree: int | None = None,
     subdivisions: int = 1,
-    h_upper: float = 0.1,
-    h_lower: float = 1 / 7,
-    cell: str = "triangle",
+    cell: str | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,
+    **mesh_options,
 ) -> Scene:
     """Contact patch test: a uniform dead pressure through a flat non-matching interface.
 
     Two identical Neo-Hookean blocks stacked (the upper one the slave); the top of the upper
-    block carries the nominal traction ``(0, -pressure)``; the lower block is supported
-    vertically at its bottom; both left sides are held horizontally. The exact solution is a
-    homogeneous deformation with ``lambda_N = pressure`` everywhere on the interface.
+    block carries the nominal traction ``-pressure e_z``; the lower block is supported
+    normally at its bottom; the faces x = 0 (and y = 0 in 3D) of both blocks are held
+    normally. The exact solution is a homogeneous deformation with ``lambda_N = pressure``
+    everywhere on the interface.
+
+    Parameters
+    ----------
+    dim
+        2 (:func:`contact_ufl.meshes.patch_2d`) or 3 (:func:`contact_ufl.meshes.patch_3d`).
+    cell
+        Cell type of the meshes (default: simplices).
+    mesh_options
+        Passed to the mesh generator (element sizes).
     """
-    sm = meshes.patch_2d(h_upper=h_upper, h_lower=h_lower, cell=cell, comm=comm)
+    if dim == 2:
+        sm = meshes.patch_2d(cell=cell or "triangle", comm=comm, **mesh_options)
+        sides = {0: ("upper_left", "lower_left")}
+    else:
+        sm = meshes.patch_3d(cell=cell or "tetrahedron", comm=comm, **mesh_options)
+        sides = {0: ("upper_x0", "lower_x0"), 1: ("upper_y0", "lower_y0")}
     tags = sm.tags
     material = NeoHookean(E, nu)
+    traction = np.zeros(dim)
+    traction[-1] = -pressure
+    supports = [Dirichlet(tags["lower_bottom"], 0.0, component=dim - 1)]
+    supports += [
+        Dirichlet(tags[name], 0.0, component=k) for k, names in sides.items() for name in names
+    ]
     return Scene(
         sm.mesh,
         sm.cell_tags,
@@ -121,17 +143,13 @@ def patch_2d(
             ContactPair(
                 tags["upper_contact"],
                 tags["lower_contact"],
-                eps_N=10.0 * E / h_upper,
+                eps_N=10.0 * E,
                 quadrature_degree=quadrature_degree,
                 quadrature_subdivisions=subdivisions,
             )
         ],
-        dirichlet=[
-            Dirichlet(tags["lower_bottom"], 0.0, component=1),
-            Dirichlet(tags["lower_left"], 0.0, component=0),
-            Dirichlet(tags["upper_left"], 0.0, component=0),
-        ],
-        loads=[DeadTraction(tags["upper_top"], lambda t: (0.0, -pressure * t))],
+        dirichlet=supports,
+        loads=[DeadTraction(tags["upper_top"], lambda t: traction * t)],
         tags=tags,
     )
 

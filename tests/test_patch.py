@@ -5,14 +5,14 @@ import pytest
 
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import body_resultants
-from contact_ufl.scenes import patch_2d
+from contact_ufl.scenes import patch
 
 PRESSURE = 0.01
 TIGHT = {"snes_rtol": 1e-13, "snes_atol": 1e-15}
 
 
-def solve_patch(degree, subdivisions):
-    scene = patch_2d(pressure=PRESSURE, quadrature_degree=degree, subdivisions=subdivisions)
+def solve_patch(degree, subdivisions, dim=2, cell=None):
+    scene = patch(dim, PRESSURE, quadrature_degree=degree, subdivisions=subdivisions, cell=cell)
     problem = ContactProblem(scene, verbose=False, petsc_options=TIGHT)
     problem.solve(num_steps=1)
     return problem
@@ -53,3 +53,21 @@ def test_patch_one_gauss_rule_is_not_enough():
     problem = solve_patch(3, 1)
     lam = problem.contacts[0].lambda_N.x.array
     assert np.abs(lam / PRESSURE - 1.0).max() > 1e-2
+
+
+@pytest.mark.parametrize(
+    "cell, degree, subdivisions, tolerance",
+    [
+        ("tetrahedron", 2, 4, 1e-2),  # triangle master facets
+        ("hexahedron", 3, 2, 3e-2),  # bilinear quadrilateral master facets
+    ],
+)
+def test_patch_3d(cell, degree, subdivisions, tolerance):
+    problem = solve_patch(degree, subdivisions, dim=3, cell=cell)
+    lam = problem.contacts[0].lambda_N.x.array
+    assert np.abs(lam / PRESSURE - 1.0).max() < tolerance
+    force = problem.contact_force()
+    assert abs(force[2] / PRESSURE - 1.0) < 1e-12
+    resultants = body_resultants(problem, problem.contact_residual())
+    slave, master = (resultants[b.tag] for b in problem.scene.bodies)
+    assert np.linalg.norm(slave + master) < 1e-14 * np.linalg.norm(slave)
