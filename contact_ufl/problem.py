@@ -368,37 +368,33 @@ class ContactProblem:
         max_cutbacks: int = 8,
         callback: Callable[[ContactProblem, StepRecord], None] | None = None,
     ) -> History:
-        """Load stepping from the current pseudo-time to ``t_end`` with cut-backs.
+        """Load stepping from the current pseudo-time to ``t_end`` in ``num_steps`` steps.
 
-        A step whose Newton solve diverges is restored and halved, at most ``max_cutbacks``
-        times in a row; then :class:`ConvergenceError` names the step. Accepted steps are in
-        :attr:`history` (and were passed to ``callback``) whatever happens later.
+        A step whose Newton solve fails is restored and halved; after two converged steps in
+        a row the step grows back (at most to its initial size). A step smaller than the
+        initial one halved ``max_cutbacks`` times raises :class:`ConvergenceError`, which
+        names the step. Accepted steps are in :attr:`history` (and were passed to
+        ``callback``, e.g. a :class:`~contact_ufl.output.ResultWriter`) whatever happens later.
         """
-        t0 = self.t
-        dt = (t_end - t0) / num_steps
-        failures = 0
+        dt0 = (t_end - self.t) / num_steps
+        dt, streak = dt0, 0
         while self.t < t_end - 1e-12 * abs(t_end):
-            t_new = min(self.t + dt, t_end)
+            t_prev, t_new = self.t, min(self.t + dt, t_end)
             saved = [f.x.array.copy() for f in self.unknowns]
-            t_prev = self.t
             start = time.perf_counter()
             ok, its, reason = self.solve_step(t_new)
             if not ok:
-                for f, a in zip(self.unknowns, saved, strict=True):
-                    f.x.array[:] = a
-                self.set_time(t_prev)
-                self._state = None
+                self._restore(saved, t_prev)
                 self.history.cutbacks.append((t_new, reason))
-                failures += 1
                 self._print(f"  step to t = {t_new:.5g} failed ({reason}): cutting back")
-                if failures > max_cutbacks:
+                dt, streak = 0.5 * dt, 0
+                if dt < dt0 * 0.5**max_cutbacks * (1.0 - 1e-9):
                     raise ConvergenceError(
                         f"load step from t = {t_prev:.6g} to t = {t_new:.6g} did not converge "
-                        f"({reason}) after {max_cutbacks} cut-backs"
+                        f"({reason}) after {max_cutbacks} cut-backs; the state of "
+                        f"t = {t_prev:.6g} is kept"
                     )
-                dt *= 0.5
                 continue
-            failures = 0
             record = StepRecord(
                 len(self.history.steps) + 1,
                 t_new,
@@ -412,7 +408,16 @@ class ContactProblem:
             self._print(self._format(record))
             if callback is not None:
                 callback(self, record)
+            streak += 1
+            if streak >= 2 and dt < dt0:
+                dt, streak = min(2.0 * dt, dt0), 0
         return self.history
+
+    def _restore(self, saved: list[np.ndarray], t: float) -> None:
+        for f, a in zip(self.unknowns, saved, strict=True):
+            f.x.array[:] = a
+        self.set_time(t)
+        self._state = None
 
     # -- results --------------------------------------------------------------------
     def contact_force(self, k: int | None = None) -> np.ndarray:

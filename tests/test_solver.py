@@ -1,0 +1,36 @@
+"""Load stepping: cut-back of diverging steps, a clear error when cut-backs run out."""
+
+import pytest
+
+from contact_ufl import scenes
+from contact_ufl.errors import ConvergenceError
+from contact_ufl.problem import ContactProblem
+
+
+def hertz_problem(**options):
+    hertz = scenes.hertz_2d(h_contact=0.02, depth=0.01)
+    return ContactProblem(hertz.scene, verbose=False, petsc_options=options)
+
+
+def test_diverging_step_is_cut_back():
+    """Three Newton iterations cannot do the whole load in one step: the step is halved."""
+    problem = hertz_problem(snes_max_it=3)
+    history = problem.solve(num_steps=1)
+    assert len(history.cutbacks) >= 1
+    assert history.cutbacks[0][0] == pytest.approx(1.0)
+    assert problem.t == pytest.approx(1.0)
+    assert all(r.newton_iterations <= 3 for r in history.steps)
+    reference = hertz_problem()
+    reference.solve(num_steps=4)
+    assert problem.contact_force()[1] == pytest.approx(reference.contact_force()[1], rel=1e-8)
+
+
+def test_cutbacks_run_out_with_a_clear_error():
+    problem = hertz_problem()
+    problem.solve(num_steps=2, t_end=0.5)
+    accepted = list(problem.history.steps)
+    problem.snes.setTolerances(max_it=1)  # now no step can converge
+    with pytest.raises(ConvergenceError, match=r"load step from t = .* did not converge"):
+        problem.solve(num_steps=1, t_end=1.0, max_cutbacks=2)
+    assert problem.history.steps[: len(accepted)] == accepted  # nothing accepted is lost
+    assert problem.t == pytest.approx(accepted[-1].t)  # state restored to the last accepted
