@@ -258,15 +258,36 @@ class ContactProblem:
 
     def _residual(self, snes, x, F) -> None:
         self._set_state(x)
-        r = self._r
-        with r.localForm() as r_local:
-            r_local.set(0.0)
-        fem_petsc.assemble_vector(r, self.residual_form)
-        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self._T.multTranspose(r, F)
+        self._assemble(self.residual_form, F)
         if len(self._bc_rows):
             u = self.u.x.array[self._bc_rows]
             F.array[self._bc_rows] = u - self._prescribed(self.t)
+
+    def _assemble(self, forms, out: PETSc.Vec) -> PETSc.Vec:
+        """Assemble ``forms`` over the assembled fields and map them to the unknowns."""
+        r = self._r
+        with r.localForm() as r_local:
+            r_local.set(0.0)
+        fem_petsc.assemble_vector(r, forms)
+        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self._T.multTranspose(r, out)
+        return out
+
+    def reaction(self, tag: int) -> np.ndarray:
+        """Resultant of the support reaction on the facets ``tag`` at the current state.
+
+        It is the residual of the displacement equations (internal minus external forces,
+        contact included) summed over the dofs of those facets, without the equations that
+        prescribe them.
+        """
+        R = self._assemble(self.residual_form, self._R.duplicate())
+        gdim = self.V.mesh.geometry.dim
+        owned = self.V.dofmap.index_map.size_local
+        facets = self.scene.facet_tags.find(tag)
+        blocks = dolfinx.fem.locate_dofs_topological(self.V, gdim - 1, facets)
+        blocks = blocks[blocks < owned]
+        local = R.array[: owned * gdim].reshape(-1, gdim)[blocks].sum(axis=0)
+        return self.comm.allreduce(local, MPI.SUM)
 
     def contact_residual(self) -> PETSc.Vec:
         """The contact terms alone of the residual at the current state, as a vector of the
@@ -275,14 +296,7 @@ class ContactProblem:
             self._contact_residual_form = dolfinx.fem.form(
                 self._contact_residual_ufl, entity_maps=[c.slave.entity_map for c in self.contacts]
             )
-        r = self._r
-        with r.localForm() as r_local:
-            r_local.set(0.0)
-        fem_petsc.assemble_vector(r, self._contact_residual_form)
-        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        out = self._R.duplicate()
-        self._T.multTranspose(r, out)
-        return out
+        return self._assemble(self._contact_residual_form, self._R.duplicate())
 
     def _assemble_jacobian_matrix(self, first: bool = False) -> PETSc.Mat:
         K = self._K
