@@ -172,6 +172,14 @@ class FrictionlessContact:
         self.gdim = gdim = mesh.geometry.dim
         self.fdim = fdim = mesh.topology.dim - 1
         degree = V.ufl_element().embedded_superdegree
+        # the master surface is interpolated from its vertices: exact for P1/Q1 only
+        geometry_degree = mesh.geometry.cmaps[0].degree
+        collective_check(
+            mesh.comm,
+            degree == 1 and geometry_degree == 1,
+            f"contact needs degree-1 displacement and geometry (got {degree} and "
+            f"{geometry_degree}): higher-order master surfaces are not implemented",
+        )
         qdeg = pair.quadrature_degree or 2 * degree + 1
         self.slave = SlaveSurface(V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions)
         self.master = MasterSurface(V, facet_tags, pair.master)

@@ -66,3 +66,8 @@ def test_dirichlet_on_missing_tag(scene):
 def test_bad_material(E, nu, message):
     with pytest.raises(ValueError, match=message):
         NeoHookean(E, nu)
+
+
+def test_higher_order_displacement_is_rejected(scene):
+    with pytest.raises(ContactInputError, match="degree-1 displacement"):
+        ContactProblem(scene, degree=2, verbose=False)
