@@ -301,12 +301,11 @@ class MasterSurface:
         facets = facets[facets < num_owned]
         cells, local = exterior_facet_cells(mesh, facets, "master")
         layout = self.V.dofmap.dof_layout
-        nv = basix.topology(_basix_cell(mesh, tdim))[fdim][0].__len__()
+        reference_facets = basix.topology(_basix_cell(mesh, tdim))[fdim]
+        nv = len(reference_facets[0])
+        # the vertex dofs of each reference facet (vertices come first in the closure)
         closure = np.array(
-            [
-                layout.entity_closure_dofs(fdim, f)[:nv]
-                for f in range(len(basix.topology(_basix_cell(mesh, tdim))[fdim]))
-            ]
+            [layout.entity_closure_dofs(fdim, f)[:nv] for f in range(len(reference_facets))]
         )
         cell_dofs = self.V.dofmap.list[cells]
         nodes = np.take_along_axis(cell_dofs, closure[local], axis=1)
