@@ -259,13 +259,34 @@ class FrictionlessContact:
         nodes = ufl.as_matrix([[vhat[a * gdim + i] for i in range(gdim)] for a in range(self.nn)])
         return _interpolate(self.N, nodes, gdim)
 
-    def residuals(self, v, vhat, lambda_test) -> tuple:
-        """Contact parts of the residuals of ``u``, ``xhat`` and ``lambda_N``."""
-        traction = self.t_N * self.nu
+    @property
+    def fields(self) -> list[dolfinx.fem.Function]:
+        """Fields of the assembled system this pair adds (after the displacement)."""
+        return [self.xhat, self.lambda_N]
+
+    @property
+    def unknowns(self) -> list[dolfinx.fem.Function]:
+        """Unknowns this pair adds (after the displacement)."""
+        return [self.lambda_N]
+
+    def traction(self) -> ufl.core.expr.Expr:
+        """Contact traction on the slave surface, ``T = t_N nu`` (frictionless)."""
+        return self.t_N * self.nu
+
+    def residuals(self, v: ufl.Argument) -> tuple[ufl.Form, list[ufl.Form]]:
+        """Contact part of the displacement residual, and the residuals of :attr:`fields`."""
+        vhat, lambda_test = ufl.TestFunction(self.Qx), ufl.TestFunction(self.L)
+        traction = self.traction()
         F_u = -ufl.dot(traction, v) * self.ds
         F_x = ufl.dot(traction, self.master_test_at_projection(vhat)) * self.ds
         F_l = -(self.lambda_N - self.t_N) / self.eps_N * lambda_test * self.ds
-        return F_u, F_x, F_l
+        return F_u, [F_x, F_l]
+
+    def update_history(self, T, x, block_slice) -> None:
+        """Refresh data that needs the chain operator (none without friction)."""
+
+    def commit(self, x) -> None:
+        """Accept the current state as the converged state of a load step."""
 
     # -- search -------------------------------------------------------------------------
     def _default_radius(self) -> float:
@@ -325,8 +346,8 @@ class FrictionlessContact:
 
         Returns
         -------
-        For every owned dof of ``xhat`` (unrolled, local order), the stacked index of the
-        displacement unknown it gathers, or -1.
+        The gathered fields: pairs of a field and, for every owned dof of it (unrolled, local
+        order), the stacked index of the displacement unknown it gathers, or -1.
         """
         start = time.perf_counter()
         gdim, nn = self.gdim, self.nn
@@ -351,7 +372,8 @@ class FrictionlessContact:
         self._set(self.M, np.where(sliding, proj.sliding, 0.0))
         self._set(self.mask, paired.astype(float))
         self.search_time += time.perf_counter() - start
-        return self._unrolled(self.Qx, gather.reshape(npts, nn * gdim), fill=-1)
+        self._gather = self._unrolled(self.Qx, gather.reshape(npts, nn * gdim), fill=-1)
+        return [(self.xhat, self._gather)]
 
     def multiplier_at_points(self) -> np.ndarray:
         """lambda_N at the owned slave quadrature points, ``(ncells * nq,)``."""

@@ -137,15 +137,15 @@ class ContactProblem:
         contact_residuals = [0]
         fields, unknowns = [u], [u]
         for c in self.contacts:
-            vhat, mu = ufl.TestFunction(c.Qx), ufl.TestFunction(c.L)
-            Fu_c, Fx_c, Fl_c = c.residuals(v, vhat, mu)
+            Fu_c, F_fields = c.residuals(v)
             residuals[0] = residuals[0] + Fu_c
             contact_residuals[0] = contact_residuals[0] + Fu_c
-            residuals += [Fx_c, Fl_c]
-            contact_residuals += [Fx_c, Fl_c]
-            fields += [c.xhat, c.lambda_N]
-            unknowns.append(c.lambda_N)
+            residuals += F_fields
+            contact_residuals += F_fields
+            fields += c.fields
+            unknowns += c.unknowns
         self.fields, self.unknowns = fields, unknowns
+        self._field_index = {id(f): k for k, f in enumerate(fields)}
         jacobian = [
             [_nonempty(ufl.derivative(Fi, f, ufl.TrialFunction(f.function_space))) for f in fields]
             for Fi in residuals
@@ -205,7 +205,7 @@ class ContactProblem:
         self._JT = None
         self._pattern = None
         self._state = None
-        self._update_contact()
+        self._update_contact(self.x)
         self._J = self._assemble_jacobian_matrix(first=True)
         self.snes = PETSc.SNES().create(self.comm)
         self.snes.setOptionsPrefix(prefix)
@@ -235,26 +235,41 @@ class ContactProblem:
         fem_petsc.assign(x, self.unknowns)
         for f in self.unknowns:
             f.x.scatter_forward()
-        self._update_contact()
+        self._update_contact(x)
         self._state = x.copy()
 
-    def _update_contact(self) -> None:
+    def _update_contact(self, x: PETSc.Vec) -> None:
         """Search, refresh the contact data and (if the pairing changed) the operator T."""
         gathers = [c.update(self.layout) for c in self.contacts]
-        pattern = np.concatenate(gathers) if gathers else np.zeros(0, np.int64)
+        pattern = [cols for g in gathers for _, cols in g]
+        pattern = np.concatenate(pattern) if pattern else np.zeros(0, np.int64)
         changed = self._pattern is None or not np.array_equal(pattern, self._pattern)
         changed = self.comm.allreduce(changed, MPI.LOR)
         if changed:
             self._pattern = pattern
-            blocks = [(0, 0)] + [(2 + 2 * k, 1 + k) for k in range(len(self.contacts))]
-            self._T = chain_operator(
-                self.full_layout,
-                self.layout,
-                blocks,
-                [1 + 2 * k for k in range(len(self.contacts))],
-                gathers,
-            )
+            self._T = self._chain_operator(gathers)
             self._JT = None
+        for c in self.contacts:
+            c.update_history(self._T, x, self._block_slice)
+
+    def _chain_operator(self, gathers: list[list]) -> PETSc.Mat:
+        """``T``: identity from each unknown to its assembled field, gathers for the others."""
+        unknown_index = {id(f): k for k, f in enumerate(self.unknowns)}
+        identity, gather_blocks, gather_cols = [], [], []
+        for row, f in enumerate(self.fields):
+            if id(f) in unknown_index:
+                identity.append((row, unknown_index[id(f)]))
+        for c, g in zip(self.contacts, gathers, strict=True):
+            for f, cols in g:
+                gather_blocks.append(self._field_index[id(f)])
+                gather_cols.append(cols)
+        return chain_operator(self.full_layout, self.layout, identity, gather_blocks, gather_cols)
+
+    def _block_slice(self, f: dolfinx.fem.Function) -> slice:
+        """Local (owned) range of the assembled field ``f`` in the full layout."""
+        k = self._field_index[id(f)]
+        start = int(self.full_layout.local_sizes[:k].sum())
+        return slice(start, start + int(self.full_layout.local_sizes[k]))
 
     def _residual(self, snes, x, F) -> None:
         self._set_state(x)
@@ -419,6 +434,9 @@ class ContactProblem:
                 time.perf_counter() - start,
             )
             self.history.steps.append(record)
+            for c in self.contacts:
+                c.commit(self.x)
+            self._state = None
             self._print(self._format(record))
             if callback is not None:
                 callback(self, record)
