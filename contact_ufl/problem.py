@@ -20,6 +20,7 @@ from petsc4py import PETSc
 
 from contact_ufl.contact import FrictionlessContact
 from contact_ufl.errors import ConvergenceError
+from contact_ufl.friction import FrictionalContact
 from contact_ufl.layout import StackedLayout, chain_operator
 from contact_ufl.loads import BodyForce, evaluate, load_constant
 from contact_ufl.scene import Scene
@@ -110,7 +111,10 @@ class ContactProblem:
         )
         self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=scene.facet_tags)
         self.t = 0.0
-        self.contacts = [FrictionlessContact(self.u, scene.facet_tags, p) for p in scene.contacts]
+        self.contacts = [
+            (FrictionalContact if p.mu > 0 else FrictionlessContact)(self.u, scene.facet_tags, p)
+            for p in scene.contacts
+        ]
         self._build_forms()
         self._build_dirichlet()
         self._build_solver(petsc_options or {}, petsc_options_prefix)
@@ -162,7 +166,7 @@ class ContactProblem:
         self._K = fem_petsc.create_matrix(self.jacobian_form, kind="mpi")
         self._contact_force_forms = [
             [
-                dolfinx.fem.form(c.t_N * c.nu[i] * c.ds, entity_maps=[c.slave.entity_map])
+                dolfinx.fem.form(c.traction()[i] * c.ds, entity_maps=[c.slave.entity_map])
                 for i in range(self.V.mesh.geometry.dim)
             ]
             for c in self.contacts
@@ -259,7 +263,7 @@ class ContactProblem:
         for row, f in enumerate(self.fields):
             if id(f) in unknown_index:
                 identity.append((row, unknown_index[id(f)]))
-        for c, g in zip(self.contacts, gathers, strict=True):
+        for g in gathers:
             for f, cols in g:
                 gather_blocks.append(self._field_index[id(f)])
                 gather_cols.append(cols)

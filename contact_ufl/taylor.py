@@ -16,7 +16,9 @@ from petsc4py import PETSc
 
 @dataclass
 class TaylorResult:
-    """Steps, remainders of order zero (|R(z+h dz) - R(z)|) and one, and the slopes."""
+    """Steps, remainders of order zero (|R(z+h dz) - R(z)|) and one, and the slopes.
+
+    ``active_changed`` also covers stick/slip changes of frictional pairs."""
 
     h: np.ndarray
     zeroth: np.ndarray
@@ -32,8 +34,10 @@ class TaylorResult:
 
 def _signature(problem) -> tuple[list, list]:
     facets = [c.projection.facet.copy() for c in problem.contacts]
-    active = [c.active().copy() for c in problem.contacts]
-    return facets, active
+    status = [
+        c.active().astype(int) + (c.stick() if hasattr(c, "stick") else 0) for c in problem.contacts
+    ]
+    return facets, status
 
 
 def _same(a: list, b: list, comm: MPI.Comm) -> bool:
@@ -88,7 +92,12 @@ def smooth_field(x: np.ndarray, amplitude: float, gdim: int, phase: float = 0.0)
 
 
 def contact_state(
-    problem, body_tag: int, shift: np.ndarray, amplitude: float = 0.01, multiplier: float = 0.05
+    problem,
+    body_tag: int,
+    shift: np.ndarray,
+    amplitude: float = 0.01,
+    multiplier: float = 0.05,
+    tangential: float = 0.0,
 ) -> None:
     """Put ``problem`` in a generic state of contact: every body deformed by a smooth field,
     the body ``body_tag`` also translated by ``shift`` (into the other), smooth positive
@@ -104,7 +113,12 @@ def contact_state(
     )
     for c in problem.contacts:
         c.lambda_N.interpolate(lambda x: multiplier * (1.0 + 0.2 * np.sin(5.0 * x[0])))
+        if hasattr(c, "lambda_T"):
+            c.lambda_T.interpolate(
+                lambda x: tangential * np.vstack([np.sin(3.0 * x[0] + k) for k in range(gdim)])
+            )
     dolfinx.fem.petsc.assign(problem.unknowns, problem.x)
+    problem.forget_state()
     problem.evaluate_residual(problem.x)
 
 
@@ -142,18 +156,28 @@ CURVED_STATES = {
 }
 
 
-def curved_case(dim: int, num_steps: int = 4):
+def curved_case(dim: int, num_steps: int = 4, mu: float = 0.0):
     """The Taylor test case on curved surfaces: problem at its state, direction, steps.
 
-    Over the steps no slave point changes master facet or contact status.
+    With ``mu > 0`` the state has a slip history: the step is committed half-way along the
+    translation, and the tangential multipliers are smooth and non-zero (a small ``mu``
+    puts the contact points in slip, a large one in stick). Over the steps no slave point
+    changes master facet, contact status or stick/slip status.
     """
+    import dataclasses
+
     from contact_ufl.problem import ContactProblem
     from contact_ufl.scenes import curved_pair
 
     scene = curved_pair(dim)
+    scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu)
     problem = ContactProblem(scene, verbose=False)
     state = CURVED_STATES[dim]
     tag = scene.bodies[0].tag
-    contact_state(problem, tag, np.array(state["shift"]))
+    shift = np.array(state["shift"])
+    if mu > 0:
+        contact_state(problem, tag, 0.5 * shift)
+        problem.contacts[0].commit(problem.x)
+    contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
     direction = sliding_direction(problem, tag, np.array(state["slide"]))
     return problem, direction, [state["h0"] * 2.0**-k for k in range(num_steps)]
