@@ -32,6 +32,7 @@ from __future__ import annotations
 import dolfinx
 import numpy as np
 import ufl
+from mpi4py import MPI
 
 from contact_ufl.contact import (
     ContactPair,
@@ -71,6 +72,11 @@ class FrictionalContact(FrictionlessContact):
         self._gather_n = None
         self._x_commit = None
         self._xhat_n_commit = None
+        #: Slip increments s_T of the last converged step at the owned slave points, and
+        #: which of them stuck.
+        self.last_slip = np.zeros((0, self.gdim))
+        self.last_stick = np.zeros(0, dtype=bool)
+        self.last_weak_slip = 0.0
         self._friction_kinematics()
 
     def _friction_kinematics(self) -> None:
@@ -132,32 +138,71 @@ class FrictionalContact(FrictionlessContact):
     def commit(self, x) -> None:
         """The converged projection becomes the reference of the next step's slip."""
         owned = len(self._gather)
+        self.last_slip = self.slip_at_points()
+        self.last_stick = self.stick()
+        self.last_weak_slip = self.weak_slip(self.last_stick | ~self.active())
         self._gather_n = self._gather.copy()
         self._xhat_n_commit = self.xhat.x.array[:owned].copy()
         self._x_commit = x.copy()
         self.xi_n.x.array[:] = self.xi0.x.array
         self.mask_n.x.array[:] = self.mask.x.array
+        self.xhat_n.x.array[:] = self.xhat.x.array
 
     # -- inspection -------------------------------------------------------------------
-    def stick(self) -> np.ndarray:
-        """Mask of the owned slave points in stick (``|q| < mu t_N``), of those in contact."""
-        proj = self.projection
+    def slip_at_points(self) -> np.ndarray:
+        """Slip increment s_T since the last converged step at the owned slave points."""
         gdim = self.gdim
         x = self.slave.positions(self.u).reshape(-1, gdim)
-        nu = proj.normal
-        lam_T = self._vector_at_points(self.lambda_T)
         nodes = self._values(self.xhat_n).reshape(len(x), self.nn, gdim)
         N_n = shape_functions(self.nn, gdim, self._values(self.xi_n))[0]
         s = (x - np.einsum("pa,pad->pd", N_n, nodes)) * self._values(self.mask_n)
+        return self._tangential(s)
 
-        def tangential(w):
-            return w - np.einsum("pd,pd->p", w, nu)[:, None] * nu
+    def weak_slip(self, stick: np.ndarray) -> float:
+        """Largest ``|int s_T phi_i| / int phi_i`` over the multiplier nodes whose whole
+        support sticks (``stick``: mask of the owned points): zero to solver tolerance, the
+        stick condition as the multiplier equation imposes it."""
+        mu_test = ufl.TestFunction(self.L_T)
+        form = dolfinx.fem.form(
+            ufl.dot(self.slip, mu_test) * self.ds, entity_maps=[self.slave.entity_map]
+        )
+        nodal = dolfinx.fem.Function(self.L_T)
+        dolfinx.fem.assemble_vector(nodal.x.array, form)
+        nodal.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        mass = dolfinx.fem.Function(self.L)
+        dolfinx.fem.assemble_vector(
+            mass.x.array,
+            dolfinx.fem.form(
+                ufl.TestFunction(self.L) * self.ds, entity_maps=[self.slave.entity_map]
+            ),
+        )
+        mass.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        slipping = dolfinx.fem.Function(self.L)
+        cells = (~stick).reshape(self.slave.num_cells, self.slave.num_points).any(axis=1)
+        np.add.at(slipping.x.array, self.L.dofmap.list[: self.slave.num_cells][cells], 1.0)
+        slipping.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        owned = self.L.dofmap.index_map.size_local
+        stuck = (slipping.x.array[:owned] == 0) & (mass.x.array[:owned] > 0)
+        values = np.linalg.norm(nodal.x.array.reshape(-1, self.gdim)[:owned][stuck], axis=1)
+        local = (values / mass.x.array[:owned][stuck]).max(initial=0.0)
+        return self.u.function_space.mesh.comm.allreduce(local, op=MPI.MAX)
 
-        q = tangential(lam_T) + float(self.eps_T.value) * tangential(s)
+    def tangential_multiplier_at_points(self) -> np.ndarray:
+        """Tangential part of lambda_T at the owned slave points."""
+        return self._tangential(self._vector_at_points(self.lambda_T))
+
+    def stick(self) -> np.ndarray:
+        """Mask of the owned slave points in stick (``|q| <= mu t_N``), of those in contact."""
+        proj = self.projection
+        q = self.tangential_multiplier_at_points() + float(self.eps_T.value) * self.slip_at_points()
         lam_N = self.multiplier_at_points()
         t_N = np.where(proj.facet >= 0, lam_N + float(self.eps_N.value) * proj.gap, 0.0)
         radius = float(self.mu.value) * np.maximum(t_N, 0.0)
         return self.active() & (np.einsum("pd,pd->p", q, q) <= radius**2)
+
+    def _tangential(self, w: np.ndarray) -> np.ndarray:
+        nu = self.projection.normal
+        return w - np.einsum("pd,pd->p", w, nu)[:, None] * nu
 
     def _values(self, f: dolfinx.fem.Function) -> np.ndarray:
         bs = f.function_space.dofmap.index_map_bs

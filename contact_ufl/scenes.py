@@ -180,3 +180,45 @@ def curved_pair(
         contacts=[ContactPair(tags[names[2]], tags[names[3]], eps_N=eps_N)],
         tags=tags,
     )
+
+
+def pushed_block(
+    mu: float = 0.3,
+    pressure: float = 0.01,
+    push: float = 0.05,
+    E: float = 1.0,
+    nu: float = 0.3,
+    subdivisions: int = 4,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """A block pressed onto a flat, then pushed tangentially (stick, then slip).
+
+    The upper block of the 2D patch scene carries the dead pressure ``pressure`` on its top
+    for pseudo-time 0 to 1 (then held); from t = 1 to 2 its top is moved horizontally by
+    ``push (t - 1)``. The lower block is clamped at its bottom. The tangential contact force
+    grows in stick and saturates at ``mu`` times the normal force when the block slides.
+    """
+    sm = meshes.patch_2d(h_upper=0.1, h_lower=1 / 7, comm=comm)
+    tags = sm.tags
+    material = NeoHookean(E, nu)
+    return Scene(
+        sm.mesh,
+        sm.cell_tags,
+        sm.facet_tags,
+        bodies=[Body(tags["upper"], material, "upper"), Body(tags["lower"], material, "lower")],
+        contacts=[
+            ContactPair(
+                tags["upper_contact"],
+                tags["lower_contact"],
+                eps_N=10.0 * E,
+                mu=mu,
+                quadrature_subdivisions=subdivisions,
+            )
+        ],
+        dirichlet=[
+            Dirichlet(tags["lower_bottom"], (0.0, 0.0)),
+            Dirichlet(tags["upper_top"], lambda t: push * max(t - 1.0, 0.0), component=0),
+        ],
+        loads=[DeadTraction(tags["upper_top"], lambda t: (0.0, -pressure * min(t, 1.0)))],
+        tags=tags,
+    )

@@ -5,6 +5,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from contact_ufl import scenes
 from contact_ufl.friction import FrictionalContact
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scenes import curved_pair
@@ -49,3 +50,44 @@ def test_no_nan_where_q_vanishes():
     R = problem.evaluate_residual(problem.x)
     J = problem.evaluate_jacobian(problem.x)
     assert np.isfinite(R.norm()) and np.isfinite(J.norm())
+
+
+def test_block_sticks_then_slides():
+    """A block pressed on a flat and pushed: stuck while the tangential force is below
+    mu N (no slip, in the weak sense of the multiplier equation), sliding above it (every
+    contact point slips, against the frictional traction on the slave body)."""
+    mu, push, steps = 0.3, 0.03, 10
+    problem = ContactProblem(scenes.pushed_block(mu=mu, push=push), verbose=False)
+    c = problem.contacts[0]
+    log = []
+
+    def record(problem, step):
+        active = c.active()
+        friction = problem.comm.allreduce(
+            float(np.sum(np.einsum("pd,pd->p", c.last_slip[active], c.last_slip[active])))
+        )
+        log.append(
+            dict(
+                t=step.t,
+                ratio=abs(step.contact_force[0]) / step.contact_force[1],
+                active=problem.comm.allreduce(int(active.sum())),
+                stick=problem.comm.allreduce(int((c.last_stick & active).sum())),
+                weak_slip=c.last_weak_slip,
+                slip2=friction,
+            )
+        )
+
+    problem.solve(num_steps=2, t_end=1.0, callback=record)
+    problem.solve(num_steps=steps, t_end=2.0, callback=record)
+    increment = push / steps
+    stuck = [r for r in log if r["t"] > 1.0 and r["ratio"] < 0.5 * mu]
+    sliding = [r for r in log if r["t"] > 1.75]
+    assert stuck and sliding
+    for r in stuck:
+        assert r["stick"] == r["active"] > 0
+        assert r["weak_slip"] < 1e-5 * increment
+    for r in log:
+        assert r["ratio"] <= mu * (1.0 + 1e-8)
+    for r in sliding:
+        assert r["stick"] == 0 and r["active"] > 0
+        assert np.sqrt(r["slip2"]) > 0.1 * increment
