@@ -53,3 +53,124 @@ def fit_elliptic_profile(x: np.ndarray, p: np.ndarray, threshold: float = 0.1):
     xc = -c1 / (2.0 * c2)
     p0_sq = c0 - c2 * xc**2
     return float(np.sqrt(-p0_sq / c2)), float(np.sqrt(p0_sq)), float(xc)
+
+
+# -- Cantilever elastica under a tip force -----------------------------------------------------
+
+
+def bending_stiffness_plane_strain(E: float, nu: float, h: float) -> float:
+    """Bending stiffness per unit width ``EI = E' h^3 / 12``, ``E' = E / (1 - nu^2)``, of a
+    plane-strain beam of thickness ``h``."""
+    return E / (1.0 - nu**2) * h**3 / 12.0
+
+
+def _elastica_from_tip(k: float, tip_angle: float, follower: bool) -> np.ndarray:
+    """Integrate the elastica from the free end ``s = 1`` back to the clamp ``s = 0``.
+
+    Unknowns ``(theta, theta', x, y)`` along the arc length ``s`` (unit length); the
+    curvature equation is ``theta'' = k cos(theta - theta_tip)`` for a force perpendicular
+    to the tip tangent and ``theta'' = k cos(theta)`` for a dead force in ``-y``; at the tip
+    ``theta = tip_angle``, ``theta' = 0`` (no moment), position ``(0, 0)``. Returns the state
+    at ``s = 0``.
+    """
+    from scipy.integrate import solve_ivp
+
+    shift = tip_angle if follower else 0.0
+
+    def rhs(s, z):
+        return [z[1], k * np.cos(z[0] - shift), np.cos(z[0]), np.sin(z[0])]
+
+    sol = solve_ivp(rhs, (1.0, 0.0), [tip_angle, 0.0, 0.0, 0.0], rtol=1e-12, atol=1e-14)
+    return sol.y[:, -1]
+
+
+def cantilever_elastica(k: float, follower: bool) -> tuple[float, float, float]:
+    """Tip of an inextensible, shear-rigid cantilever (Euler elastica) under a tip force.
+
+    The beam of length ``L`` lies along ``+x``, clamped at ``x = 0``; the force of magnitude
+    ``P`` at ``x = L`` points initially in ``-y``. ``follower=True``: the force stays
+    perpendicular to the deformed tip tangent (follower load); ``False``: it stays in ``-y``
+    (dead load). With the moment ``M = EI theta'`` the equilibrium of the part beyond ``s``
+    gives ``theta'' = k cos(theta - theta_L)`` (follower) or ``k cos(theta)`` (dead), ``k =
+    P L^2 / EI``, ``theta(0) = 0``, ``theta'(L) = 0``. Integrated from the tip, where the state
+    is known up to the tip angle ``theta_L``: for the follower load the clamp condition only
+    rotates the solution (``theta_L = -phi(0)`` of the problem with ``theta_L = 0``); for the
+    dead load ``theta_L`` is found by bisection.
+
+    Parameters
+    ----------
+    k
+        Load parameter ``P L^2 / EI`` (``EI`` per unit width in plane strain, see
+        :func:`bending_stiffness_plane_strain`).
+    follower
+        Follower (perpendicular to the deformed axis) or dead (fixed ``-y``) force.
+
+    Returns
+    -------
+    u/L, v/L, theta_L
+        Tip displacement along and across the undeformed axis, over ``L``, and the tip
+        rotation (radians, negative: clockwise).
+    """
+    from scipy.optimize import brentq
+
+    if follower:
+        phi0 = _elastica_from_tip(k, 0.0, True)
+        tip = -phi0[0]
+    else:
+        tip = brentq(
+            lambda a: _elastica_from_tip(k, a, False)[0], -0.5 * np.pi + 1e-12, 0.0, xtol=1e-15
+        )
+    _, _, x0, y0 = _elastica_from_tip(k, tip, follower)
+    # positions relative to the tip; the clamp is at angle 0 in the global frame
+    return float(-x0 - 1.0), float(-y0), float(tip)
+
+
+#: Tip displacements ``(u/L, v/L)`` of the cantilever elastica under a tip force ``P``
+#: initially in ``-y``, by load parameter ``k = P L^2 / EI``. Follower force perpendicular to
+#: the deformed axis: the follower-load elastica (the classical benchmark of e.g. Argyris &
+#: Symeonidis, "Nonlinear finite element analysis of elastic systems under nonconservative
+#: loading - natural formulation. Part I", Comput. Methods Appl. Mech. Eng. 26, 75-123,
+#: 1981), values to five digits of :func:`cantilever_elastica`.
+ELASTICA_FOLLOWER_TIP: dict[float, tuple[float, float]] = {
+    1.0: (-0.06435, -0.32064),
+    2.0: (-0.23264, -0.57384),
+}
+
+#: Same for a dead tip force fixed in ``-y``: Bisshopp & Drucker, "Large deflection of
+#: cantilever beams", Q. Appl. Math. 3, 272-275 (1945) (reproduced by
+#: :func:`cantilever_elastica`).
+ELASTICA_DEAD_TIP: dict[float, tuple[float, float]] = {
+    1.0: (-0.05643, -0.30172),
+    2.0: (-0.16064, -0.49346),
+}
+
+
+def neo_hookean_pressure_stretch(mu: float, lmbda: float, p: float, follower: bool) -> float:
+    """Stretch ``l`` of a plane-strain Neo-Hookean block in homogeneous biaxial compression.
+
+    The block is loaded by a pressure ``p`` on all its sides (``F = diag(l, l, 1)``); with
+    :class:`~contact_ufl.materials.NeoHookean`, ``P = mu (F - F^-T) + lambda ln(J) F^-T`` and
+    ``P_11 = mu (l - 1/l) + 2 lambda ln(l) / l``. A follower pressure (``p`` per unit current
+    area, nominal traction ``-p J F^-T N = -p l N``) gives ``P_11 = -p l``; a dead traction
+    ``-p N`` per unit reference area gives ``P_11 = -p``.
+
+    Parameters
+    ----------
+    mu, lmbda
+        Lame parameters.
+    p
+        Pressure (positive in compression, ``0 <= p``).
+    follower
+        Follower pressure or dead traction.
+
+    Returns
+    -------
+    The stretch ``l`` (``<= 1``).
+    """
+    from scipy.optimize import brentq
+
+    def residual(l: float) -> float:
+        load = -p * l if follower else -p
+        return mu * (l - 1.0 / l) + 2.0 * lmbda * np.log(l) / l - load
+
+    return float(brentq(residual, 1e-6, 1.0, xtol=1e-15))

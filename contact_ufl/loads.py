@@ -2,6 +2,12 @@
 
 Values are given either as constants or as callables of the pseudo-time ``t``; they are
 refreshed into DOLFINx constants at every load step, so forms are compiled once.
+
+Dead loads (:class:`DeadTraction`, :class:`BodyForce`) keep their direction and magnitude per
+unit reference area or volume. Follower loads (:class:`FollowerPressure`,
+:class:`FollowerForce`) depend on the deformation ``F = I + grad u``: their virtual work is
+a function of ``u``, so the Jacobian of the problem (``ufl.derivative`` of the whole
+residual) contains their load stiffness, which is not symmetric.
 """
 
 from __future__ import annotations
@@ -12,6 +18,9 @@ from dataclasses import dataclass
 import dolfinx
 import numpy as np
 import ufl
+from mpi4py import MPI
+
+from contact_ufl.errors import ContactInputError
 
 Value = float | Sequence[float] | Callable[[float], float | Sequence[float]]
 
@@ -42,7 +51,16 @@ class Dirichlet:
 
 @dataclass(frozen=True)
 class DeadTraction:
-    """Nominal (first Piola) traction per unit reference area, fixed in direction."""
+    """Nominal (first Piola) traction per unit reference area, fixed in direction (dead).
+
+    Parameters
+    ----------
+    tag
+        Facet tag of the loaded surface.
+    value
+        Traction vector ``T`` (force per unit reference area), or a callable of ``t``. A
+        resultant ``P`` spread over a reference area ``A0`` is ``T = P / A0``.
+    """
 
     tag: int
     value: Value
@@ -54,7 +72,15 @@ class DeadTraction:
 
 @dataclass(frozen=True)
 class BodyForce:
-    """Dead body force per unit reference volume (``rho_0 f`` of ``formulation.md``)."""
+    """Dead body force per unit reference volume (``rho_0 f`` of ``formulation.md``).
+
+    Parameters
+    ----------
+    tag
+        Cell tag of the loaded body.
+    value
+        Force vector per unit reference volume, or a callable of ``t``.
+    """
 
     tag: int
     value: Value
@@ -64,7 +90,126 @@ class BodyForce:
         return ufl.dot(constant, v) * dx(self.tag)
 
 
-def load_constant(mesh: dolfinx.mesh.Mesh, load) -> dolfinx.fem.Constant:
-    """A constant of the right shape for ``load``, initialised at t = 0."""
+def deformation_gradient(u: dolfinx.fem.Function) -> ufl.core.expr.Expr:
+    """``F = I + grad u`` of the displacement ``u`` (gradient in the reference frame)."""
+    return ufl.Identity(u.ufl_shape[0]) + ufl.grad(u)
+
+
+@dataclass(frozen=True)
+class FollowerPressure:
+    """Pressure normal to the deformed surface (a follower load).
+
+    A pressure ``p`` (force per unit *current* area, positive pushing into the body) on the
+    facets ``tag``. Pulled back to the reference surface by Nanson's formula
+    ``n da = J F^-T N dA`` it is the nominal (first Piola) traction per unit reference area
+
+    ``T = -p J F^-T N = -p cof(F) N``,
+
+    with ``N`` the outward unit normal of the reference surface (``ufl.FacetNormal``) and
+    ``F = I + grad u``. Its external virtual work is ``int T . v dS_o`` over the reference
+    facets. ``T`` depends on ``u``: the load stiffness ``-p d(cof F)/du N`` is in the Jacobian
+    through ``ufl.derivative`` of the residual; it is not symmetric in general.
+
+    Parameters
+    ----------
+    tag
+        Facet tag of the loaded surface.
+    value
+        Pressure ``p`` (stress units: force per unit current area), a scalar or a callable of
+        the pseudo-time ``t`` returning one.
+    """
+
+    tag: int
+    value: float | Callable[[float], float]
+
+    def traction(self, u: dolfinx.fem.Function, p: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """The nominal traction ``T = -p J F^-T N`` per unit reference area."""
+        N = ufl.FacetNormal(u.function_space.mesh)
+        return -p * ufl.dot(ufl.cofac(deformation_gradient(u)), N)
+
+    def virtual_work(self, u, v, ds, constant):
+        """External virtual work ``int -p J F^-T N . v dS_o`` (``constant`` holds ``p``)."""
+        return ufl.dot(self.traction(u, constant), v) * ds(self.tag)
+
+
+@dataclass(frozen=True)
+class FollowerForce:
+    """A resultant force whose direction follows the deformation (e.g. a follower tip force).
+
+    The magnitude ``P`` is spread uniformly over the reference area ``A0 = int_{tag} dS_o``
+    of the facets ``tag``; its direction at each point is the reference direction ``d0``
+    carried by the deformation and normalised, ``F d0 / |F d0|``. The nominal (first Piola)
+    traction per unit reference area is
+
+    ``T = (P / A0) F d0 / |F d0|``,    ``F = I + grad u``,
+
+    and the external virtual work ``int T . v dS_o``. With ``d0`` tangent to the loaded
+    section (e.g. ``(0, -1)`` on the end section ``x = L`` of a beam along x), ``F d0`` is
+    the deformed section's tangent: the force stays perpendicular to the deformed beam axis
+    (the classical follower tip load). Its resultant is ``P`` times the mean direction, i.e.
+    exactly ``P`` while the section stays straight. The load stiffness (``ufl.derivative``
+    of ``T . v`` through ``F``) is non-symmetric.
+
+    Parameters
+    ----------
+    tag
+        Facet tag of the loaded surface.
+    value
+        Magnitude ``P`` of the resultant force (force units; per unit thickness in plane
+        strain), a scalar or a callable of the pseudo-time ``t`` returning one.
+    direction
+        Reference direction ``d0`` (any nonzero length: only its direction counts), of the
+        dimension of the mesh.
+    """
+
+    tag: int
+    value: float | Callable[[float], float]
+    direction: Sequence[float]
+
+    def reference_area(self, ds: ufl.Measure, mesh: dolfinx.mesh.Mesh) -> float:
+        """``A0 = int_{tag} dS_o``, summed over all ranks."""
+        one = dolfinx.fem.Constant(mesh, 1.0)
+        local = dolfinx.fem.assemble_scalar(dolfinx.fem.form(one * ds(self.tag)))
+        return mesh.comm.allreduce(local, MPI.SUM)
+
+    def traction(
+        self, u: dolfinx.fem.Function, magnitude: ufl.core.expr.Expr
+    ) -> ufl.core.expr.Expr:
+        """The nominal traction ``T = magnitude F d0 / |F d0|`` per unit reference area."""
+        d0 = np.asarray(self.direction, dtype=float)
+        gdim = u.ufl_shape[0]
+        if d0.shape != (gdim,) or not np.linalg.norm(d0) > 0.0:
+            raise ContactInputError(
+                f"FollowerForce on facet tag {self.tag}: direction must be a nonzero vector of "
+                f"dimension {gdim}, got {tuple(d0.tolist())}"
+            )
+        d = ufl.dot(deformation_gradient(u), ufl.as_vector(d0.tolist()))
+        return magnitude * d / ufl.sqrt(ufl.dot(d, d))
+
+    def virtual_work(self, u, v, ds, constant):
+        """External virtual work ``int (P / A0) F d0 / |F d0| . v dS_o`` (``constant``: P).
+
+        ``A0`` is assembled here once (collectively) and enters the form as a constant.
+        """
+        mesh = u.function_space.mesh
+        area = self.reference_area(ds, mesh)
+        if not area > 0.0:
+            raise ContactInputError(f"FollowerForce: facet tag {self.tag} has zero reference area")
+        inverse_area = dolfinx.fem.Constant(mesh, 1.0 / area)
+        return ufl.dot(self.traction(u, constant * inverse_area), v) * ds(self.tag)
+
+
+#: Loads applied on tagged facets (all but :class:`BodyForce`, whose tag is a cell tag).
+SurfaceLoad = DeadTraction | FollowerPressure | FollowerForce
+#: Any load of a scene.
+Load = SurfaceLoad | BodyForce
+
+
+def load_constant(mesh: dolfinx.mesh.Mesh, load: Load) -> dolfinx.fem.Constant:
+    """A constant of the right shape for ``load``, initialised at t = 0.
+
+    A vector for dead tractions and body forces, a scalar (the pressure or force magnitude)
+    for follower loads.
+    """
     shape = evaluate(load.value, 0.0).shape
     return dolfinx.fem.Constant(mesh, np.zeros(shape))

@@ -10,7 +10,7 @@ from mpi4py import MPI
 
 from contact_ufl.contact import ContactPair
 from contact_ufl.errors import collective_check
-from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet
+from contact_ufl.loads import BodyForce, Dirichlet, FollowerForce, FollowerPressure, Load, evaluate
 from contact_ufl.materials import Hyperelastic
 
 
@@ -40,7 +40,7 @@ class Scene:
     dirichlet
         Prescribed displacements.
     loads
-        Dead tractions and body forces.
+        Dead tractions, body forces and follower loads (:mod:`contact_ufl.loads`).
     tags
         Names of the tags (for look-up and messages), e.g. from :mod:`contact_ufl.meshes`.
     """
@@ -51,7 +51,7 @@ class Scene:
     bodies: list[Body]
     contacts: list[ContactPair] = field(default_factory=list)
     dirichlet: list[Dirichlet] = field(default_factory=list)
-    loads: list[DeadTraction | BodyForce] = field(default_factory=list)
+    loads: list[Load] = field(default_factory=list)
     tags: dict[str, int] = field(default_factory=dict)
 
     def validate(self) -> None:
@@ -81,10 +81,28 @@ class Scene:
                 comm, count > 0, f"body {body.name or body.tag}: cell tag {body.tag} has no cells"
             )
         facet_values = comm.allreduce(set(np.unique(self.facet_tags.values).tolist()), MPI.BOR)
-        for item in [*self.dirichlet, *[ld for ld in self.loads if isinstance(ld, DeadTraction)]]:
+        surface_loads = [ld for ld in self.loads if not isinstance(ld, BodyForce)]
+        for item in [*self.dirichlet, *surface_loads]:
             collective_check(
                 comm,
                 item.tag in facet_values,
                 f"{type(item).__name__}: facet tag {item.tag} does not exist "
                 f"(facet tags: {sorted(facet_values)})",
             )
+        for load in self.loads:
+            if isinstance(load, FollowerPressure | FollowerForce):
+                shape = evaluate(load.value, 0.0).shape
+                collective_check(
+                    comm,
+                    shape == (),
+                    f"{type(load).__name__} on facet tag {load.tag}: the value is a scalar "
+                    f"magnitude, got shape {shape}",
+                )
+            if isinstance(load, FollowerForce):
+                d0 = np.asarray(load.direction, dtype=float)
+                collective_check(
+                    comm,
+                    d0.shape == (gdim,) and bool(np.linalg.norm(d0) > 0.0),
+                    f"FollowerForce on facet tag {load.tag}: direction must be a nonzero "
+                    f"vector of dimension {gdim}, got {tuple(d0.tolist())}",
+                )
