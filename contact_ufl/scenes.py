@@ -40,6 +40,8 @@ def hertz_2d(
     eps_factor: float = 1.0,
     quadrature_degree: int | None = None,
     h_far: float = 0.2,
+    mu: float = 0.0,
+    shift: float = 0.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> HertzScene:
     """Plane-strain Hertz problem: an elastic half disc (R = 1) pressed onto an elastic block.
@@ -63,6 +65,11 @@ def hertz_2d(
         Quadrature degree of the contact integrals (default of :class:`ContactPair`).
     h_far
         Element size far from the contact.
+    mu
+        Friction coefficient.
+    shift
+        Horizontal displacement of the top of the disc from t = 1 to t = 2 (the vertical one
+        is held at ``depth``): the Cattaneo-Mindlin loading.
     """
     E_flat = E if E_flat is None else E_flat
     sm = meshes.hertz_2d(h_contact=h_contact, h_far=h_far, comm=comm)
@@ -80,12 +87,16 @@ def hertz_2d(
                 tags["cylinder_contact"],
                 tags["block_contact"],
                 eps_N=eps_factor * E / h_contact,
+                mu=mu,
                 quadrature_degree=quadrature_degree,
             )
         ],
         dirichlet=[
             Dirichlet(tags["block_bottom"], (0.0, 0.0)),
-            Dirichlet(tags["cylinder_top"], lambda t: (0.0, -depth * t)),
+            Dirichlet(
+                tags["cylinder_top"],
+                lambda t: (shift * max(t - 1.0, 0.0), -depth * min(t, 1.0)),
+            ),
         ],
         tags=tags,
     )
