@@ -877,3 +877,21 @@ def cylinders_3d(
             gmsh.model.mesh.setOrder(order)
 
     return _generate(comm, "cylinders_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
+
+
+def tag_single_body(
+    mesh: dolfinx.mesh.Mesh, sides: list[Callable[[np.ndarray], np.ndarray]]
+) -> tuple[dolfinx.mesh.MeshTags, dolfinx.mesh.MeshTags]:
+    """Tags of a one-body mesh made without gmsh (e.g. ``dolfinx.mesh.create_rectangle``).
+
+    Every cell gets tag 1; the boundary facets located by ``sides[k]`` (a marker of points
+    ``x`` of shape ``(3, n)``) get tag ``k + 1`` (the first marker wins where they overlap).
+    """
+    tdim = mesh.topology.dim
+    cells = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
+    cell_tags = dolfinx.mesh.meshtags(mesh, tdim, cells, np.ones_like(cells))
+    facets = [dolfinx.mesh.locate_entities_boundary(mesh, tdim - 1, s) for s in sides]
+    values = [np.full(len(f), k + 1, dtype=np.int32) for k, f in enumerate(facets)]
+    all_facets, first = np.unique(np.concatenate(facets), return_index=True)
+    facet_tags = dolfinx.mesh.meshtags(mesh, tdim - 1, all_facets, np.concatenate(values)[first])
+    return cell_tags, facet_tags

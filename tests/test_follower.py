@@ -25,6 +25,7 @@ from contact_ufl.loads import (
     load_constant,
 )
 from contact_ufl.materials import NeoHookean
+from contact_ufl.meshes import tag_single_body
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Scene
 from contact_ufl.taylor import smooth_field, taylor_test
@@ -39,20 +40,6 @@ REL_TOL = 0.02
 MAX_NEWTON = 6
 
 
-def tagged_mesh(mesh, sides):
-    """Cell tag 1 on all cells; facet tags ``k + 1`` on the boundary facets of ``sides[k]``."""
-    tdim = mesh.topology.dim
-    cells = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
-    cell_tags = dolfinx.mesh.meshtags(mesh, tdim, cells, np.ones_like(cells))
-    facets = [dolfinx.mesh.locate_entities_boundary(mesh, tdim - 1, s) for s in sides]
-    values = [np.full(len(f), k + 1, dtype=np.int32) for k, f in enumerate(facets)]
-    order = np.argsort(np.concatenate(facets))
-    facet_tags = dolfinx.mesh.meshtags(
-        mesh, tdim - 1, np.concatenate(facets)[order], np.concatenate(values)[order]
-    )
-    return cell_tags, facet_tags
-
-
 def cantilever_scene(load) -> Scene:
     """The beam ``[0, L] x [-H/2, H/2]`` clamped at x = 0 (tag 1), ``load`` on x = L (tag 2)."""
     mesh = dolfinx.mesh.create_rectangle(
@@ -61,7 +48,7 @@ def cantilever_scene(load) -> Scene:
         [NX, NY],
         dolfinx.mesh.CellType.quadrilateral,
     )
-    cells, facets = tagged_mesh(
+    cells, facets = tag_single_body(
         mesh, [lambda x: np.isclose(x[0], 0.0), lambda x: np.isclose(x[0], L)]
     )
     return Scene(
@@ -179,7 +166,7 @@ def unit_square(n: int = 2):
         lambda x: np.isclose(x[1], 0.0),
         lambda x: np.isclose(x[1], 1.0),
     ]
-    return (mesh, *tagged_mesh(mesh, sides))
+    return (mesh, *tag_single_body(mesh, sides))
 
 
 @pytest.mark.parametrize("follower", [True, False])

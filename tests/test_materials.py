@@ -12,6 +12,7 @@ from scipy.optimize import brentq
 from contact_ufl.errors import ContactInputError
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet
 from contact_ufl.materials import NeoHookean, SaintVenantKirchhoff
+from contact_ufl.meshes import tag_single_body
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Scene
 
@@ -19,22 +20,13 @@ from contact_ufl.scene import Body, Scene
 def block(comm=MPI.COMM_WORLD, n=4):
     """The unit square, one body (tag 1), sides tagged left 1, right 2, bottom 3, top 4."""
     mesh = dolfinx.mesh.create_unit_square(comm, n, n)
-    tdim = mesh.topology.dim
-    cells = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
-    cell_tags = dolfinx.mesh.meshtags(mesh, tdim, cells, np.ones_like(cells))
     sides = [
         lambda x: np.isclose(x[0], 0),
         lambda x: np.isclose(x[0], 1),
         lambda x: np.isclose(x[1], 0),
         lambda x: np.isclose(x[1], 1),
     ]
-    facets = [dolfinx.mesh.locate_entities_boundary(mesh, tdim - 1, s) for s in sides]
-    values = [np.full(len(f), k + 1, dtype=np.int32) for k, f in enumerate(facets)]
-    order = np.argsort(np.concatenate(facets))
-    facet_tags = dolfinx.mesh.meshtags(
-        mesh, tdim - 1, np.concatenate(facets)[order], np.concatenate(values)[order]
-    )
-    return mesh, cell_tags, facet_tags
+    return (mesh, *tag_single_body(mesh, sides))
 
 
 def piola_11(material, l1, l2):
