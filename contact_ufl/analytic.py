@@ -174,3 +174,29 @@ def neo_hookean_pressure_stretch(mu: float, lmbda: float, p: float, follower: bo
         return mu * (l - 1.0 / l) + 2.0 * lmbda * np.log(l) / l - load
 
     return float(brentq(residual, 1e-6, 1.0, xtol=1e-15))
+
+
+@dataclass(frozen=True)
+class CattaneoMindlin2D:
+    """Plane Cattaneo-Mindlin problem: two elastically identical cylinders under the normal
+    load ``P`` and then a monotonically increasing tangential load ``Q < mu P`` (per unit
+    length). The stick zone is ``|x| < c`` with ``c = a sqrt(1 - Q / (mu P))``; the shear
+    traction is ``mu p0 (sqrt(1 - x^2/a^2) - (c/a) sqrt(1 - x^2/c^2))`` in it and ``mu p(x)``
+    in the slip zones (Johnson, *Contact Mechanics*, 1985, section 7.1).
+    """
+
+    hertz: Hertz2D
+    Q: float
+    mu: float
+
+    @property
+    def c(self) -> float:
+        """Half-width of the stick zone."""
+        return self.hertz.a * float(np.sqrt(1.0 - self.Q / (self.mu * self.hertz.P)))
+
+    def shear(self, x: np.ndarray) -> np.ndarray:
+        """Magnitude of the shear traction at distance ``x`` from the centre."""
+        x = np.asarray(x)
+        a, c, p0 = self.hertz.a, self.c, self.hertz.p0
+        stick = self.mu * (c / a) * p0 * np.sqrt(np.clip(1.0 - (x / c) ** 2, 0.0, None))
+        return self.mu * self.hertz.pressure(x) - np.where(np.abs(x) < c, stick, 0.0)

@@ -140,3 +140,28 @@ def weak_contact_law(problem, pair: int = 0) -> tuple[float, float]:
         comm.allreduce(gap.max(initial=0.0), MPI.MAX),
         comm.allreduce(lam.max(initial=0.0), MPI.MAX),
     )
+
+
+def stick_zone_half_width(problem, pair: int = 0) -> float:
+    """Half-width of the stick zone of a 2D frictional pair at its last converged step.
+
+    Its edges are placed half-way between the outermost sticking quadrature point and the
+    next slipping one on either side (the zone is taken along x).
+    """
+    c = problem.contacts[pair]
+    x = c.slave.positions(problem.u).reshape(-1, c.gdim)[:, 0]
+    active = c.active()
+    stick = c.last_stick & active
+    slip = ~c.last_stick & active
+    comm = problem.comm
+    xs = np.concatenate(comm.allgather(x[stick]))
+    xl = np.concatenate(comm.allgather(x[slip]))
+    if len(xs) == 0:
+        return 0.0
+    right, left = xs.max(), xs.min()
+    beyond_right, beyond_left = xl[xl > right], xl[xl < left]
+    if len(beyond_right):
+        right = 0.5 * (right + beyond_right.min())
+    if len(beyond_left):
+        left = 0.5 * (left + beyond_left.max())
+    return 0.5 * (right - left)

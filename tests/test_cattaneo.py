@@ -1,0 +1,24 @@
+"""Cattaneo-Mindlin (2D): the stick zone and the shear traction against Johnson (1985) 7.1."""
+
+import pytest
+
+from contact_ufl.verification import cattaneo_mindlin_run
+
+
+@pytest.fixture(scope="module")
+def levels():
+    """a/h ~ 20; four tangential load levels up to Q / (mu P) ~ 0.7."""
+    records, _ = cattaneo_mindlin_run(0.0025)
+    return records
+
+
+def test_stick_zone_half_width(levels):
+    assert [r["Q_over_muP"] for r in levels] == sorted(r["Q_over_muP"] for r in levels)
+    assert 0.1 < levels[0]["Q_over_muP"] and levels[-1]["Q_over_muP"] < 0.9
+    for r in levels:
+        assert abs(r["stick_zone_error"]) < 0.05, r
+
+
+def test_shear_traction_profile(levels):
+    for r in levels:
+        assert r["shear_error"] < 0.1, r
