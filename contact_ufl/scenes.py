@@ -20,6 +20,12 @@ from contact_ufl.materials import NeoHookean
 from contact_ufl.scene import Body, Scene
 
 
+def rotation_2d(angle: float) -> np.ndarray:
+    """The 2x2 rotation matrix of ``angle`` (radians)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
 @dataclass
 class HertzScene:
     """The 2D Hertz scene and its analytic data."""
@@ -42,6 +48,7 @@ def hertz_2d(
     h_far: float = 0.2,
     mu: float = 0.0,
     shift: float = 0.0,
+    rotation: float = 0.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> HertzScene:
     """Plane-strain Hertz problem: an elastic half disc (R = 1) pressed onto an elastic block.
@@ -70,10 +77,15 @@ def hertz_2d(
     shift
         Horizontal displacement of the top of the disc from t = 1 to t = 2 (the vertical one
         is held at ``depth``): the Cattaneo-Mindlin loading.
+    rotation
+        Rotate the whole scene (geometry and prescribed displacements) by this angle
+        (radians) about the origin: a frame-indifferent model gives rotated results.
     """
     E_flat = E if E_flat is None else E_flat
     sm = meshes.hertz_2d(h_contact=h_contact, h_far=h_far, comm=comm)
     tags = sm.tags
+    R = rotation_2d(rotation)
+    sm.mesh.geometry.x[:, :2] = sm.mesh.geometry.x[:, :2] @ R.T
     scene = Scene(
         sm.mesh,
         sm.cell_tags,
@@ -95,7 +107,7 @@ def hertz_2d(
             Dirichlet(tags["block_bottom"], (0.0, 0.0)),
             Dirichlet(
                 tags["cylinder_top"],
-                lambda t: (shift * max(t - 1.0, 0.0), -depth * min(t, 1.0)),
+                lambda t: R @ (shift * max(t - 1.0, 0.0), -depth * min(t, 1.0)),
             ),
         ],
         tags=tags,

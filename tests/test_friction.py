@@ -91,3 +91,26 @@ def test_block_sticks_then_slides():
     for r in sliding:
         assert r["stick"] == 0 and r["active"] > 0
         assert np.sqrt(r["slip2"]) > 0.1 * increment
+
+
+def test_objectivity_under_a_large_rotation():
+    """Rotating the whole frictional scene by 70 degrees rotates the contact force and leaves
+    the Newton iterations unchanged."""
+    angle = np.deg2rad(70.0)
+    runs = []
+    for rotation in (0.0, angle):
+        hertz = scenes.hertz_2d(
+            h_contact=0.01, depth=0.005, mu=0.3, shift=0.0015, rotation=rotation
+        )
+        problem = ContactProblem(hertz.scene, verbose=False)
+        problem.solve(num_steps=2, t_end=1.0)
+        problem.solve(num_steps=3, t_end=2.0)
+        runs.append(problem)
+    reference, rotated = runs
+    R = scenes.rotation_2d(angle)
+    f0, f1 = reference.contact_force(), rotated.contact_force()
+    assert abs(f0[0]) > 0.1 * abs(f0[1])  # a real tangential load
+    assert np.allclose(R @ f0, f1, rtol=0, atol=1e-8 * np.linalg.norm(f0))
+    assert [s.newton_iterations for s in reference.history.steps] == [
+        s.newton_iterations for s in rotated.history.steps
+    ]
