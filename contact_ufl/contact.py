@@ -355,7 +355,11 @@ class FrictionlessContact:
         points = self.slave.positions(self.u).reshape(-1, gdim)
         current = self.master.current_nodes(self.u)
         cols = layout.from_block_global(0, self.master.global_nodes.astype(np.int64) * bs)
-        nodes, cols, _ = self._candidates(current, points, cols)
+        payload = np.hstack([cols, self.master.keys.astype(np.int64)])
+        nodes, payload, _ = self._candidates(current, points, payload)
+        # candidates in a rank-independent order: ties between facets break the same way
+        order = np.lexsort(payload[:, nn:].T[::-1])
+        nodes, cols = nodes[order], payload[order, :nn]
         proj = closest_points(points, nodes, self.radius)
         self.projection = proj
         paired = proj.facet >= 0

@@ -49,6 +49,7 @@ def hertz_2d(
     mu: float = 0.0,
     shift: float = 0.0,
     rotation: float = 0.0,
+    gap: float = 0.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> HertzScene:
     """Plane-strain Hertz problem: an elastic half disc (R = 1) pressed onto an elastic block.
@@ -80,9 +81,11 @@ def hertz_2d(
     rotation
         Rotate the whole scene (geometry and prescribed displacements) by this angle
         (radians) about the origin: a frame-indifferent model gives rotated results.
+    gap
+        Initial gap between the disc and the block (``depth`` includes it).
     """
     E_flat = E if E_flat is None else E_flat
-    sm = meshes.hertz_2d(h_contact=h_contact, h_far=h_far, comm=comm)
+    sm = meshes.hertz_2d(h_contact=h_contact, h_far=h_far, gap=gap, comm=comm)
     tags = sm.tags
     R = rotation_2d(rotation)
     sm.mesh.geometry.x[:, :2] = sm.mesh.geometry.x[:, :2] @ R.T

@@ -284,9 +284,9 @@ class MasterSurface:
         Reference positions of the nodes, ``(nf, nn, gdim)``.
     global_nodes
         Global block index of each node in the displacement index map, ``(nf, nn)``.
-    facet_ids
-        A global, rank-independent id of each facet (global index of its first node and
-        the others, hashed into one int64), used for tie-breaking and change detection.
+    keys
+        Sorted input (mesh file) indices of the vertices of each facet, ``(nf, nn)``: the
+        same on any number of ranks and in any rigidly moved copy of the scene.
     """
 
     V: dolfinx.fem.FunctionSpace
@@ -322,6 +322,12 @@ class MasterSurface:
         self.global_nodes = imap.local_to_global(nodes.ravel().astype(np.int32)).reshape(
             nodes.shape
         )
+        # a key of each facet independent of the partition and of rigid motions: the sorted
+        # input (file) indices of its vertices, to break ties between equidistant facets
+        geometry_nodes = np.take_along_axis(
+            mesh.geometry.dofmaps[0][cells], np.array(reference_facets)[local], axis=1
+        )
+        self.keys = np.sort(mesh.geometry.input_global_indices[geometry_nodes], axis=1)
 
     @property
     def num_facets(self) -> int:
