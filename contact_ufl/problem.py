@@ -185,6 +185,10 @@ class ContactProblem:
                 dofs = blocks[blocks < owned]
                 self._bc_dofs.append(dofs)
                 self._bc_values.append((bc, i))
+        # prescribed-displacement equations k (u - g) = 0 are scaled by a stiffness k = E L^(d-2)
+        # so that every row of the residual is a force (one absolute tolerance for all)
+        size, E = self._scales()
+        self._bc_scale = E * size ** (gdim - 2)
         self._bc_rows = (
             np.concatenate(self._bc_dofs).astype(np.int64)
             if self._bc_dofs
@@ -225,11 +229,14 @@ class ContactProblem:
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
 
+    def _scales(self) -> tuple[float, float]:
+        """The scene's diameter L and largest Young's modulus E."""
+        lo, hi = global_bounds(self.comm, self.V.mesh.geometry.x)
+        return float(np.linalg.norm(hi - lo)), max(b.material.E for b in self.scene.bodies)
+
     def _default_atol(self) -> float:
         """A force scale: 1e-11 of ``E_max L^(d-1)`` with L the scene's diameter."""
-        lo, hi = global_bounds(self.comm, self.V.mesh.geometry.x)
-        size = float(np.linalg.norm(hi - lo))
-        E = max(b.material.E for b in self.scene.bodies)
+        size, E = self._scales()
         return 1e-11 * E * size ** (self.V.mesh.geometry.dim - 1)
 
     def _set_state(self, x: PETSc.Vec) -> None:
@@ -280,7 +287,7 @@ class ContactProblem:
         self._assemble(self.residual_form, F)
         if len(self._bc_rows):
             u = self.u.x.array[self._bc_rows]
-            F.array[self._bc_rows] = u - self._prescribed(self.t)
+            F.array[self._bc_rows] = self._bc_scale * (u - self._prescribed(self.t))
 
     def _assemble(self, forms, out: PETSc.Vec) -> PETSc.Vec:
         """Assemble ``forms`` over the assembled fields and map them to the unknowns."""
@@ -349,7 +356,7 @@ class ContactProblem:
 
     def _zero_bc_rows(self, J: PETSc.Mat) -> None:
         rows = self.layout.owned(0, self._bc_rows).astype(PETSc.IntType)
-        J.zeroRows(rows, diag=1.0)
+        J.zeroRows(rows, diag=self._bc_scale)
 
     def _jacobian(self, snes, x, J, P) -> None:
         self._set_state(x)

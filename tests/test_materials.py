@@ -117,3 +117,29 @@ def test_manifold_mesh_is_rejected():
     scene = Scene(mesh, cell_tags, facet_tags, [Body(1, NeoHookean(1.0, 0.3))])
     with pytest.raises(ContactInputError, match="topological dimension 2 in 3D"):
         ContactProblem(scene, verbose=False)
+
+
+def test_prescribed_displacement_with_a_stiff_material():
+    """Prescribed displacements are met whatever the units of the moduli: the support
+    equations are scaled to forces, so the absolute tolerance cannot accept a state that
+    does not satisfy them (E = 7e9 here)."""
+    mesh, cells, facets = block()
+    scene = Scene(
+        mesh,
+        cells,
+        facets,
+        [Body(1, NeoHookean(6.896e9, 0.32))],
+        dirichlet=[
+            Dirichlet(1, 0.0, component=0),
+            Dirichlet(3, 0.0, component=1),
+            Dirichlet(2, lambda s: 0.01 * s, component=0),
+        ],
+    )
+    problem = ContactProblem(scene, verbose=False)
+    problem.solve(num_steps=1)
+    assert problem.history.steps[0].newton_iterations >= 2
+    u = problem.u.x.array.reshape(-1, 2)
+    x = problem.V.tabulate_dof_coordinates()[:, :2]
+    right = np.isclose(x[:, 0], 1.0)
+    assert np.allclose(u[right, 0], 0.01, rtol=0, atol=1e-12)
+    assert abs(problem.reaction(2)[0]) > 1e7  # a real force, of the order E * strain
