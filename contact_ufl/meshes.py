@@ -312,16 +312,19 @@ def _disc_on_block(
     master_ratio: float,
     refine_radius: float,
     order: int,
+    x_disc: float = 0.0,
 ) -> None:
-    """Build and mesh the half disc over a block with a flat (``lower_radius`` None) or arc top."""
+    """Build and mesh the half disc over a block with a flat (``lower_radius`` None) or arc top.
+
+    The disc's centre is at ``(x_disc, R + gap)``."""
     geo = gmsh.model.geo
     R, a = radius, 0.5 * width
     yc = R + gap
-    # upper body: lower half of the circle of centre (0, R + gap)
-    c = geo.addPoint(0.0, yc, 0.0)
-    p_left = geo.addPoint(-R, yc, 0.0)
-    p_bottom = geo.addPoint(0.0, gap, 0.0)
-    p_right = geo.addPoint(R, yc, 0.0)
+    # upper body: lower half of the circle of centre (x_disc, R + gap)
+    c = geo.addPoint(x_disc, yc, 0.0)
+    p_left = geo.addPoint(x_disc - R, yc, 0.0)
+    p_bottom = geo.addPoint(x_disc, gap, 0.0)
+    p_right = geo.addPoint(x_disc + R, yc, 0.0)
     arc_left = geo.addCircleArc(p_left, c, p_bottom)
     arc_right = geo.addCircleArc(p_bottom, c, p_right)
     diameter = geo.addLine(p_right, p_left)
@@ -384,6 +387,7 @@ def hertz_2d(
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+    x_disc: float = 0.0,
 ) -> SceneMesh:
     """Plane Hertz scene: a half disc resting on a rectangular block.
 
@@ -417,6 +421,8 @@ def hertz_2d(
         If given, the gmsh mesh is also written there (e.g. ``"meshes/hertz_2d.msh"``).
     ghost_mode
         Ghost mode of the cell partitioner.
+    x_disc
+        Horizontal position of the disc's centre (and of the refinement).
 
     Returns
     -------
@@ -441,7 +447,17 @@ def hertz_2d(
 
     def build() -> None:
         _disc_on_block(
-            radius, gap, width, height, None, h_contact, h_far, master_ratio, refine_radius, order
+            radius,
+            gap,
+            width,
+            height,
+            None,
+            h_contact,
+            h_far,
+            master_ratio,
+            refine_radius,
+            order,
+            x_disc,
         )
 
     return _generate(comm, "hertz_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)

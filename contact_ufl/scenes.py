@@ -248,3 +248,58 @@ def pushed_block(
         loads=[DeadTraction(tags["upper_top"], lambda t: (0.0, -pressure * min(t, 1.0)))],
         tags=tags,
     )
+
+
+def ironing(
+    mu: float = 0.3,
+    h_indenter: float = 0.05,
+    h_block: float = 0.25,
+    depth: float = 1.0,
+    slide: float = 10.0,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """The 2D "shallow ironing" problem (Yang, Laursen & Meng 2005; Poulios & Renard 2015).
+
+    A Neo-Hookean block 12 x 4 (E = 6.896e8, nu = 0.32), clamped at its bottom, and a
+    stiffer indenter (E = 6.896e9) whose bottom is a half circle of radius 0.75, starting at
+    1 from the block's left end. The indenter's top is pressed down by ``depth`` from t = 0
+    to 1, then moved along the block by ``slide`` from t = 1 to 2. The slave surface is the
+    indenter's arc (the finer mesh), the master surface the block's top.
+    """
+    sm = meshes.hertz_2d(
+        radius=0.75,
+        block=(12.0, 4.0),
+        h_contact=h_indenter,
+        h_far=h_block,
+        master_ratio=h_block / h_indenter,
+        refine_radius=1.0,
+        x_disc=-5.0,
+        comm=comm,
+    )
+    tags = sm.tags
+    E_block, E_indenter, nu = 6.896e8, 6.896e9, 0.32
+    return Scene(
+        sm.mesh,
+        sm.cell_tags,
+        sm.facet_tags,
+        bodies=[
+            Body(tags["cylinder"], NeoHookean(E_indenter, nu), "indenter"),
+            Body(tags["block"], NeoHookean(E_block, nu), "block"),
+        ],
+        contacts=[
+            ContactPair(
+                tags["cylinder_contact"],
+                tags["block_contact"],
+                eps_N=E_block / h_block,
+                mu=mu,
+                search_radius=1.0,
+            )
+        ],
+        dirichlet=[
+            Dirichlet(tags["block_bottom"], (0.0, 0.0)),
+            Dirichlet(
+                tags["cylinder_top"], lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0))
+            ),
+        ],
+        tags=tags,
+    )
