@@ -355,12 +355,16 @@ class FrictionlessContact:
         points = self.slave.positions(self.u).reshape(-1, gdim)
         current = self.master.current_nodes(self.u)
         cols = layout.from_block_global(0, self.master.global_nodes.astype(np.int64) * bs)
-        payload = np.hstack([cols, self.master.keys.astype(np.int64)])
+        payload = np.hstack(
+            [cols, self.master.keys.astype(np.int64), self.master.boundary_edges.astype(np.int64)]
+        )
         nodes, payload, _ = self._candidates(current, points, payload)
         # candidates in a rank-independent order: ties between facets break the same way
-        order = np.lexsort(payload[:, nn:].T[::-1])
-        nodes, cols = nodes[order], payload[order, :nn]
+        order = np.lexsort(payload[:, nn : 2 * nn].T[::-1])
+        nodes, payload = nodes[order], payload[order]
+        cols, boundary = payload[:, :nn], payload[:, 2 * nn :].astype(bool)
         proj = closest_points(points, nodes, self.radius)
+        release_beyond_boundary(proj, points, boundary)
         self.projection = proj
         paired = proj.facet >= 0
         npts = len(points)
@@ -404,6 +408,38 @@ class FrictionlessContact:
         out = np.full((Q.dofmap.index_map.size_local, bs), fill, dtype=values.dtype)
         out[self._owned_blocks(Q)] = values
         return out.ravel()
+
+
+def _on_edges(nn: int, xi: np.ndarray, tol: float = 1e-12) -> np.ndarray:
+    """Which edges of :data:`~contact_ufl.surfaces.FACET_EDGES` hold the points ``xi``."""
+    if nn == 2:
+        return np.stack([xi[:, 0] <= tol, xi[:, 0] >= 1 - tol], axis=1)
+    s, t = xi[:, 0], xi[:, 1]
+    if nn == 3:
+        return np.stack([t <= tol, s <= tol, s + t >= 1 - tol], axis=1)
+    return np.stack([t <= tol, s <= tol, s >= 1 - tol, t >= 1 - tol], axis=1)
+
+
+def release_beyond_boundary(proj: Projection, points: np.ndarray, boundary: np.ndarray) -> None:
+    """Unpair the points beyond the edge of the master surface (in place).
+
+    A point whose closest point is on an edge (2D: an end point) of the master *surface*
+    boundary, and off the normal through it, lies beyond the surface: it is not in contact
+    (the last facet is not a half-plane). ``boundary``: boundary-edge flags per candidate.
+    """
+    paired = np.flatnonzero(proj.facet >= 0)
+    if len(paired) == 0:
+        return
+    facet = proj.facet[paired]
+    on_edge = _on_edges(boundary.shape[1], proj.xi[paired])  # as many edges as nodes
+    at_boundary = (on_edge & boundary[facet]).any(axis=1)
+    d = points[paired] - proj.y[paired]
+    normal_part = np.einsum("pd,pd->p", d, proj.normal[paired])
+    off_normal = np.linalg.norm(d - normal_part[:, None] * proj.normal[paired], axis=1)
+    beyond = at_boundary & (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > 0)
+    released = paired[beyond]
+    proj.facet[released] = -1
+    proj.gap[released] = -np.inf
 
 
 def comm_max(comm: MPI.Comm, value: int) -> int:

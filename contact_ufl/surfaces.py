@@ -287,6 +287,9 @@ class MasterSurface:
     keys
         Sorted input (mesh file) indices of the vertices of each facet, ``(nf, nn)``: the
         same on any number of ranks and in any rigidly moved copy of the scene.
+    boundary_edges
+        For each facet, which of its :data:`FACET_EDGES` lie on the boundary of the master
+        surface (2D: which of its two nodes are end points of the surface), ``(nf, ne)``.
     """
 
     V: dolfinx.fem.FunctionSpace
@@ -327,7 +330,9 @@ class MasterSurface:
         geometry_nodes = np.take_along_axis(
             mesh.geometry.dofmaps[0][cells], np.array(reference_facets)[local], axis=1
         )
-        self.keys = np.sort(mesh.geometry.input_global_indices[geometry_nodes], axis=1)
+        node_keys = mesh.geometry.input_global_indices[geometry_nodes]
+        self.keys = np.sort(node_keys, axis=1)
+        self.boundary_edges = _boundary_edges(self.V.mesh.comm, node_keys, nodes, flip, swap)
 
     @property
     def num_facets(self) -> int:
@@ -367,3 +372,37 @@ def global_bounds(comm: MPI.Comm, points: np.ndarray) -> tuple[np.ndarray, np.nd
     comm.Allreduce(np.ascontiguousarray(lo, dtype=float), glo, op=MPI.MIN)
     comm.Allreduce(np.ascontiguousarray(hi, dtype=float), ghi, op=MPI.MAX)
     return glo, ghi
+
+
+#: Edges of a master facet by its (oriented) node numbers: the end points of a segment, the
+#: edges of a triangle and of a bilinear quadrilateral (basix vertex order).
+FACET_EDGES = {2: [(0,), (1,)], 3: [(0, 1), (0, 2), (1, 2)], 4: [(0, 1), (0, 2), (1, 3), (2, 3)]}
+
+
+def _boundary_edges(comm: MPI.Comm, node_keys: np.ndarray, nodes: np.ndarray, flip, swap):
+    """Which facet edges (end points in 2D) belong to one master facet only, over all ranks.
+
+    ``node_keys`` are the input indices of the facet nodes before the orientation swap
+    ``swap`` applied to the facets ``flip``; they are swapped the same way here.
+    """
+    keys = node_keys.copy()
+    keys[flip, swap[0]], keys[flip, swap[1]] = node_keys[flip, swap[1]], node_keys[flip, swap[0]]
+    nn = nodes.shape[1]
+    edges = FACET_EDGES[nn]
+    width = len(edges[0])
+    local = np.stack([np.sort(keys[:, list(e)], axis=1) for e in edges], axis=1)  # (nf, ne, w)
+    everything = np.concatenate(comm.allgather(local.reshape(-1, width)))
+    unique, counts = np.unique(everything, axis=0, return_counts=True)
+    once = unique[counts == 1]
+    flat = local.reshape(-1, width)
+    if len(once) == 0 or len(flat) == 0:
+        return np.zeros(local.shape[:2], dtype=bool)
+    return _rows_in(flat, once).reshape(local.shape[:2])
+
+
+def _rows_in(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Which rows of the integer array ``a`` are rows of ``b`` (vectorised)."""
+    row = np.dtype([("", a.dtype)] * a.shape[1])
+    a_rows = np.ascontiguousarray(a).view(row).ravel()
+    b_rows = np.ascontiguousarray(b.astype(a.dtype)).view(row).ravel()
+    return np.isin(a_rows, b_rows)

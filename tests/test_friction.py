@@ -4,6 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from mpi4py import MPI
 
 from contact_ufl import scenes
 from contact_ufl.friction import FrictionalContact
@@ -116,3 +117,19 @@ def test_objectivity_under_a_large_rotation():
     assert [s.newton_iterations for s in reference.history.steps] == [
         s.newton_iterations for s in rotated.history.steps
     ]
+
+
+def test_points_beyond_the_master_surface_are_released():
+    """The pushed block slides past the end of the lower block: its overhanging part is not
+    in contact (the last master facet is not an infinite line)."""
+    problem = ContactProblem(scenes.pushed_block(push=0.3), verbose=False)
+    problem.solve(num_steps=2, t_end=1.0)
+    problem.solve(num_steps=10, t_end=2.0)
+    c = problem.contacts[0]
+    x = c.slave.positions(problem.u).reshape(-1, 2)[:, 0]
+    end = c.master.current_nodes(problem.u)[..., 0].max(initial=-np.inf)
+    end = problem.comm.allreduce(end, op=MPI.MAX)
+    overhang = x > end + 1e-9
+    assert problem.comm.allreduce(int(overhang.sum())) > 0
+    assert problem.comm.allreduce(int((c.active() & overhang).sum())) == 0
+    assert problem.comm.allreduce(int(c.active().sum())) > 20
