@@ -4,7 +4,7 @@ For one contact pair (slave facet tag, master facet tag) this module builds, in 
 contact integrals of ``formulation.md``
 
     - int_{S_oc} <lambda_N + eps_N g> nu . (U1* - U2*(Y)) dS_o
-    - int_{S_oc} (lambda_N - <lambda_N + eps_N g>) lambda_N* / eps_N dS_o
+    - int_{S_oc} (lambda_N - <lambda_N + eps_N g>) lambda_N* dS_o    (times eps_N, see below)
 
 (the seed's weak form times -1, so that the bulk term reads ``+ int Pi : Grad U*``).
 
@@ -279,7 +279,9 @@ class FrictionlessContact:
         traction = self.traction()
         F_u = -ufl.dot(traction, v) * self.ds
         F_x = ufl.dot(traction, self.master_test_at_projection(vhat)) * self.ds
-        F_l = -(self.lambda_N - self.t_N) / self.eps_N * lambda_test * self.ds
+        # the seed's multiplier equation times eps_N (an equivalent weak form): its rows are
+        # forces like those of the displacement, for conditioning and one tolerance
+        F_l = -(self.lambda_N - self.t_N) * lambda_test * self.ds
         return F_u, [F_x, F_l]
 
     def update_history(self, T, x, block_slice) -> None:

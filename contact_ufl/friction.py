@@ -4,7 +4,7 @@ Adds to the frictionless terms of :mod:`contact_ufl.contact` (``formulation.md``
 
     traction   T = <lambda_N + eps_N g> nu - P(q),   q = lambda_T + eps_T s_T
     - int_{S_oc} T . (U1* - U2*(Y)) dS_o
-    - int_{S_oc} (lambda_T - P(q)) . lambda_T* / eps_T dS_o
+    - int_{S_oc} (lambda_T - P(q)) . lambda_T* dS_o     (the seed's equation times eps_T)
 
 with ``P(q) = min(1, mu <lambda_N + eps_N g> / |q|) q``, the projection of q onto the disc of
 radius ``mu <lambda_N + eps_N g>`` (``P(0) = 0``, the seed's rule; the stick test is written
@@ -45,10 +45,15 @@ from contact_ufl.projection import shape_functions
 
 
 def disc_projection(q, radius):
-    """Projection of the vector ``q`` onto the disc of radius ``radius >= 0``."""
+    """Projection of the vector ``q`` onto the disc of radius ``radius >= 0``.
+
+    A disc of radius 0 (no contact pressure) projects everything to 0, with a zero
+    derivative, also at ``q = 0``: an open point has ``lambda_T = 0`` whatever q is.
+    """
     qq = ufl.dot(q, q)
     safe_norm = ufl.sqrt(qq + ufl.conditional(ufl.eq(qq, 0.0), 1.0, 0.0))
-    return ufl.conditional(ufl.le(qq, radius**2), q, radius / safe_norm * q)
+    stick = ufl.And(ufl.le(qq, radius**2), ufl.gt(radius, 0.0))
+    return ufl.conditional(stick, q, radius / safe_norm * q)
 
 
 class FrictionalContact(FrictionlessContact):
@@ -108,7 +113,8 @@ class FrictionalContact(FrictionlessContact):
     def residuals(self, v: ufl.Argument) -> tuple[ufl.Form, list[ufl.Form]]:
         F_u, (F_x, F_l) = super().residuals(v)
         lambda_test = ufl.TestFunction(self.L_T)
-        F_t = -ufl.dot(self.lambda_T - self.t_T, lambda_test) / self.eps_T * self.ds
+        # times eps_T, like the normal multiplier equation (see FrictionlessContact)
+        F_t = -ufl.dot(self.lambda_T - self.t_T, lambda_test) * self.ds
         # xhat_n has no equation of its own: a zero residual, present so that derivatives
         # with respect to it are assembled and chained onto the displacement by T
         F_n = self._zero * ufl.dot(self.xhat_n, ufl.TestFunction(self.Qx)) * self.ds
@@ -198,7 +204,7 @@ class FrictionalContact(FrictionlessContact):
         lam_N = self.multiplier_at_points()
         t_N = np.where(proj.facet >= 0, lam_N + float(self.eps_N.value) * proj.gap, 0.0)
         radius = float(self.mu.value) * np.maximum(t_N, 0.0)
-        return self.active() & (np.einsum("pd,pd->p", q, q) <= radius**2)
+        return self.active() & (np.einsum("pd,pd->p", q, q) <= radius**2) & (radius > 0)
 
     def _tangential(self, w: np.ndarray) -> np.ndarray:
         nu = self.projection.normal

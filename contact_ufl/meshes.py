@@ -911,3 +911,78 @@ def tag_single_body(
     all_facets, first = np.unique(np.concatenate(facets), return_index=True)
     facet_tags = dolfinx.mesh.meshtags(mesh, tdim - 1, all_facets, np.concatenate(values)[first])
     return cell_tags, facet_tags
+
+
+def ironing_2d(
+    radius: float = 0.75,
+    punch_height: float = 1.5,
+    block: tuple[float, float] = (12.0, 4.0),
+    x_punch: float = 1.0,
+    gap: float = 0.0,
+    h_punch: float = 0.05,
+    h_block: float = 0.2,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> SceneMesh:
+    """The "ironing" scene: a punch with a rounded bottom over a long block.
+
+    Block ``[0, w] x [-height, 0]``; punch: a half disc of radius ``radius`` and centre
+    ``(x_punch, radius + gap)`` under a rectangle ``2 radius`` wide and ``punch_height`` tall.
+
+    Returns
+    -------
+    SceneMesh
+        Cells ``"punch"`` (1), ``"block"`` (2); facets ``"punch_contact"`` (the arc and the
+        vertical sides, 11), ``"punch_top"`` (12), ``"block_contact"`` (top, 13),
+        ``"block_bottom"`` (14), ``"block_sides"`` (15).
+    """
+    _check_positive(radius=radius, punch_height=punch_height, h_punch=h_punch, h_block=h_block)
+    _check_common(gap, 1)
+    width, height = block
+
+    def build() -> None:
+        geo = gmsh.model.geo
+        R, yc = radius, radius + gap
+        c = geo.addPoint(x_punch, yc, 0.0)
+        p_left = geo.addPoint(x_punch - R, yc, 0.0)
+        p_bottom = geo.addPoint(x_punch, gap, 0.0)
+        p_right = geo.addPoint(x_punch + R, yc, 0.0)
+        t_right = geo.addPoint(x_punch + R, yc + punch_height, 0.0)
+        t_left = geo.addPoint(x_punch - R, yc + punch_height, 0.0)
+        arc_left = geo.addCircleArc(p_left, c, p_bottom)
+        arc_right = geo.addCircleArc(p_bottom, c, p_right)
+        side_right = geo.addLine(p_right, t_right)
+        top = geo.addLine(t_right, t_left)
+        side_left = geo.addLine(t_left, p_left)
+        punch = geo.addPlaneSurface(
+            [geo.addCurveLoop([arc_left, arc_right, side_right, top, side_left])]
+        )
+        q = [
+            geo.addPoint(x, y, 0.0)
+            for x, y in [(0.0, -height), (width, -height), (width, 0.0), (0.0, 0.0)]
+        ]
+        bottom, right, block_top, left = (geo.addLine(q[i], q[(i + 1) % 4]) for i in range(4))
+        body = geo.addPlaneSurface([geo.addCurveLoop([bottom, right, block_top, left])])
+        geo.synchronize()
+        _add_groups(
+            [
+                ("punch", 2, [punch]),
+                ("block", 2, [body]),
+                ("punch_contact", 1, [arc_left, arc_right, side_right, side_left]),
+                ("punch_top", 1, [top]),
+                ("block_contact", 1, [block_top]),
+                ("block_bottom", 1, [bottom]),
+                ("block_sides", 1, [left, right]),
+            ],
+            tdim=2,
+        )
+        distance = gmsh.model.mesh.field.add("Distance")
+        gmsh.model.mesh.field.setNumbers(distance, "CurvesList", [block_top])
+        lower = _threshold(distance, h_block, 4.0 * h_block, 0.5, height)
+        _set_background(
+            [_restricted(_constant(h_punch), 2, [punch]), _restricted(lower, 2, [body])]
+        )
+        gmsh.model.mesh.generate(2)
+
+    return _generate(comm, "ironing_2d", build, 2, _mesh_options(1), msh_file, ghost_mode)

@@ -214,6 +214,10 @@ class ContactProblem:
         self._pattern = None
         self._state = None
         self._update_contact(self.x)
+        for c in self.contacts:  # the initial state is the converged state of step 0
+            c.commit(self.x)
+        self._state = None
+        self._update_contact(self.x)
         self._J = self._assemble_jacobian_matrix(first=True)
         self.snes = PETSc.SNES().create(self.comm)
         self.snes.setOptionsPrefix(prefix)
@@ -394,8 +398,14 @@ class ContactProblem:
         self.set_time(t)
         fem_petsc.assign(self.unknowns, self.x)
         self._state = None
-        self.snes.solve(None, self.x)
-        reason = self.snes.getConvergedReason()
+        try:
+            self.snes.solve(None, self.x)
+            reason = self.snes.getConvergedReason()
+        except PETSc.Error as error:  # e.g. a failed factorisation: a failed step, not a crash
+            self._print(f"  PETSc error in the Newton solve: {error}")
+            reason = PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
+        if reason <= 0:
+            self.snes.getKSP().getPC().reset()  # no stale factorisation in the next try
         self._state = None
         self._set_state(self.x)
         names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}

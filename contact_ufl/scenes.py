@@ -248,3 +248,49 @@ def pushed_block(
         loads=[DeadTraction(tags["upper_top"], lambda t: (0.0, -pressure * min(t, 1.0)))],
         tags=tags,
     )
+
+
+def ironing(
+    mu: float = 0.3,
+    h_punch: float = 0.05,
+    h_block: float = 0.2,
+    depth: float = 1.0,
+    slide: float = 10.0,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """The 2D "shallow ironing" problem (Yang, Laursen & Meng 2005; Poulios & Renard 2015).
+
+    A Neo-Hookean block 12 x 4 (E = 6.896e8, nu = 0.32) clamped at its bottom, and a stiffer
+    punch (E = 6.896e9) with a rounded bottom of radius 0.75, its axis 1 from the block's
+    left end. The punch's top is pressed down by ``depth`` from t = 0 to 1, then moved along
+    the block by ``slide`` from t = 1 to 2. The slave surface is the punch's arc and sides
+    (the finer mesh), the master surface the block's top.
+    """
+    sm = meshes.ironing_2d(h_punch=h_punch, h_block=h_block, comm=comm)
+    tags = sm.tags
+    E_block, E_punch, nu = 6.896e8, 6.896e9, 0.32
+    return Scene(
+        sm.mesh,
+        sm.cell_tags,
+        sm.facet_tags,
+        bodies=[
+            Body(tags["punch"], NeoHookean(E_punch, nu), "punch"),
+            Body(tags["block"], NeoHookean(E_block, nu), "block"),
+        ],
+        contacts=[
+            ContactPair(
+                tags["punch_contact"],
+                tags["block_contact"],
+                eps_N=E_block / h_block,
+                mu=mu,
+                search_radius=1.0,
+            )
+        ],
+        dirichlet=[
+            Dirichlet(tags["block_bottom"], (0.0, 0.0)),
+            Dirichlet(
+                tags["punch_top"], lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0))
+            ),
+        ],
+        tags=tags,
+    )
