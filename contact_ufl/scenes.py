@@ -7,6 +7,7 @@ data needed to compare with the analytic solution.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -127,6 +128,7 @@ def patch(
     subdivisions: int = 1,
     cell: str | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,
+    mu: float = 0.0,
     **mesh_options,
 ) -> Scene:
     """Contact patch test: a uniform dead pressure through a flat non-matching interface.
@@ -143,6 +145,8 @@ def patch(
         2 (:func:`contact_ufl.meshes.patch_2d`) or 3 (:func:`contact_ufl.meshes.patch_3d`).
     cell
         Cell type of the meshes (default: simplices).
+    mu
+        Friction coefficient of the interface.
     mesh_options
         Passed to the mesh generator (element sizes).
     """
@@ -170,6 +174,7 @@ def patch(
                 tags["upper_contact"],
                 tags["lower_contact"],
                 eps_N=10.0 * E,
+                mu=mu,
                 quadrature_degree=quadrature_degree,
                 quadrature_subdivisions=subdivisions,
             )
@@ -224,29 +229,15 @@ def pushed_block(
     ``push (t - 1)``. The lower block is clamped at its bottom. The tangential contact force
     grows in stick and saturates at ``mu`` times the normal force when the block slides.
     """
-    sm = meshes.patch_2d(h_upper=0.1, h_lower=1 / 7, comm=comm)
-    tags = sm.tags
-    material = NeoHookean(E, nu)
-    return Scene(
-        sm.mesh,
-        sm.cell_tags,
-        sm.facet_tags,
-        bodies=[Body(tags["upper"], material, "upper"), Body(tags["lower"], material, "lower")],
-        contacts=[
-            ContactPair(
-                tags["upper_contact"],
-                tags["lower_contact"],
-                eps_N=10.0 * E,
-                mu=mu,
-                quadrature_subdivisions=subdivisions,
-            )
-        ],
+    scene = patch(2, pressure, E, nu, subdivisions=subdivisions, mu=mu, comm=comm)
+    tags = scene.tags
+    return dataclasses.replace(
+        scene,
         dirichlet=[
             Dirichlet(tags["lower_bottom"], (0.0, 0.0)),
             Dirichlet(tags["upper_top"], lambda t: push * max(t - 1.0, 0.0), component=0),
         ],
         loads=[DeadTraction(tags["upper_top"], lambda t: (0.0, -pressure * min(t, 1.0)))],
-        tags=tags,
     )
 
 

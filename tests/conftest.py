@@ -25,3 +25,16 @@ def hertz_sequence():
 def hertz_moderate(hertz_sequence):
     """Hertz at a/h ~ 10 (the accuracy target mesh)."""
     return hertz_sequence[-1]
+
+
+def tagged_unit_square(n: int = 4, cell_type=None):
+    """The unit square as one body (cell tag 1), sides tagged left 1, right 2, bottom 3, top 4."""
+    import dolfinx
+    import numpy as np
+
+    from contact_ufl.meshes import tag_single_body
+
+    cell_type = cell_type or dolfinx.mesh.CellType.triangle
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, cell_type)
+    sides = [lambda x, k=k, v=v: np.isclose(x[k], v) for k, v in ((0, 0), (0, 1), (1, 0), (1, 1))]
+    return (mesh, *tag_single_body(mesh, sides))

@@ -7,6 +7,7 @@ import dolfinx.fem.petsc
 import numpy as np
 import pytest
 import ufl
+from conftest import tagged_unit_square
 from mpi4py import MPI
 
 from contact_ufl.analytic import (
@@ -157,16 +158,7 @@ def test_dead_tip_force():
 
 def unit_square(n: int = 2):
     """The unit square of quadrilaterals; sides left 1, right 2, bottom 3, top 4."""
-    mesh = dolfinx.mesh.create_unit_square(
-        MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType.quadrilateral
-    )
-    sides = [
-        lambda x: np.isclose(x[0], 0.0),
-        lambda x: np.isclose(x[0], 1.0),
-        lambda x: np.isclose(x[1], 0.0),
-        lambda x: np.isclose(x[1], 1.0),
-    ]
-    return (mesh, *tag_single_body(mesh, sides))
+    return tagged_unit_square(n, dolfinx.mesh.CellType.quadrilateral)
 
 
 @pytest.mark.parametrize("follower", [True, False])

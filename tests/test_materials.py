@@ -6,27 +6,20 @@ import dolfinx
 import numpy as np
 import pytest
 import ufl
+from conftest import tagged_unit_square
 from mpi4py import MPI
 from scipy.optimize import brentq
 
 from contact_ufl.errors import ContactInputError
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet
 from contact_ufl.materials import NeoHookean, SaintVenantKirchhoff
-from contact_ufl.meshes import tag_single_body
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Scene
 
 
-def block(comm=MPI.COMM_WORLD, n=4):
+def block(n=4):
     """The unit square, one body (tag 1), sides tagged left 1, right 2, bottom 3, top 4."""
-    mesh = dolfinx.mesh.create_unit_square(comm, n, n)
-    sides = [
-        lambda x: np.isclose(x[0], 0),
-        lambda x: np.isclose(x[0], 1),
-        lambda x: np.isclose(x[1], 0),
-        lambda x: np.isclose(x[1], 1),
-    ]
-    return (mesh, *tag_single_body(mesh, sides))
+    return tagged_unit_square(n)
 
 
 def piola_11(material, l1, l2):
