@@ -37,6 +37,7 @@ with standard mortar multipliers.
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 
@@ -384,6 +385,32 @@ class FrictionlessContact:
         self.search_time += time.perf_counter() - start
         self._gather = self._unrolled(self.Qx, gather.reshape(npts, nn * gdim), fill=-1)
         return [(self.xhat, self._gather)]
+
+    def assemble_nodal(self, form: dolfinx.fem.Form, space) -> np.ndarray:
+        """Assemble the linear ``form`` over a multiplier ``space`` of the slave submesh;
+        the owned and ghost values, accumulated."""
+        f = dolfinx.fem.Function(space)
+        dolfinx.fem.assemble_vector(f.x.array, form)
+        f.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        return f.x.array
+
+    @functools.cached_property
+    def nodal_mass(self) -> np.ndarray:
+        """``int phi_i dS_o`` of the owned multiplier nodes (the reference surface)."""
+        form = dolfinx.fem.form(
+            ufl.TestFunction(self.L) * self.ds, entity_maps=[self.slave.entity_map]
+        )
+        return self.assemble_nodal(form, self.L)[: self.L.dofmap.index_map.size_local].copy()
+
+    def count_at_nodes(self, mask: np.ndarray) -> np.ndarray:
+        """For each owned multiplier node, how many of the (owned) points ``mask`` selects
+        lie in the cells around it, over all ranks."""
+        counts = dolfinx.fem.Function(self.L)
+        per_cell = mask.reshape(self.slave.num_cells, self.slave.num_points).sum(axis=1)
+        dofs = self.L.dofmap.list[: self.slave.num_cells]
+        np.add.at(counts.x.array, dofs, per_cell[:, None].astype(float))
+        counts.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        return counts.x.array[: self.L.dofmap.index_map.size_local]
 
     def multiplier_at_points(self) -> np.ndarray:
         """lambda_N at the owned slave quadrature points, ``(ncells * nq,)``."""

@@ -29,6 +29,8 @@ normal part to zero.
 
 from __future__ import annotations
 
+import functools
+
 import dolfinx
 import numpy as np
 import ufl
@@ -77,6 +79,7 @@ class FrictionalContact(FrictionlessContact):
         self._gather_n = None
         self._x_commit = None
         self._xhat_n_commit = None
+        self._work = None  # vectors of update_history, allocated once
         #: Slip increments s_T of the last converged step at the owned slave points, and
         #: which of them stuck.
         self.last_slip = np.zeros((0, self.gdim))
@@ -133,9 +136,11 @@ class FrictionalContact(FrictionlessContact):
         if self._x_commit is None:
             self.xhat_n.x.array[:owned] = self.xhat.x.array[:owned]
         else:
-            dx = x.copy()
+            if self._work is None:
+                self._work = (x.duplicate(), T.createVecLeft())
+            dx, full = self._work
+            x.copy(dx)
             dx.axpy(-1.0, self._x_commit)
-            full = T.createVecLeft()
             T.mult(dx, full)
             moved = full.array[block_slice(self.xhat_n)]
             self.xhat_n.x.array[:owned] = self._xhat_n_commit + moved
@@ -164,33 +169,22 @@ class FrictionalContact(FrictionlessContact):
         s = (x - np.einsum("pa,pad->pd", N_n, nodes)) * self._values(self.mask_n)
         return self._tangential(s)
 
+    @functools.cached_property
+    def _slip_form(self) -> dolfinx.fem.Form:
+        return dolfinx.fem.form(
+            ufl.dot(self.slip, ufl.TestFunction(self.L_T)) * self.ds,
+            entity_maps=[self.slave.entity_map],
+        )
+
     def weak_slip(self, stick: np.ndarray) -> float:
         """Largest ``|int s_T phi_i| / int phi_i`` over the multiplier nodes whose whole
         support sticks (``stick``: mask of the owned points): zero to solver tolerance, the
         stick condition as the multiplier equation imposes it."""
-        mu_test = ufl.TestFunction(self.L_T)
-        form = dolfinx.fem.form(
-            ufl.dot(self.slip, mu_test) * self.ds, entity_maps=[self.slave.entity_map]
-        )
-        nodal = dolfinx.fem.Function(self.L_T)
-        dolfinx.fem.assemble_vector(nodal.x.array, form)
-        nodal.x.scatter_reverse(dolfinx.la.InsertMode.add)
-        mass = dolfinx.fem.Function(self.L)
-        dolfinx.fem.assemble_vector(
-            mass.x.array,
-            dolfinx.fem.form(
-                ufl.TestFunction(self.L) * self.ds, entity_maps=[self.slave.entity_map]
-            ),
-        )
-        mass.x.scatter_reverse(dolfinx.la.InsertMode.add)
-        slipping = dolfinx.fem.Function(self.L)
-        cells = (~stick).reshape(self.slave.num_cells, self.slave.num_points).any(axis=1)
-        np.add.at(slipping.x.array, self.L.dofmap.list[: self.slave.num_cells][cells], 1.0)
-        slipping.x.scatter_reverse(dolfinx.la.InsertMode.add)
         owned = self.L.dofmap.index_map.size_local
-        stuck = (slipping.x.array[:owned] == 0) & (mass.x.array[:owned] > 0)
-        values = np.linalg.norm(nodal.x.array.reshape(-1, self.gdim)[:owned][stuck], axis=1)
-        local = (values / mass.x.array[:owned][stuck]).max(initial=0.0)
+        nodal = self.assemble_nodal(self._slip_form, self.L_T)[: owned * self.gdim]
+        stuck = (self.count_at_nodes(~stick) == 0) & (self.nodal_mass > 0)
+        values = np.linalg.norm(nodal.reshape(-1, self.gdim)[stuck], axis=1)
+        local = (values / self.nodal_mass[stuck]).max(initial=0.0)
         return self.u.function_space.mesh.comm.allreduce(local, op=MPI.MAX)
 
     def tangential_multiplier_at_points(self) -> np.ndarray:

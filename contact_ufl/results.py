@@ -112,29 +112,19 @@ def weak_contact_law(problem, pair: int = 0) -> tuple[float, float]:
     """
     c = problem.contacts[pair]
     mu = ufl.TestFunction(c.L)
+    owned = c.L.dofmap.index_map.size_local
 
     def nodal(expr):
         form = dolfinx.fem.form(expr * mu * c.ds, entity_maps=[c.slave.entity_map])
-        f = dolfinx.fem.Function(c.L)
-        dolfinx.fem.assemble_vector(f.x.array, form)
-        f.x.scatter_reverse(dolfinx.la.InsertMode.add)
-        return f.x.array
+        return c.assemble_nodal(form, c.L)[:owned]
 
-    active = c.active().reshape(c.slave.num_cells, c.slave.num_points)
-    dofs = c.L.dofmap.list[: c.slave.num_cells]
-    touches = dolfinx.fem.Function(c.L)  # number of open (resp. closed) points next to a node
-    counts = []
-    for mask in (~active, active):
-        touches.x.array[:] = 0.0
-        np.add.at(touches.x.array, dofs, mask.sum(axis=1)[:, None].astype(float))
-        touches.x.scatter_reverse(dolfinx.la.InsertMode.add)
-        counts.append(touches.x.array.copy())
-    owned = c.L.dofmap.index_map.size_local
-    mass = nodal(1.0)[:owned]
-    closed = ((counts[0] == 0) & (counts[1] > 0))[:owned]
-    open_ = ((counts[1] == 0) & (counts[0] > 0))[:owned]
-    gap = np.abs(nodal(c.gap)[:owned][closed] / mass[closed])
-    lam = np.abs(nodal(c.lambda_N)[:owned][open_] / mass[open_])
+    active = c.active()
+    opened, touched = c.count_at_nodes(~active), c.count_at_nodes(active)
+    mass = c.nodal_mass
+    closed = (opened == 0) & (touched > 0)
+    open_ = (touched == 0) & (opened > 0)
+    gap = np.abs(nodal(c.gap)[closed] / mass[closed])
+    lam = np.abs(nodal(c.lambda_N)[open_] / mass[open_])
     comm = problem.comm
     return (
         comm.allreduce(gap.max(initial=0.0), MPI.MAX),

@@ -38,3 +38,15 @@ def tagged_unit_square(n: int = 4, cell_type=None):
     mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, cell_type)
     sides = [lambda x, k=k, v=v: np.isclose(x[k], v) for k, v in ((0, 0), (0, 1), (1, 0), (1, 1))]
     return (mesh, *tag_single_body(mesh, sides))
+
+
+def symmetric_square(material, loads, n: int = 4, cell_type=None, dirichlet=()):
+    """One body on the unit square, held normally on its left and bottom sides (symmetry),
+    with ``loads`` (and extra ``dirichlet`` conditions) on the tags of
+    :func:`tagged_unit_square`."""
+    from contact_ufl.loads import Dirichlet
+    from contact_ufl.scene import Body, Scene
+
+    mesh, cells, facets = tagged_unit_square(n, cell_type)
+    supports = [Dirichlet(1, 0.0, component=0), Dirichlet(3, 0.0, component=1), *dirichlet]
+    return Scene(mesh, cells, facets, [Body(1, material)], dirichlet=supports, loads=list(loads))

@@ -7,7 +7,7 @@ import dolfinx.fem.petsc
 import numpy as np
 import pytest
 import ufl
-from conftest import tagged_unit_square
+from conftest import symmetric_square, tagged_unit_square
 from mpi4py import MPI
 
 from contact_ufl.analytic import (
@@ -168,19 +168,11 @@ def test_pressure_homogeneous_compression(follower):
     for a dead traction of the same reference value."""
     material = NeoHookean(1.0, 0.3)
     p = 0.25
-    mesh, cells, facets = unit_square()
     if follower:
         loads = [FollowerPressure(tag, lambda t: p * t) for tag in (2, 4)]
     else:
         loads = [DeadTraction(2, lambda t: (-p * t, 0.0)), DeadTraction(4, lambda t: (0.0, -p * t))]
-    scene = Scene(
-        mesh,
-        cells,
-        facets,
-        [Body(1, material)],
-        dirichlet=[Dirichlet(1, 0.0, component=0), Dirichlet(3, 0.0, component=1)],
-        loads=loads,
-    )
+    scene = symmetric_square(material, loads, n=2, cell_type=dolfinx.mesh.CellType.quadrilateral)
     problem = ContactProblem(scene, verbose=False)
     problem.solve(num_steps=4)
     stretch = 1.0 + point_displacement(problem, (1.0, 1.0))

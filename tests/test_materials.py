@@ -6,7 +6,7 @@ import dolfinx
 import numpy as np
 import pytest
 import ufl
-from conftest import tagged_unit_square
+from conftest import symmetric_square, tagged_unit_square
 from mpi4py import MPI
 from scipy.optimize import brentq
 
@@ -31,15 +31,7 @@ def piola_11(material, l1, l2):
 @pytest.mark.parametrize("material", [NeoHookean(1.0, 0.3), SaintVenantKirchhoff(1.0, 0.3)])
 def test_uniaxial_dead_traction(material):
     t = 0.08
-    mesh, cells, facets = block()
-    scene = Scene(
-        mesh,
-        cells,
-        facets,
-        [Body(1, material)],
-        dirichlet=[Dirichlet(1, 0.0, component=0), Dirichlet(3, 0.0, component=1)],
-        loads=[DeadTraction(2, lambda s: (t * s, 0.0))],
-    )
+    scene = symmetric_square(material, [DeadTraction(2, lambda s: (t * s, 0.0))])
     problem = ContactProblem(scene, verbose=False)
     problem.solve(num_steps=2)
     u = problem.u.x.array.reshape(-1, 2)
@@ -116,17 +108,8 @@ def test_prescribed_displacement_with_a_stiff_material():
     """Prescribed displacements are met whatever the units of the moduli: the support
     equations are scaled to forces, so the absolute tolerance cannot accept a state that
     does not satisfy them (E = 7e9 here)."""
-    mesh, cells, facets = block()
-    scene = Scene(
-        mesh,
-        cells,
-        facets,
-        [Body(1, NeoHookean(6.896e9, 0.32))],
-        dirichlet=[
-            Dirichlet(1, 0.0, component=0),
-            Dirichlet(3, 0.0, component=1),
-            Dirichlet(2, lambda s: 0.01 * s, component=0),
-        ],
+    scene = symmetric_square(
+        NeoHookean(6.896e9, 0.32), [], dirichlet=[Dirichlet(2, lambda s: 0.01 * s, component=0)]
     )
     problem = ContactProblem(scene, verbose=False)
     problem.solve(num_steps=1)
