@@ -12,6 +12,7 @@ Generators
 * :func:`patch_2d`: two stacked rectangles (contact patch test), triangles or quadrilaterals.
 * :func:`patch_3d`: two stacked boxes, tetrahedra or hexahedra.
 * :func:`cylinders_3d`: half cylinder on a block with a cylindrical top of crossed axis.
+* :func:`beams_3d`: two cantilever beams clamped at opposite ends, overlapping in plan.
 
 Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
 11, 12, ... in the order they are listed in each generator's documentation; always look them
@@ -41,6 +42,8 @@ __all__ = [
     "patch_2d",
     "patch_3d",
     "cylinders_3d",
+    "BeamPair",
+    "beams_3d",
 ]
 
 _CELL_TAG0 = 1
@@ -986,3 +989,138 @@ def ironing_2d(
         gmsh.model.mesh.generate(2)
 
     return _generate(comm, "ironing_2d", build, 2, _mesh_options(1), msh_file, ghost_mode)
+
+
+# --------------------------------------------------------------------------------------------
+# 3D: two cantilever beams, overlapping in plan (the showcase)
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BeamPair:
+    """Geometry of :func:`beams_3d` (lengths in the units of the mesh).
+
+    The lower beam occupies ``[0, length] x [0, width] x [-lower_height, 0]`` and is clamped
+    at ``x = 0``; the upper beam ``[tip, tip + length] x [0, width] x [gap, gap + height]`` is
+    clamped at ``x = tip + length`` and free at ``x = tip``, above the lower beam.
+    """
+
+    length: float = 10.0
+    width: float = 1.0
+    height: float = 1.0
+    lower_height: float = 1.5
+    gap: float = 0.5
+    tip: float = 6.0
+    master_start: float = 4.0
+
+    @property
+    def overlap(self) -> float:
+        """Length of the upper beam's part above the lower beam."""
+        return self.length - self.tip
+
+
+def beams_3d(
+    geometry: BeamPair = BeamPair(),
+    divisions: int = 4,
+    master_ratio: float = 1.25,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> SceneMesh:
+    """Two hexahedral cantilever beams clamped at opposite ends, overlapping in plan.
+
+    Structured hexahedra: ``divisions`` elements through the width and the height of the
+    upper beam, and elements of that height through the lower one; along the axis the upper
+    beam has elements of size ``height / divisions`` and the lower beam ``master_ratio``
+    times longer ones, so the interface meshes do not match.
+    The contact surfaces are only the parts that can touch: the bottom of the upper beam
+    above the lower beam (``tip <= x <= length``) and the top of the lower beam from
+    ``master_start`` to its free end.
+
+    Parameters
+    ----------
+    geometry
+        Lengths of the pair (:class:`BeamPair`); ``gap > 0`` and
+        ``0 < master_start < tip < length``.
+    divisions
+        Elements through the height (and width) of each beam.
+    master_ratio
+        Axial element length of the lower beam / that of the upper beam.
+    comm, msh_file, ghost_mode
+        As in :func:`hertz_2d`.
+
+    Returns
+    -------
+    SceneMesh
+        Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"`` (11),
+        ``"lower_contact"`` (12), ``"upper_clamp"`` (end x = tip + length, 13),
+        ``"lower_clamp"`` (end x = 0, 14), ``"upper_tip"`` (end x = tip, 15).
+    """
+    g = geometry
+    _check_positive(
+        length=g.length,
+        width=g.width,
+        height=g.height,
+        lower_height=g.lower_height,
+        gap=g.gap,
+        master_ratio=master_ratio,
+        divisions=float(divisions),
+    )
+    if not 0.0 < g.master_start < g.tip < g.length:
+        raise ValueError(
+            f"need 0 < master_start < tip < length, got {g.master_start}, {g.tip}, {g.length}"
+        )
+    h_upper = g.height / divisions
+    h_lower = master_ratio * h_upper
+    tol = 1e-6 * g.length
+
+    def box(x0: float, x1: float, z0: float, height: float) -> int:
+        return gmsh.model.occ.addBox(x0, 0.0, z0, x1 - x0, g.width, height)
+
+    def face(volume: int, axis: int, coord: float) -> int:
+        """The face of ``volume`` in the plane ``x[axis] = coord``."""
+        for f in _boundary(3, [volume], 2):
+            flat = _flat(f, tol)
+            if flat is not None and flat[0] == axis and abs(flat[1] - coord) < tol:
+                return f
+        raise RuntimeError(f"volume {volume} has no face at x[{axis}] = {coord}")
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        # each beam in two boxes, so that the contact surfaces are faces of their own
+        boxes = [
+            box(0.0, g.master_start, -g.lower_height, g.lower_height),
+            box(g.master_start, g.length, -g.lower_height, g.lower_height),
+            box(g.tip, g.length, g.gap, g.height),
+            box(g.length, g.tip + g.length, g.gap, g.height),
+        ]
+        _, pieces = occ.fragment([(3, b) for b in boxes[:2]], [(3, b) for b in boxes[2:]])
+        occ.synchronize()
+        clamped_lower, master_part, slave_part, clamped_upper = (p[0][1] for p in pieces)
+        lower, upper = [clamped_lower, master_part], [slave_part, clamped_upper]
+        for volumes, h in ((lower, h_lower), (upper, h_upper)):
+            for c in _boundary(3, volumes, 1):
+                extent = np.ptp(_bbox(1, c), axis=0)
+                axis = int(np.argmax(extent))
+                size = (h, g.width / divisions, g.height / divisions)[axis]
+                gmsh.model.mesh.setTransfiniteCurve(c, _divisions(extent[axis], size) + 1)
+            for f in _boundary(3, volumes, 2):
+                gmsh.model.mesh.setTransfiniteSurface(f)
+                gmsh.model.mesh.setRecombine(2, f)
+            for v in volumes:
+                gmsh.model.mesh.setTransfiniteVolume(v)
+        _add_groups(
+            [
+                ("upper", 3, upper),
+                ("lower", 3, lower),
+                ("upper_contact", 2, [face(slave_part, 2, g.gap)]),
+                ("lower_contact", 2, [face(master_part, 2, 0.0)]),
+                ("upper_clamp", 2, [face(clamped_upper, 0, g.tip + g.length)]),
+                ("lower_clamp", 2, [face(clamped_lower, 0, 0.0)]),
+                ("upper_tip", 2, [face(slave_part, 0, g.tip)]),
+            ],
+            tdim=3,
+        )
+        gmsh.model.mesh.generate(3)
+
+    return _generate(comm, "beams_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)

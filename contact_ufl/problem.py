@@ -158,6 +158,7 @@ class ContactProblem:
         self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
         self._contact_residual_ufl = contact_residuals
         self._contact_residual_form = None
+        self._load_resultant_forms = None
         self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
         spaces = [f.function_space for f in fields]
         self.full_layout = StackedLayout(spaces)
@@ -318,6 +319,27 @@ class ContactProblem:
         blocks = blocks[blocks < owned]
         local = R.array[: owned * gdim].reshape(-1, gdim)[blocks].sum(axis=0)
         return self.comm.allreduce(local, MPI.SUM)
+
+    def load_resultant(self) -> np.ndarray:
+        """Resultant of all applied loads (dead and follower) at the current state."""
+        if self._load_resultant_forms is None:
+            mesh = self.V.mesh
+            gdim = mesh.geometry.dim
+            self._load_resultant_forms = []
+            for i in range(gdim):
+                e_i = dolfinx.fem.Constant(mesh, np.eye(gdim)[i])
+                work = sum(
+                    load.virtual_work(
+                        self.u, e_i, self.dx if isinstance(load, BodyForce) else self.ds, c
+                    )
+                    for load, c in self._load_constants
+                )
+                self._load_resultant_forms.append(dolfinx.fem.form(work) if work else None)
+        local = [
+            dolfinx.fem.assemble_scalar(f) if f is not None else 0.0
+            for f in self._load_resultant_forms
+        ]
+        return self.comm.allreduce(np.asarray(local, dtype=float), MPI.SUM)
 
     def contact_residual(self) -> PETSc.Vec:
         """The contact terms alone of the residual at the current state, as a vector of the

@@ -155,3 +155,29 @@ def stick_zone_half_width(problem, pair: int = 0) -> float:
     if len(beyond_left):
         left = 0.5 * (left + beyond_left.max())
     return 0.5 * (right - left)
+
+
+def _facet_integral(problem, expr, tag: int) -> np.ndarray:
+    """``int_{tag} expr dS_o`` (a vector expression), summed over all ranks."""
+    values = [
+        dolfinx.fem.assemble_scalar(dolfinx.fem.form(expr[i] * problem.ds(tag)))
+        for i in range(expr.ufl_shape[0])
+    ]
+    return problem.comm.allreduce(np.asarray(values), MPI.SUM)
+
+
+def section_motion(problem, tag: int) -> tuple[np.ndarray, np.ndarray]:
+    """Mean displacement and deformed unit normal of the facets ``tag`` (e.g. a beam's end).
+
+    Returns ``(u_mean, n)`` with ``u_mean = int u dS_o / int dS_o`` and ``n`` the direction of
+    the deformed area vector ``int J F^-T N dS_o`` (the section's rotation is the angle
+    between ``n`` and the reference normal).
+    """
+    u = problem.u
+    mesh = problem.V.mesh
+    area = _facet_integral(problem, ufl.as_vector([dolfinx.fem.Constant(mesh, 1.0)]), tag)[0]
+    if not area > 0.0:
+        raise ValueError(f"facet tag {tag} has no facet")
+    F = ufl.Identity(len(u)) + ufl.grad(u)
+    n = _facet_integral(problem, ufl.cofac(F) * ufl.FacetNormal(mesh), tag)
+    return _facet_integral(problem, u, tag) / area, n / np.linalg.norm(n)

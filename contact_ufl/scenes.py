@@ -16,7 +16,7 @@ from mpi4py import MPI
 from contact_ufl import meshes
 from contact_ufl.analytic import plane_strain_modulus
 from contact_ufl.contact import ContactPair
-from contact_ufl.loads import DeadTraction, Dirichlet
+from contact_ufl.loads import DeadTraction, Dirichlet, FollowerForce
 from contact_ufl.materials import NeoHookean
 from contact_ufl.scene import Body, Scene
 
@@ -285,3 +285,109 @@ def ironing(
         ],
         tags=tags,
     )
+
+
+@dataclass
+class BeamsScene:
+    """The two-beam showcase scene and the data of its beam-theory estimates."""
+
+    scene: Scene
+    geometry: meshes.BeamPair
+    E: float
+    nu: float
+    load: float
+
+    @property
+    def bending_stiffness(self) -> float:
+        """``EI`` of the upper beam (bending towards the lower one)."""
+        g = self.geometry
+        return self.E * g.width * g.height**3 / 12.0
+
+    @property
+    def lower_bending_stiffness(self) -> float:
+        """``EI`` of the lower beam."""
+        g = self.geometry
+        return self.E * g.width * g.lower_height**3 / 12.0
+
+    def two_springs(self, P: float) -> tuple[float, float]:
+        """Beam-theory estimate ``(N, w)`` of the contact force and the upper tip deflection.
+
+        The upper beam is a cantilever of length ``L`` with tip stiffness ``k1 = 3 EI / L^3``;
+        the lower one, loaded at ``a = tip`` from its clamp, has ``k2 = 3 EI_2 / a^3``. Contact
+        starts at ``P_c = k1 gap``; then ``N = (P - P_c) k2 / (k1 + k2)`` and the tip deflects
+        by ``gap + N / k2`` (before, by ``P / k1`` and ``N = 0``).
+        """
+        g = self.geometry
+        k1 = 3.0 * self.bending_stiffness / g.length**3
+        k2 = 3.0 * self.lower_bending_stiffness / g.tip**3
+        P_c = k1 * g.gap
+        if P <= P_c:
+            return 0.0, P / k1
+        N = (P - P_c) * k2 / (k1 + k2)
+        return N, g.gap + N / k2
+
+
+def beams(
+    mu: float = 0.0,
+    load: float = 6.0,
+    divisions: int = 4,
+    E: float = 1.0e3,
+    nu: float = 0.3,
+    geometry: meshes.BeamPair | None = None,
+    eps_factor: float = 1.0,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> BeamsScene:
+    """Two Neo-Hookean cantilevers, the upper one pushed at its free tip by a follower force.
+
+    The beams of :func:`contact_ufl.meshes.beams_3d` are clamped at opposite ends. The free
+    end section of the upper beam carries the follower force :class:`FollowerForce` of
+    magnitude ``load * t * EI / L^2`` (``t`` the pseudo-time), directed along the carried
+    reference direction ``-e_z``: it stays perpendicular to the deformed beam axis. The upper
+    beam bends down, its tip meets the lower beam and, as it rotates, slides along it.
+    Slave: the bottom of the upper beam above the lower one; master: the top of the lower
+    beam near its free end; ``eps_N = eps_factor E / h`` with ``h`` the upper element size.
+
+    Parameters
+    ----------
+    mu
+        Friction coefficient.
+    load
+        Final follower force in units of ``EI / L^2``.
+    divisions
+        Hexahedra through the height of each beam.
+    E, nu
+        Neo-Hookean material of both beams.
+    geometry
+        Lengths (default :class:`contact_ufl.meshes.BeamPair`).
+    eps_factor
+        Scale of the augmentation parameter.
+    """
+    geometry = geometry or meshes.BeamPair()
+    sm = meshes.beams_3d(geometry, divisions=divisions, comm=comm)
+    tags = sm.tags
+    material = NeoHookean(E, nu)
+    EI = E * geometry.width * geometry.height**3 / 12.0
+    P_end = load * EI / geometry.length**2
+    h = geometry.height / divisions
+    scene = Scene(
+        sm.mesh,
+        sm.cell_tags,
+        sm.facet_tags,
+        bodies=[Body(tags["upper"], material, "upper"), Body(tags["lower"], material, "lower")],
+        contacts=[
+            ContactPair(
+                tags["upper_contact"],
+                tags["lower_contact"],
+                eps_N=eps_factor * E / h,
+                mu=mu,
+                search_radius=geometry.gap + geometry.height,
+            )
+        ],
+        dirichlet=[
+            Dirichlet(tags["upper_clamp"], (0.0, 0.0, 0.0)),
+            Dirichlet(tags["lower_clamp"], (0.0, 0.0, 0.0)),
+        ],
+        loads=[FollowerForce(tags["upper_tip"], lambda t: P_end * t, (0.0, 0.0, -1.0))],
+        tags=tags,
+    )
+    return BeamsScene(scene, geometry, E, nu, load)
