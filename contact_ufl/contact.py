@@ -50,7 +50,7 @@ from mpi4py import MPI
 from contact_ufl.errors import check_positive, collective_check
 from contact_ufl.layout import StackedLayout
 from contact_ufl.projection import Projection, closest_points
-from contact_ufl.surfaces import MasterSurface, SlaveSurface, global_bounds
+from contact_ufl.surfaces import QUADRATURE_RULES, MasterSurface, SlaveSurface, global_bounds
 
 
 @dataclass(frozen=True)
@@ -80,6 +80,11 @@ class ContactPair:
     quadrature_subdivisions
         Repeat that rule on a uniform split of every slave facet (composite rule): the master
         facet edges put kinks into the integrand that one Gauss rule resolves poorly.
+    quadrature_rule
+        ``"gauss"`` (default) or ``"lobatto"`` (Gauss-Lobatto-Legendre, intervals and
+        quadrilaterals): the Lobatto points include the vertices of the slave facets, so a
+        slave edge or corner that meets the master surface (the tip of a beam) is itself a
+        contact point and cannot sink into the master between Gauss points.
     """
 
     slave: int
@@ -90,6 +95,7 @@ class ContactPair:
     search_radius: float | None = None
     quadrature_degree: int | None = None
     quadrature_subdivisions: int = 1
+    quadrature_rule: str = "gauss"
 
     def validate(self, comm: MPI.Comm) -> None:
         """Raise a clear error (on every rank) for invalid parameters."""
@@ -103,6 +109,12 @@ class ContactPair:
             comm,
             int(self.quadrature_subdivisions) >= 1,
             f"quadrature_subdivisions must be >= 1, got {self.quadrature_subdivisions}",
+        )
+        collective_check(
+            comm,
+            self.quadrature_rule in QUADRATURE_RULES,
+            f"quadrature_rule must be one of {sorted(QUADRATURE_RULES)}, "
+            f"got {self.quadrature_rule!r}",
         )
         collective_check(
             comm,
@@ -182,7 +194,9 @@ class FrictionlessContact:
             f"{geometry_degree}): higher-order master surfaces are not implemented",
         )
         qdeg = pair.quadrature_degree or 2 * degree + 1
-        self.slave = SlaveSurface(V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions)
+        self.slave = SlaveSurface(
+            V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions, pair.quadrature_rule
+        )
         self.master = MasterSurface(V, facet_tags, pair.master)
         self.nn = nn = comm_max(mesh.comm, self.master.nodes.shape[1])
         sub = self.slave.submesh
@@ -419,10 +433,19 @@ class FrictionlessContact:
 
     def active(self) -> np.ndarray:
         """Mask of the owned slave quadrature points in contact (``lambda_N + eps_N g > 0``)."""
+        return self.normal_traction_at_points() > 0.0
+
+    def normal_traction_at_points(self) -> np.ndarray:
+        """``t_N = <lambda_N + eps_N g>`` at the owned slave points (0 where unpaired)."""
         proj = self.projection
         lam = self.multiplier_at_points()
         gap = np.where(proj.facet >= 0, proj.gap, -np.inf)
-        return (proj.facet >= 0) & (lam + float(self.eps_N.value) * gap > 0.0)
+        return np.maximum(lam + float(self.eps_N.value) * gap, 0.0)
+
+    def traction_at_points(self) -> np.ndarray:
+        """Contact traction on the slave body at the owned slave points, ``(n, gdim)``: the
+        integrand of :meth:`traction` (nominal, per unit reference area)."""
+        return self.normal_traction_at_points()[:, None] * self.projection.normal
 
     def _owned_blocks(self, Q: dolfinx.fem.FunctionSpace) -> np.ndarray:
         return Q.dofmap.list[: self.slave.num_cells].ravel()

@@ -191,14 +191,27 @@ class FrictionalContact(FrictionlessContact):
         """Tangential part of lambda_T at the owned slave points."""
         return self._tangential(self._vector_at_points(self.lambda_T))
 
+    def _trial_and_radius(self) -> tuple[np.ndarray, np.ndarray]:
+        """The trial traction ``q = lambda_T + eps_T s_T`` and the disc radius ``mu t_N``."""
+        q = self.tangential_multiplier_at_points() + float(self.eps_T.value) * self.slip_at_points()
+        return q, float(self.mu.value) * self.normal_traction_at_points()
+
     def stick(self) -> np.ndarray:
         """Mask of the owned slave points in stick (``|q| <= mu t_N``), of those in contact."""
-        proj = self.projection
-        q = self.tangential_multiplier_at_points() + float(self.eps_T.value) * self.slip_at_points()
-        lam_N = self.multiplier_at_points()
-        t_N = np.where(proj.facet >= 0, lam_N + float(self.eps_N.value) * proj.gap, 0.0)
-        radius = float(self.mu.value) * np.maximum(t_N, 0.0)
-        return self.active() & (np.einsum("pd,pd->p", q, q) <= radius**2) & (radius > 0)
+        q, radius = self._trial_and_radius()
+        return (np.einsum("pd,pd->p", q, q) <= radius**2) & (radius > 0)
+
+    def tangential_traction_at_points(self) -> np.ndarray:
+        """The frictional traction on the slave body at the owned slave points: ``q``
+        projected onto the Coulomb disc of radius ``mu t_N``, ``(n, gdim)``."""
+        q, radius = self._trial_and_radius()
+        norm = np.linalg.norm(q, axis=1)
+        scale = np.where(norm <= radius, 1.0, radius / np.where(norm > 0.0, norm, 1.0))
+        return np.where(radius[:, None] > 0.0, scale[:, None] * q, 0.0)
+
+    def traction_at_points(self) -> np.ndarray:
+        """Contact traction (normal and frictional) on the slave body at the owned points."""
+        return super().traction_at_points() + self.tangential_traction_at_points()
 
     def _tangential(self, w: np.ndarray) -> np.ndarray:
         nu = self.projection.normal

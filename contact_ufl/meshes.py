@@ -1000,23 +1000,28 @@ def ironing_2d(
 class BeamPair:
     """Geometry of :func:`beams_3d` (lengths in the units of the mesh).
 
-    The lower beam occupies ``[0, length] x [0, width] x [-lower_height, 0]`` and is clamped
-    at ``x = 0``; the upper beam ``[tip, tip + length] x [0, width] x [gap, gap + height]`` is
-    clamped at ``x = tip + length`` and free at ``x = tip``, above the lower beam.
+    The lower beam occupies ``[0, lower_length] x [-e, width + e] x [-lower_height, 0]`` with
+    ``e = (lower_width - width) / 2`` and is clamped at ``x = 0``; the upper beam ``[tip, tip
+    + length] x [0, width] x [gap, gap + height]`` is clamped at ``x = tip + length`` and free
+    at ``x = tip``, above the middle of the lower beam. The lower beam is the wider one, so the
+    side edges of the two beams do not lie on top of each other (an edge-on-edge contact is
+    degenerate: a slave point on the edge of the master surface is in or out by round-off).
     """
 
     length: float = 10.0
+    lower_length: float = 14.0
     width: float = 1.0
     height: float = 1.0
     lower_height: float = 1.5
-    gap: float = 0.5
+    lower_width: float = 1.5
+    gap: float = 3.0
     tip: float = 6.0
     master_start: float = 4.0
 
     @property
     def overlap(self) -> float:
         """Length of the upper beam's part above the lower beam."""
-        return self.length - self.tip
+        return self.lower_length - self.tip
 
 
 def beams_3d(
@@ -1032,16 +1037,17 @@ def beams_3d(
     Structured hexahedra: ``divisions`` elements through the width and the height of the
     upper beam, and elements of that height through the lower one; along the axis the upper
     beam has elements of size ``height / divisions`` and the lower beam ``master_ratio``
-    times longer ones, so the interface meshes do not match.
+    times longer (and wider, an odd number across) ones, so the interface meshes do not
+    match.
     The contact surfaces are only the parts that can touch: the bottom of the upper beam
-    above the lower beam (``tip <= x <= length``) and the top of the lower beam from
+    above the lower beam (``tip <= x <= lower_length``) and the top of the lower beam from
     ``master_start`` to its free end.
 
     Parameters
     ----------
     geometry
         Lengths of the pair (:class:`BeamPair`); ``gap > 0`` and
-        ``0 < master_start < tip < length``.
+        ``0 < master_start < tip < lower_length < tip + length``.
     divisions
         Elements through the height (and width) of each beam.
     master_ratio
@@ -1066,16 +1072,20 @@ def beams_3d(
         master_ratio=master_ratio,
         divisions=float(divisions),
     )
-    if not 0.0 < g.master_start < g.tip < g.length:
+    if not g.lower_width > g.width:
+        raise ValueError(f"need lower_width > width, got {g.lower_width} and {g.width}")
+    if not 0.0 < g.master_start < g.tip < g.lower_length < g.tip + g.length:
         raise ValueError(
-            f"need 0 < master_start < tip < length, got {g.master_start}, {g.tip}, {g.length}"
+            "need 0 < master_start < tip < lower_length < tip + length, got "
+            f"{g.master_start}, {g.tip}, {g.lower_length}, {g.tip + g.length}"
         )
     h_upper = g.height / divisions
     h_lower = master_ratio * h_upper
     tol = 1e-6 * g.length
 
-    def box(x0: float, x1: float, z0: float, height: float) -> int:
-        return gmsh.model.occ.addBox(x0, 0.0, z0, x1 - x0, g.width, height)
+    def box(x0: float, x1: float, z0: float, height: float, width: float) -> int:
+        y0 = 0.5 * (g.width - width)
+        return gmsh.model.occ.addBox(x0, y0, z0, x1 - x0, width, height)
 
     def face(volume: int, axis: int, coord: float) -> int:
         """The face of ``volume`` in the plane ``x[axis] = coord``."""
@@ -1089,21 +1099,30 @@ def beams_3d(
         occ = gmsh.model.occ
         # each beam in two boxes, so that the contact surfaces are faces of their own
         boxes = [
-            box(0.0, g.master_start, -g.lower_height, g.lower_height),
-            box(g.master_start, g.length, -g.lower_height, g.lower_height),
-            box(g.tip, g.length, g.gap, g.height),
-            box(g.length, g.tip + g.length, g.gap, g.height),
+            box(0.0, g.master_start, -g.lower_height, g.lower_height, g.lower_width),
+            box(g.master_start, g.lower_length, -g.lower_height, g.lower_height, g.lower_width),
+            box(g.tip, g.lower_length, g.gap, g.height, g.width),
+            box(g.lower_length, g.tip + g.length, g.gap, g.height, g.width),
         ]
         _, pieces = occ.fragment([(3, b) for b in boxes[:2]], [(3, b) for b in boxes[2:]])
         occ.synchronize()
         clamped_lower, master_part, slave_part, clamped_upper = (p[0][1] for p in pieces)
         lower, upper = [clamped_lower, master_part], [slave_part, clamped_upper]
-        for volumes, h in ((lower, h_lower), (upper, h_upper)):
+        h_width = g.width / divisions
+        for volumes, sizes, odd_across in (
+            (lower, (h_lower, master_ratio * h_width, g.height / divisions), True),
+            (upper, (h_upper, h_width, g.height / divisions), False),
+        ):
             for c in _boundary(3, volumes, 1):
                 extent = np.ptp(_bbox(1, c), axis=0)
                 axis = int(np.argmax(extent))
-                size = (h, g.width / divisions, g.height / divisions)[axis]
-                gmsh.model.mesh.setTransfiniteCurve(c, _divisions(extent[axis], size) + 1)
+                n = _divisions(extent[axis], sizes[axis])
+                if odd_across and axis == 1:
+                    # an odd number of master facets across the width: the plane of symmetry
+                    # y = width / 2, where the slave sits, is inside a facet and not on an
+                    # edge (the faceted master normal jumps there)
+                    n += 1 - n % 2
+                gmsh.model.mesh.setTransfiniteCurve(c, n + 1)
             for f in _boundary(3, volumes, 2):
                 gmsh.model.mesh.setTransfiniteSurface(f)
                 gmsh.model.mesh.setRecombine(2, f)

@@ -21,7 +21,8 @@ class ResultWriter:
     problem
         The contact problem.
     folder
-        Output folder; ``displacement.bp`` and ``contact_<k>.bp`` are written there.
+        Output folder; ``displacement.bp`` and ``contact_<k>.bp`` (the multipliers of pair
+        ``k``) are written there.
     """
 
     def __init__(self, problem, folder: str | Path):
@@ -32,9 +33,8 @@ class ResultWriter:
         comm = problem.comm
         self.writers = [dolfinx.io.VTXWriter(comm, folder / "displacement.bp", [problem.u])]
         for k, c in enumerate(problem.contacts):
-            self.writers.append(
-                dolfinx.io.VTXWriter(comm, folder / f"contact_{k}.bp", [c.lambda_N])
-            )
+            multipliers = [c.lambda_N] + ([c.lambda_T] if hasattr(c, "lambda_T") else [])
+            self.writers.append(dolfinx.io.VTXWriter(comm, folder / f"contact_{k}.bp", multipliers))
 
     def write(self, t: float) -> None:
         """Write the current state at pseudo-time ``t``."""
@@ -56,6 +56,127 @@ def _pyvista():
 
     pyvista.OFF_SCREEN = True
     return pyvista
+
+
+def gathered_grid(problem, deformed: bool = True):
+    """The mesh of all ranks as one pyvista grid on rank 0 (``None`` on the other ranks).
+
+    Each rank contributes its owned cells; the point data hold the displacement, and the
+    cell data ``"body"`` the cell tag of each cell. With ``deformed`` the grid is warped by
+    the displacement.
+    """
+    pv = _pyvista()
+    V = problem.V
+    mesh = V.mesh
+    tdim, gdim = mesh.topology.dim, mesh.geometry.dim
+    topology, cell_types, x = dolfinx.plot.vtk_mesh(V)
+    owned = mesh.topology.index_map(tdim).size_local
+    cells = topology.reshape(len(cell_types), -1)[:owned]
+    u = np.zeros((x.shape[0], 3))
+    u[:, :gdim] = problem.u.x.array.reshape(-1, gdim)[: x.shape[0]]
+    body = np.zeros(owned, dtype=np.int32)
+    tags = problem.scene.cell_tags
+    local = tags.indices < owned
+    body[tags.indices[local]] = tags.values[local]
+    parts = problem.comm.gather((cells, cell_types[:owned], x, u, body), root=0)
+    if problem.comm.rank != 0:
+        return None
+    offset, all_cells = 0, []
+    for c, _, xx, _, _ in parts:
+        shifted = c.copy()
+        shifted[:, 1:] += offset
+        all_cells.append(shifted)
+        offset += len(xx)
+    grid = pv.UnstructuredGrid(
+        np.concatenate(all_cells).ravel(),
+        np.concatenate([p[1] for p in parts]),
+        np.concatenate([p[2] for p in parts]),
+    )
+    grid.point_data["displacement"] = np.concatenate([p[3] for p in parts])
+    grid.cell_data["body"] = np.concatenate([p[4] for p in parts])
+    return grid.warp_by_vector("displacement") if deformed else grid
+
+
+def gathered_tractions(problem, pair: int = 0) -> tuple[np.ndarray, ...] | None:
+    """Current positions ``(n, 3)``, contact tractions ``(n, 3)`` and normal tractions
+    ``t_N`` ``(n,)`` (nominal, on the slave body) of the slave points in contact, gathered on
+    rank 0 (``None`` on the other ranks)."""
+    c = problem.contacts[pair]
+    gdim = c.gdim
+    active = c.active()
+    x = np.zeros((int(active.sum()), 3))
+    t = np.zeros_like(x)
+    x[:, :gdim] = c.slave.positions(problem.u).reshape(-1, gdim)[active]
+    t[:, :gdim] = c.traction_at_points()[active]
+    t_N = c.normal_traction_at_points()[active]
+    parts = problem.comm.gather((x, t, t_N), root=0)
+    if problem.comm.rank != 0:
+        return None
+    return tuple(np.concatenate([p[k] for p in parts]) for k in range(3))
+
+
+def _view(plotter, view: str) -> None:
+    """Camera: ``"iso"`` (3D view from the front, above and to the right), ``"xz"`` (the
+    x-z plane seen from -y: the plane of bending of the beams) or ``"xy"`` (seen from +z)."""
+    directions = {"iso": (0.7, -1.0, 0.6), "xz": (0.0, -1.0, 0.0), "xy": (0.0, 0.0, 1.0)}
+    if view not in directions:
+        raise ValueError(f"view must be one of {sorted(directions)}, got {view!r}")
+    up = (0.0, 1.0, 0.0) if view == "xy" else (0.0, 0.0, 1.0)
+    plotter.view_vector(directions[view], viewup=up)
+    plotter.reset_camera()
+
+
+def _screenshot(plotter, path: str | Path, title: str) -> None:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    plotter.add_text(title, font_size=12)
+    plotter.screenshot(str(path))
+    plotter.close()
+
+
+def plot_reference(problem, path: str | Path, view: str = "iso", title: str = "") -> None:
+    """The reference configuration: the mesh of every body, coloured by body (collective;
+    rank 0 writes the picture)."""
+    grid = gathered_grid(problem, deformed=False)
+    if grid is None:
+        return
+    pv = _pyvista()
+    plotter = pv.Plotter(off_screen=True, window_size=(1200, 700))
+    plotter.add_mesh(grid, scalars="body", show_edges=True, cmap="Pastel1", show_scalar_bar=False)
+    _view(plotter, view)
+    _screenshot(plotter, path, title)
+
+
+def plot_contact_state(
+    problem, path: str | Path, view: str = "iso", title: str = "", scale: float | None = None
+) -> None:
+    """The deformed bodies with the contact tractions of the first pair drawn as arrows at
+    the slave points in contact, coloured by the normal traction ``t_N`` (at a converged
+    state the multiplier lambda_N there; collective, rank 0 writes the picture).
+
+    ``scale`` is the arrow length per unit traction (default: the longest arrow is a
+    tenth of the scene's size).
+    """
+    grid = gathered_grid(problem)
+    tractions = gathered_tractions(problem)
+    if grid is None:
+        return
+    pv = _pyvista()
+    plotter = pv.Plotter(off_screen=True, window_size=(1200, 700))
+    plotter.add_mesh(grid, color="lightgrey", show_edges=True, opacity=0.5)
+    x, t, t_N = tractions
+    magnitude = np.linalg.norm(t, axis=1)
+    if len(x) and magnitude.max() > 0.0:
+        size = float(np.linalg.norm(np.ptp(grid.points, axis=0)))
+        factor = scale or 0.1 * size / magnitude.max()
+        arrows = pv.PolyData(x)
+        arrows["traction"] = t
+        arrows["length"] = magnitude
+        arrows["t_N"] = t_N
+        glyphs = arrows.glyph(orient="traction", scale="length", factor=factor)
+        plotter.add_mesh(glyphs, scalars="t_N", cmap="plasma")
+    _view(plotter, view)
+    _screenshot(plotter, path, title)
 
 
 def deformed_grid(problem):

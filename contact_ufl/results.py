@@ -181,3 +181,68 @@ def section_motion(problem, tag: int) -> tuple[np.ndarray, np.ndarray]:
     F = ufl.Identity(len(u)) + ufl.grad(u)
     n = _facet_integral(problem, ufl.cofac(F) * ufl.FacetNormal(mesh), tag)
     return _facet_integral(problem, u, tag) / area, n / np.linalg.norm(n)
+
+
+def equilibrium_error(problem, supports: list[str | int]) -> float:
+    """Global equilibrium: ``|sum of support reactions + resultant of the loads|``, relative
+    to the loads' resultant. The contact forces are internal to the scene and cancel.
+
+    ``supports`` are facet tags (or their names in ``problem.scene.tags``) that carry all
+    prescribed displacements.
+    """
+    tags = [problem.scene.tags[s] if isinstance(s, str) else s for s in supports]
+    # reaction() is the residual without the prescribed-displacement equations on the
+    # support dofs, internal minus external forces: the force of the support on the body
+    reactions = sum(problem.reaction(tag) for tag in tags)
+    load = problem.load_resultant()
+    return float(np.linalg.norm(load + reactions) / np.linalg.norm(load))
+
+
+@dataclass
+class CoulombCheck:
+    """Property (d) of the formulation for the frictional multipliers at the slave points.
+
+    Attributes
+    ----------
+    excess
+        ``max(|lambda_T| - mu lambda_N)`` over the points in contact, relative to
+        ``max(mu lambda_N)``: <= 0 up to discretisation and solver tolerance.
+    alignment
+        Smallest cosine between the slip increment of the last step and ``lambda_T`` over
+        the slipping points (1: slip along the tangential traction, ``V_T . T_T >= 0``).
+    slipping, active
+        Numbers of slipping points and of points in contact (all ranks).
+    """
+
+    excess: float
+    alignment: float
+    slipping: int
+    active: int
+
+
+def coulomb_law(problem, pair: int = 0) -> CoulombCheck:
+    """Check the Coulomb law on the multipliers of a frictional pair at its current state."""
+    c = problem.contacts[pair]
+    comm = problem.comm
+    if not hasattr(c, "lambda_T"):
+        raise ValueError(f"contact pair {pair} is frictionless")
+    active = c.active()
+    lam_N = c.multiplier_at_points()
+    lam_T = c.tangential_multiplier_at_points()
+    radius = float(c.mu.value) * lam_N
+    excess = np.linalg.norm(lam_T, axis=1) - radius
+    scale = comm.allreduce(radius[active].max(initial=0.0), MPI.MAX)
+    slip = c.slip_at_points()
+    slip_norm = np.linalg.norm(slip, axis=1)
+    slip_scale = comm.allreduce(slip_norm[active].max(initial=0.0), MPI.MAX)
+    slipping = active & ~c.stick() & (slip_norm > 1e-6 * slip_scale)
+    lam_norm = np.linalg.norm(lam_T, axis=1)
+    cos = np.einsum("pd,pd->p", slip, lam_T)[slipping] / (
+        slip_norm[slipping] * np.where(lam_norm[slipping] > 0, lam_norm[slipping], np.inf)
+    )
+    return CoulombCheck(
+        comm.allreduce(excess[active].max(initial=-np.inf), MPI.MAX) / scale,
+        comm.allreduce(cos.min(initial=1.0), MPI.MIN),
+        comm.allreduce(int(slipping.sum()), MPI.SUM),
+        comm.allreduce(int(active.sum()), MPI.SUM),
+    )

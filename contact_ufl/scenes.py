@@ -307,7 +307,7 @@ class BeamsScene:
     def lower_bending_stiffness(self) -> float:
         """``EI`` of the lower beam."""
         g = self.geometry
-        return self.E * g.width * g.lower_height**3 / 12.0
+        return self.E * g.lower_width * g.lower_height**3 / 12.0
 
     def two_springs(self, P: float) -> tuple[float, float]:
         """Beam-theory estimate ``(N, w)`` of the contact force and the upper tip deflection.
@@ -329,12 +329,12 @@ class BeamsScene:
 
 def beams(
     mu: float = 0.0,
-    load: float = 6.0,
+    load: float = 5.0,
     divisions: int = 4,
     E: float = 1.0e3,
     nu: float = 0.3,
     geometry: meshes.BeamPair | None = None,
-    eps_factor: float = 1.0,
+    eps_factor: float = 0.1,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> BeamsScene:
     """Two Neo-Hookean cantilevers, the upper one pushed at its free tip by a follower force.
@@ -360,7 +360,10 @@ def beams(
     geometry
         Lengths (default :class:`contact_ufl.meshes.BeamPair`).
     eps_factor
-        Scale of the augmentation parameter.
+        Scale of the augmentation parameter. The default 0.1 keeps ``eps_N`` nearer the
+        stiffness of slender beams than ``E / h`` (which is the stiffness scale of a solid):
+        with ``eps_factor = 1`` the first Newton iterate at the first touch penetrates so
+        deeply that the active set cycles and the step is cut back.
     """
     geometry = geometry or meshes.BeamPair()
     sm = meshes.beams_3d(geometry, divisions=divisions, comm=comm)
@@ -381,6 +384,8 @@ def beams(
                 eps_N=eps_factor * E / h,
                 mu=mu,
                 search_radius=geometry.gap + geometry.height,
+                quadrature_degree=3,
+                quadrature_rule="lobatto",
             )
         ],
         dirichlet=[

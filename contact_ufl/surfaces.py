@@ -85,16 +85,24 @@ def exterior_facet_cells(
     return cells.astype(np.int32), local
 
 
+#: Quadrature rules of the contact integrals, by name.
+QUADRATURE_RULES = {"gauss": basix.QuadratureType.default, "lobatto": basix.QuadratureType.gll}
+
+
 def composite_quadrature(
-    cell: basix.CellType, degree: int, subdivisions: int = 1
+    cell: basix.CellType, degree: int, subdivisions: int = 1, rule: str = "gauss"
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss rule of ``degree`` repeated on a uniform ``subdivisions``-fold split of ``cell``.
+    """A rule of ``degree`` repeated on a uniform ``subdivisions``-fold split of ``cell``.
 
     A master facet edge inside a slave facet puts a kink into the contact integrand, which
     one Gauss rule integrates only to O(1/n^2); a composite rule bounds the kink's error by
-    the size of one sub-cell.
+    the size of one sub-cell. ``rule`` is a key of :data:`QUADRATURE_RULES`; the Lobatto
+    rule (intervals and quadrilaterals) has points on the vertices of the (sub-)cells.
     """
-    points, weights = basix.make_quadrature(cell, degree)
+    if rule == "lobatto" and cell == basix.CellType.triangle:
+        raise ValueError("the Lobatto contact rule needs interval or quadrilateral facets")
+    points, weights = basix.make_quadrature(cell, degree, rule=QUADRATURE_RULES[rule])
+    points = np.clip(points, 0.0, 1.0)  # GLL end points come with round-off outside [0, 1]
     m = subdivisions
     if m == 1:
         return points, weights
@@ -141,6 +149,8 @@ class SlaveSurface:
         Degree of the quadrature rule of the contact integrals.
     subdivisions
         Repeat that rule on a uniform split of each facet into this many parts per edge.
+    rule
+        ``"gauss"`` or ``"lobatto"`` (:data:`QUADRATURE_RULES`).
 
     Attributes
     ----------
@@ -159,6 +169,7 @@ class SlaveSurface:
     tag: int
     quadrature_degree: int
     subdivisions: int = 1
+    rule: str = "gauss"
     submesh: dolfinx.mesh.Mesh = field(init=False)
     entity_map: dolfinx.mesh.EntityMap = field(init=False)
 
@@ -178,7 +189,7 @@ class SlaveSurface:
 
         sub_cell = _basix_cell(self.submesh, fdim)
         self.points_ref, self.weights_ref = composite_quadrature(
-            sub_cell, self.quadrature_degree, self.subdivisions
+            sub_cell, self.quadrature_degree, self.subdivisions, self.rule
         )
         self.num_points = len(self.weights_ref)
         ref = self._parent_reference_points(sub_cell, parent_local, tdim)
