@@ -50,7 +50,14 @@ from mpi4py import MPI
 from contact_ufl.errors import check_positive, collective_check
 from contact_ufl.layout import StackedLayout
 from contact_ufl.projection import Projection, closest_points
-from contact_ufl.surfaces import QUADRATURE_RULES, MasterSurface, SlaveSurface, global_bounds
+from contact_ufl.surfaces import (
+    QUADRATURE_RULES,
+    MasterSurface,
+    SlaveSurface,
+    gathered_node_positions,
+    global_bounds,
+    segment_neighbours,
+)
 
 
 @dataclass(frozen=True)
@@ -85,6 +92,12 @@ class ContactPair:
         quadrilaterals): the Lobatto points include the vertices of the slave facets, so a
         slave edge or corner that meets the master surface (the tip of a beam) is itself a
         contact point and cannot sink into the master between Gauss points.
+    master_normal
+        ``"facet"`` (default): the normal of the master facet. ``"smoothed"`` (2D): the
+        normal interpolated along the segment from averaged nodal normals, continuous from
+        one segment to the next; a slave point sliding over a master vertex then meets no
+        jump of the contact force's direction (large sliding, ironing). The nodal normals
+        depend on the neighbouring nodes, which are gathered with the segment's own.
     """
 
     slave: int
@@ -96,6 +109,7 @@ class ContactPair:
     quadrature_degree: int | None = None
     quadrature_subdivisions: int = 1
     quadrature_rule: str = "gauss"
+    master_normal: str = "facet"
 
     def validate(self, comm: MPI.Comm) -> None:
         """Raise a clear error (on every rank) for invalid parameters."""
@@ -118,14 +132,26 @@ class ContactPair:
         )
         collective_check(
             comm,
+            self.master_normal in ("facet", "smoothed"),
+            f"master_normal must be 'facet' or 'smoothed', got {self.master_normal!r}",
+        )
+        collective_check(
+            comm,
             self.slave != self.master,
             f"slave and master tags must differ (both {self.slave})",
         )
 
 
-def macaulay(a: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-    """Macaulay bracket ``<a> = max(a, 0)``."""
-    return ufl.conditional(ufl.gt(a, 0.0), a, 0.0)
+def macaulay(a: ufl.core.expr.Expr, touching: float | ufl.core.expr.Expr = 0.0):
+    """Macaulay bracket ``<a> = max(a, 0)``.
+
+    With ``touching > 0``, the values ``-touching < a <= 0`` count as positive (value ``a``,
+    derivative 1): a point within round-off of touching is in contact. Scenes that start
+    exactly at ``g = 0`` with ``lambda = 0`` sit on the kink of the bracket, where round-off
+    alone would pick a random active set (and a singular tangent) for the first iterate; the
+    value changes by at most ``touching``.
+    """
+    return ufl.conditional(ufl.gt(a, -touching), a, 0.0)
 
 
 def master_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
@@ -160,6 +186,47 @@ def _unit_normal(tangents: list, mask: ufl.core.expr.Expr) -> ufl.core.expr.Expr
     else:
         perp = ufl.cross(tangents[0], tangents[1])
     return perp / ufl.sqrt(ufl.dot(perp, perp) + (1.0 - mask))
+
+
+def _smoothed_normal(xi, nodes, flags, mask) -> ufl.core.expr.Expr:
+    """2D master normal interpolated from averaged nodal normals along the segment.
+
+    ``nodes`` rows: the segment's nodes ``a, b``, then the node before ``a`` and after ``b``
+    (``flags`` say whether those exist; at an end of the surface the segment's own tangent
+    stands in). The nodal normal of ``a`` is the sum of the unit normals of the two segments
+    at ``a``; the normal at ``xi`` the normalised linear interpolation of the nodal ones.
+    """
+    a, b, before, after = (ufl.as_vector([nodes[k, 0], nodes[k, 1]]) for k in range(4))
+    segment = b - a
+    incoming = flags[0] * (a - before) + (1.0 - flags[0]) * segment
+    outgoing = flags[1] * (after - b) + (1.0 - flags[1]) * segment
+
+    def unit_perp(t):
+        perp = ufl.as_vector([t[1], -t[0]])
+        return perp / ufl.sqrt(ufl.dot(perp, perp) + (1.0 - mask))
+
+    n_a = unit_perp(incoming) + unit_perp(segment)
+    n_b = unit_perp(segment) + unit_perp(outgoing)
+    n = (1.0 - xi[0]) * n_a + xi[0] * n_b
+    return n / ufl.sqrt(ufl.dot(n, n) + (1.0 - mask))
+
+
+def smoothed_normals(xi: np.ndarray, nodes: np.ndarray, flags: np.ndarray) -> np.ndarray:
+    """NumPy twin of :func:`_smoothed_normal` for paired points: ``xi (n, 1)``, ``nodes
+    (n, 4, 2)``, ``flags (n, 2)``; returns unit normals ``(n, 2)``."""
+    a, b, before, after = (nodes[:, k] for k in range(4))
+    segment = b - a
+    incoming = np.where(flags[:, :1], a - before, segment)
+    outgoing = np.where(flags[:, 1:], after - b, segment)
+
+    def unit_perp(t):
+        perp = np.stack([t[:, 1], -t[:, 0]], axis=1)
+        return perp / np.linalg.norm(perp, axis=1, keepdims=True)
+
+    n = (1.0 - xi) * (unit_perp(incoming) + unit_perp(segment)) + xi * (
+        unit_perp(segment) + unit_perp(outgoing)
+    )
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
 class FrictionlessContact:
@@ -199,6 +266,19 @@ class FrictionlessContact:
         )
         self.master = MasterSurface(V, facet_tags, pair.master)
         self.nn = nn = comm_max(mesh.comm, self.master.nodes.shape[1])
+        self.smoothed = pair.master_normal == "smoothed"
+        if self.smoothed:
+            collective_check(
+                mesh.comm,
+                gdim == 2,
+                "master_normal='smoothed' is implemented for 2D (segment) master surfaces only",
+            )
+            self._neighbours, self._has_neighbour = segment_neighbours(
+                mesh.comm, self.master.global_nodes
+            )
+        #: master nodes carried to each slave point: the facet's, then (smoothed) its
+        #: neighbours before and after
+        self.nx = nn + 2 if self.smoothed else nn
         sub = self.slave.submesh
 
         def space(shape):
@@ -210,13 +290,15 @@ class FrictionlessContact:
             )
             return dolfinx.fem.functionspace(sub, element)
 
-        self.Qx = space((nn * gdim,))
+        self.Qx = space((self.nx * gdim,))
         self.xhat = dolfinx.fem.Function(self.Qx, name="master_nodes")
         self.xhat0 = dolfinx.fem.Function(self.Qx)
         self.x0 = dolfinx.fem.Function(space((gdim,)))
         self.xi0 = dolfinx.fem.Function(space((fdim,)))
         self.M = dolfinx.fem.Function(space((fdim, fdim)))
         self.mask = dolfinx.fem.Function(space(()))
+        #: (smoothed normal) whether the neighbour before / after the facet exists
+        self.neighbour_flags = dolfinx.fem.Function(space((2,))) if self.smoothed else None
         self.L = dolfinx.fem.functionspace(sub, ("Lagrange", 1))
         self.lambda_N = dolfinx.fem.Function(self.L, name="lambda_N")
         p1 = self.L.ufl_element().basix_element
@@ -229,6 +311,8 @@ class FrictionlessContact:
             subdomain_id=pair.slave,
             metadata={"quadrature_degree": qdeg},
         )
+        #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see :func:`macaulay`)
+        self.touching = 1e-12 * 4.0 * self._default_radius()
         self._kinematics()
         self.radius = pair.search_radius or self._default_radius()
         self._check_facing()
@@ -245,7 +329,7 @@ class FrictionlessContact:
         self.x = x = X + self.u
 
         def nodes(f):
-            return ufl.as_matrix([[f[a * gdim + i] for i in range(gdim)] for a in range(nn)])
+            return ufl.as_matrix([[f[a * gdim + i] for i in range(gdim)] for a in range(self.nx)])
 
         xh, xh0 = nodes(self.xhat), nodes(self.xhat0)
         N0, dN0 = master_shape_functions(nn, self.xi0)
@@ -263,10 +347,17 @@ class FrictionlessContact:
         self.xi = xi = self.xi0 + self.M * ufl.as_vector(b)
         self.N, dN = master_shape_functions(nn, xi)
         self.y = _interpolate(self.N, xh, gdim)
-        tangents = [_interpolate([dN[a][al] for a in range(nn)], xh, gdim) for al in range(fdim)]
-        self.nu = _unit_normal(tangents, self.mask)
+        if self.smoothed:
+            self.nu = _smoothed_normal(xi, xh, self.neighbour_flags, self.mask)
+        else:
+            tangents = [
+                _interpolate([dN[a][al] for a in range(nn)], xh, gdim) for al in range(fdim)
+            ]
+            self.nu = _unit_normal(tangents, self.mask)
         self.gap = -ufl.dot(self.nu, x - self.y)
-        self.t_N = self.mask * macaulay(self.lambda_N + self.eps_N * self.gap)
+        self.t_N = self.mask * macaulay(
+            self.lambda_N + self.eps_N * self.gap, self.eps_N * self.touching
+        )
 
     def master_test_at_projection(self, vhat: ufl.Argument) -> ufl.core.expr.Expr:
         """The master virtual displacement ``U2*(Y(X)) = sum_a N_a(xi) vhat_a``."""
@@ -367,27 +458,50 @@ class FrictionlessContact:
         order), the stacked index of the displacement unknown it gathers, or -1.
         """
         start = time.perf_counter()
-        gdim, nn = self.gdim, self.nn
+        gdim, nn, nx = self.gdim, self.nn, self.nx
+        comm = self.V.mesh.comm
         bs = self.V.dofmap.index_map_bs
         points = self.slave.positions(self.u).reshape(-1, gdim)
         current = self.master.current_nodes(self.u)
-        cols = layout.from_block_global(0, self.master.global_nodes.astype(np.int64) * bs)
+        global_nodes = self.master.global_nodes.astype(np.int64)
+        extra = []
+        if self.smoothed:  # carry the neighbour nodes of every segment along
+            before_after = gathered_node_positions(comm, global_nodes, current, self._neighbours)
+            current = np.concatenate([current, before_after], axis=1)
+            global_nodes = np.hstack([global_nodes, self._neighbours])
+            extra = [self._has_neighbour.astype(np.int64)]
+        cols = layout.from_block_global(0, global_nodes * bs)
         payload = np.hstack(
-            [cols, self.master.keys.astype(np.int64), self.master.boundary_edges.astype(np.int64)]
+            [
+                cols,
+                self.master.keys.astype(np.int64),
+                self.master.boundary_edges.astype(np.int64),
+                *extra,
+            ]
         )
         nodes, payload, _ = self._candidates(current, points, payload)
         # candidates in a rank-independent order: ties between facets break the same way
-        order = np.lexsort(payload[:, nn : 2 * nn].T[::-1])
+        order = np.lexsort(payload[:, nx : nx + nn].T[::-1])
         nodes, payload = nodes[order], payload[order]
-        cols, boundary = payload[:, :nn], payload[:, 2 * nn :].astype(bool)
-        proj = closest_points(points, nodes, self.radius)
-        release_beyond_boundary(proj, points, boundary)
-        self.projection = proj
+        ne = self.master.boundary_edges.shape[1]
+        cols = payload[:, :nx]
+        boundary = payload[:, nx + nn : nx + nn + ne].astype(bool)
+        proj = closest_points(points, nodes[:, :nn], self.radius)
+        release_beyond_boundary(proj, points, boundary, self.touching)
         paired = proj.facet >= 0
+        if self.smoothed:
+            flags = payload[proj.facet[paired], nx + nn + ne :].astype(bool)
+            normal = smoothed_normals(proj.xi[paired], nodes[proj.facet[paired]], flags)
+            proj.normal[paired] = normal
+            proj.gap[paired] = -np.einsum("pd,pd->p", normal, points[paired] - proj.y[paired])
+            all_flags = np.zeros((len(points), 2))
+            all_flags[paired] = flags
+            self._set(self.neighbour_flags, all_flags)
+        self.projection = proj
         npts = len(points)
-        xhat = np.zeros((npts, nn * gdim))
-        xhat[paired] = nodes[proj.facet[paired]].reshape(-1, nn * gdim)
-        gather = np.full((npts, nn, gdim), -1, dtype=np.int64)
+        xhat = np.zeros((npts, nx * gdim))
+        xhat[paired] = nodes[proj.facet[paired]].reshape(-1, nx * gdim)
+        gather = np.full((npts, nx, gdim), -1, dtype=np.int64)
         gather[paired] = cols[proj.facet[paired]][:, :, None] + np.arange(gdim)
         self._set(self.xhat, xhat)
         self._set(self.xhat0, xhat)
@@ -397,7 +511,7 @@ class FrictionlessContact:
         self._set(self.M, np.where(sliding, proj.sliding, 0.0))
         self._set(self.mask, paired.astype(float))
         self.search_time += time.perf_counter() - start
-        self._gather = self._unrolled(self.Qx, gather.reshape(npts, nn * gdim), fill=-1)
+        self._gather = self._unrolled(self.Qx, gather.reshape(npts, nx * gdim), fill=-1)
         return [(self.xhat, self._gather)]
 
     def assemble_nodal(self, form: dolfinx.fem.Form, space) -> np.ndarray:
@@ -432,8 +546,9 @@ class FrictionlessContact:
         return np.einsum("qn,cn->cq", self._phi_lambda, self.lambda_N.x.array[dofs]).ravel()
 
     def active(self) -> np.ndarray:
-        """Mask of the owned slave quadrature points in contact (``lambda_N + eps_N g > 0``)."""
-        return self.normal_traction_at_points() > 0.0
+        """Mask of the owned slave quadrature points in contact (``lambda_N + eps_N g > 0``,
+        or within round-off of it: see :func:`macaulay`)."""
+        return self._touching()
 
     def normal_traction_at_points(self) -> np.ndarray:
         """``t_N = <lambda_N + eps_N g>`` at the owned slave points (0 where unpaired)."""
@@ -441,6 +556,13 @@ class FrictionlessContact:
         lam = self.multiplier_at_points()
         gap = np.where(proj.facet >= 0, proj.gap, -np.inf)
         return np.maximum(lam + float(self.eps_N.value) * gap, 0.0)
+
+    def _touching(self) -> np.ndarray:
+        """Mask of the owned points where the bracket counts as positive (:func:`macaulay`)."""
+        proj = self.projection
+        eps = float(self.eps_N.value)
+        a = self.multiplier_at_points() + eps * np.where(proj.facet >= 0, proj.gap, -np.inf)
+        return a > -eps * self.touching
 
     def traction_at_points(self) -> np.ndarray:
         """Contact traction on the slave body at the owned slave points, ``(n, gdim)``: the
@@ -472,12 +594,15 @@ def _on_edges(nn: int, xi: np.ndarray, tol: float = 1e-12) -> np.ndarray:
     return np.stack([t <= tol, s <= tol, s >= 1 - tol, t >= 1 - tol], axis=1)
 
 
-def release_beyond_boundary(proj: Projection, points: np.ndarray, boundary: np.ndarray) -> None:
+def release_beyond_boundary(
+    proj: Projection, points: np.ndarray, boundary: np.ndarray, tolerance: float = 0.0
+) -> None:
     """Unpair the points beyond the edge of the master surface (in place).
 
     A point whose closest point is on an edge (2D: an end point) of the master *surface*
-    boundary, and off the normal through it, lies beyond the surface: it is not in contact
-    (the last facet is not a half-plane). ``boundary``: boundary-edge flags per candidate.
+    boundary, and off the normal through it by more than ``tolerance`` (a length: round-off),
+    lies beyond the surface: it is not in contact (the last facet is not a half-plane).
+    ``boundary``: boundary-edge flags per candidate.
     """
     paired = np.flatnonzero(proj.facet >= 0)
     if len(paired) == 0:
@@ -488,7 +613,9 @@ def release_beyond_boundary(proj: Projection, points: np.ndarray, boundary: np.n
     d = points[paired] - proj.y[paired]
     normal_part = np.einsum("pd,pd->p", d, proj.normal[paired])
     off_normal = np.linalg.norm(d - normal_part[:, None] * proj.normal[paired], axis=1)
-    beyond = at_boundary & (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > 0)
+    beyond = (
+        at_boundary & (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > tolerance)
+    )
     released = paired[beyond]
     proj.facet[released] = -1
     proj.gap[released] = -np.inf

@@ -164,7 +164,7 @@ class FrictionalContact(FrictionlessContact):
         """Slip increment s_T since the last converged step at the owned slave points."""
         gdim = self.gdim
         x = self.slave.positions(self.u).reshape(-1, gdim)
-        nodes = self._values(self.xhat_n).reshape(len(x), self.nn, gdim)
+        nodes = self._values(self.xhat_n).reshape(len(x), self.nx, gdim)[:, : self.nn]
         N_n = shape_functions(self.nn, gdim, self._values(self.xi_n))[0]
         s = (x - np.einsum("pa,pad->pd", N_n, nodes)) * self._values(self.mask_n)
         return self._tangential(s)

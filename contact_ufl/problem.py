@@ -119,6 +119,8 @@ class ContactProblem:
         self._build_dirichlet()
         self._build_solver(petsc_options or {}, petsc_options_prefix)
         self.history = History()
+        #: line search of the second try of a failed Newton solve (see :meth:`solve_step`)
+        self.fallback_linesearch: str | None = "bt"
 
     # -- forms ------------------------------------------------------------------------
     def first_piola(self, body) -> ufl.core.expr.Expr:
@@ -413,12 +415,36 @@ class ContactProblem:
     def solve_step(self, t: float) -> tuple[bool, int, str]:
         """Solve for pseudo-time ``t`` from the current state.
 
+        Newton takes full steps first. Where that fails (a semismooth Newton can cycle
+        between contact or stick/slip states, or overshoot into inverted elements), the step
+        is solved once more from the same start with the backtracking line search
+        :attr:`fallback_linesearch` (``None``: no second try), before the caller cuts it back.
+
         Returns
         -------
-        converged, Newton iterations, SNES converged reason (name)
+        converged, Newton iterations (of both tries), SNES converged reason (name)
         """
         self.set_time(t)
         fem_petsc.assign(self.unknowns, self.x)
+        start = self.x.copy()
+        reason, its = self._newton()
+        linesearch = self.snes.getLineSearch()
+        primary = linesearch.getType()
+        if reason <= 0 and self.fallback_linesearch not in (None, primary):
+            start.copy(self.x)
+            linesearch.setType(self.fallback_linesearch)
+            try:
+                reason, more = self._newton()
+            finally:
+                linesearch.setType(primary)
+            its += more
+        self._state = None
+        self._set_state(self.x)
+        names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
+        return reason > 0, its, names.get(reason, str(reason))
+
+    def _newton(self) -> tuple[int, int]:
+        """One SNES solve from ``self.x``: converged reason and iterations."""
         self._state = None
         try:
             self.snes.solve(None, self.x)
@@ -428,10 +454,7 @@ class ContactProblem:
             reason = PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
         if reason <= 0:
             self.snes.getKSP().getPC().reset()  # no stale factorisation in the next try
-        self._state = None
-        self._set_state(self.x)
-        names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
-        return reason > 0, self.snes.getIterationNumber(), names.get(reason, str(reason))
+        return reason, self.snes.getIterationNumber()
 
     def solve(
         self,

@@ -247,6 +247,7 @@ def ironing(
     h_block: float = 0.2,
     depth: float = 1.0,
     slide: float = 10.0,
+    master_normal: str = "smoothed",
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> Scene:
     """The 2D "shallow ironing" problem (Yang, Laursen & Meng 2005; Poulios & Renard 2015).
@@ -255,7 +256,8 @@ def ironing(
     punch (E = 6.896e9) with a rounded bottom of radius 0.75, its axis 1 from the block's
     left end. The punch's top is pressed down by ``depth`` from t = 0 to 1, then moved along
     the block by ``slide`` from t = 1 to 2. The slave surface is the punch's arc and sides
-    (the finer mesh), the master surface the block's top.
+    (the finer mesh), the master surface the block's top, with the smoothed normal by default
+    (the punch slides over many master vertices).
     """
     sm = meshes.ironing_2d(h_punch=h_punch, h_block=h_block, comm=comm)
     tags = sm.tags
@@ -275,6 +277,7 @@ def ironing(
                 eps_N=E_block / h_block,
                 mu=mu,
                 search_radius=1.0,
+                master_normal=master_normal,
             )
         ],
         dirichlet=[

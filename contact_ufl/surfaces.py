@@ -417,3 +417,43 @@ def _rows_in(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     a_rows = np.ascontiguousarray(a).view(row).ravel()
     b_rows = np.ascontiguousarray(b.astype(a.dtype)).view(row).ravel()
     return np.isin(a_rows, b_rows)
+
+
+def segment_neighbours(
+    comm: MPI.Comm, global_nodes: np.ndarray
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.bool_]]:
+    """The nodes before and after each oriented master segment (2D), over all ranks.
+
+    Oriented segments ``(a, b)`` of one surface follow each other: the segment before ends at
+    ``a``, the one after starts at ``b``. Returns, for each segment, the global node index of
+    the node before ``a`` and of the node after ``b``, ``(nf, 2)``, and whether they exist
+    (at an end of the surface the node itself stands in, flagged ``False``).
+    """
+    everything = np.concatenate(comm.allgather(global_nodes.astype(np.int64))).reshape(-1, 2)
+    first, second = everything[:, 0], everything[:, 1]
+    by_second, by_first = np.argsort(second), np.argsort(first)
+    a, b = global_nodes[:, 0].astype(np.int64), global_nodes[:, 1].astype(np.int64)
+
+    def lookup(keys, sorted_order, values, query):
+        pos = np.searchsorted(keys[sorted_order], query)
+        pos = np.minimum(pos, max(len(keys) - 1, 0))
+        found = len(keys) > 0
+        hit = keys[sorted_order][pos] == query if found else np.zeros(len(query), bool)
+        return np.where(hit, values[sorted_order][pos], query), hit
+
+    before, has_before = lookup(second, by_second, first, a)
+    after, has_after = lookup(first, by_first, second, b)
+    return np.stack([before, after], axis=1), np.stack([has_before, has_after], axis=1)
+
+
+def gathered_node_positions(
+    comm: MPI.Comm, global_nodes: np.ndarray, positions: np.ndarray, wanted: np.ndarray
+) -> np.ndarray:
+    """Positions of the nodes ``wanted`` (global indices, any shape) from the nodes
+    ``global_nodes`` with ``positions`` (``(..., gdim)``) of all ranks."""
+    gdim = positions.shape[-1]
+    keys = np.concatenate(comm.allgather(global_nodes.reshape(-1).astype(np.int64)))
+    values = np.concatenate(comm.allgather(positions.reshape(-1, gdim)))
+    keys, first = np.unique(keys, return_index=True)
+    pos = np.searchsorted(keys, wanted.reshape(-1))
+    return values[first][pos].reshape(*wanted.shape, gdim)

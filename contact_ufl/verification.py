@@ -57,3 +57,71 @@ def shear_error(problem, exact: CattaneoMindlin2D, pair: int = 0) -> float:
     near = np.abs(x) < 0.8 * exact.hertz.a
     rms = np.sqrt(np.mean((shear[near] - exact.shear(x[near])) ** 2))
     return float(rms / (exact.mu * exact.hertz.p0))
+
+
+#: Global friction coefficients |Fx/Fy| at t = 1.5 of the shallow ironing problem with
+#: mu = 0.3 in the literature, as compiled by the solids4foam tutorial ``shallowIroning``
+#: (Batistic, Cardiff & Tukovic 2022, Table 1 there).
+IRONING_LITERATURE = {
+    "Poulios & Renard 2015": 0.30,
+    "Batistic et al. 2022": 0.32,
+    "Houssein 2022": 0.32,
+    "Code_Aster SSNP153": 0.34,
+    "Hartmann et al. 2009": 0.38,
+    "Yastrebov 2011": 0.47,
+    "Fischer & Wriggers 2006": 0.53,
+}
+
+
+def ironing_run(
+    mu: float,
+    h_punch: float = 0.025,
+    h_block: float = 0.1,
+    press_steps: int = 20,
+    slide_steps: int = 200,
+    verbose: bool = False,
+) -> tuple[dict, ContactProblem]:
+    """The 2D shallow ironing problem of :func:`contact_ufl.scenes.ironing`, pressing then
+    sliding; one record per converged step.
+
+    Returns ``{"mu", "history", "cutbacks", ...}`` with history records ``time``, ``Fx``,
+    ``Fy`` (the force of the support on the indenter's top, which balances the contact
+    force), ``newton_iterations`` and ``converged`` (every accepted step converged; a step
+    that does not is cut back, and the run stops with :class:`ConvergenceError` when the
+    cut-backs run out), and the problem.
+    """
+    scene = scenes.ironing(mu=mu, h_punch=h_punch, h_block=h_block)
+    problem = ContactProblem(scene, verbose=verbose, petsc_options={"snes_max_it": 40})
+    top = scene.tags["punch_top"]
+    history = []
+
+    def record(problem, step):
+        F = problem.reaction(top)
+        history.append(
+            {
+                "time": step.t,
+                "Fx": float(F[0]),
+                "Fy": float(F[1]),
+                "newton_iterations": step.newton_iterations,
+                "converged": True,
+            }
+        )
+
+    problem.solve(num_steps=press_steps, t_end=1.0, callback=record)
+    problem.solve(num_steps=slide_steps, t_end=2.0, callback=record)
+    run = {
+        "mu": mu,
+        "h_punch": h_punch,
+        "h_block": h_block,
+        "unknowns": problem.layout.global_size,
+        "history": history,
+        "cutbacks": [{"time": t, "reason": r} for t, r in problem.history.cutbacks],
+    }
+    return run, problem
+
+
+def steady_ratio(history: list[dict], window: tuple[float, float] = (1.2, 1.7)) -> float:
+    """Mean of |Fx / Fy| over the records of the steady sliding ``window`` of pseudo-time
+    (the indenter away from both ends of the block)."""
+    ratios = [abs(r["Fx"] / r["Fy"]) for r in history if window[0] <= r["time"] <= window[1]]
+    return float(np.mean(ratios))

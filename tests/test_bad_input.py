@@ -32,6 +32,7 @@ def with_pair(scene, **changes):
         (dict(mu=-0.1), "mu must be >= 0"),
         (dict(search_radius=-1.0), "search_radius must be positive"),
         (dict(quadrature_subdivisions=0), "quadrature_subdivisions must be >= 1"),
+        (dict(quadrature_rule="simpson"), "quadrature_rule must be one of"),
     ],
 )
 def test_bad_contact_pair(scene, changes, message):

@@ -27,6 +27,25 @@ def test_hertz_demo_runs(tmp_path):
     assert (out / "hertz" / "displacement.bp").is_dir()
 
 
+@pytest.mark.serial
+def test_beams_demo_runs(tmp_path):
+    out = tmp_path / "out"
+    args = ["--divisions", "3", "--mu", "0", "--load", "2", "--steps", "8", "--out", str(out)]
+    result = subprocess.run(
+        [sys.executable, str(DEMOS / "beams.py"), *args],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=tmp_path,
+    )
+    assert result.returncode == 0, result.stderr
+    for text in ("tip displacement", "contact force", "wall time"):
+        assert text in result.stdout
+    for name in ("beams_reference.png", "beams_reference_xz.png", "beams_mu0_iso.png"):
+        assert (out / name).stat().st_size > 10_000
+    assert (out / "beams_mu0" / "contact_0.bp").is_dir()
+
+
 @pytest.mark.parametrize("demo", sorted(DEMOS.glob("*.py")), ids=lambda p: p.name)
 def test_demo_is_a_notebook(demo):
     notebook = jupytext.read(demo)

@@ -1,5 +1,7 @@
 """Contact patch test: uniform pressure through a flat non-matching interface."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -71,3 +73,22 @@ def test_patch_3d(cell, degree, subdivisions, tolerance):
     resultants = body_resultants(problem, problem.contact_residual())
     slave, master = (resultants[b.tag] for b in problem.scene.bodies)
     assert np.linalg.norm(slave + master) < 1e-14 * np.linalg.norm(slave)
+
+
+def test_patch_lobatto_rule():
+    """The Gauss-Lobatto rule (points on the slave vertices, as the beams use it) passes
+    the patch test and transfers the load exactly. The end points of the slave surface lie
+    on the ends of the master surface (same widths): within round-off they stay paired."""
+    scene = patch(2, PRESSURE, quadrature_degree=3, subdivisions=4)
+    pair = dataclasses.replace(scene.contacts[0], quadrature_rule="lobatto")
+    problem = ContactProblem(
+        dataclasses.replace(scene, contacts=[pair]), verbose=False, petsc_options=TIGHT
+    )
+    c = problem.contacts[0]
+    assert np.any(np.isin(c.slave.points_ref, [0.0, 1.0]))  # the vertices are points
+    problem.solve(num_steps=1)
+    assert problem.history.steps[0].newton_iterations <= 4
+    assert problem.active_points() == problem.comm.allreduce(c.slave.X.size // 2)
+    lam = c.lambda_N.x.array
+    assert np.abs(lam / PRESSURE - 1.0).max() < 5e-3
+    assert abs(problem.contact_force()[1] / PRESSURE - 1.0) < 1e-12

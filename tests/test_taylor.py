@@ -28,3 +28,17 @@ def test_taylor_detects_a_frozen_projection():
     problem.contacts[0].frozen_projection = True
     result = taylor_test(problem, dz, steps)
     assert np.all(np.abs(result.slopes - 1.0) < 0.1), result.slopes
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.05])
+def test_taylor_smoothed_master_normal(mu):
+    """The smoothed normal depends on the neighbours of the master segment: its tangent,
+    chained through their gathered dofs, is still exact (second order)."""
+    problem, dz, steps = curved_case(2, mu=mu, master_normal="smoothed")
+    c = problem.contacts[0]
+    assert c.nx == 4 and problem.active_points() > 10
+    facet, smooth = curved_case(2, mu=mu)[0].contacts[0], c
+    assert not np.allclose(facet.projection.normal, smooth.projection.normal)
+    result = taylor_test(problem, dz, steps)
+    assert not result.facets_changed and not result.active_changed
+    assert np.all(np.abs(result.slopes - 2.0) < 0.1), result.slopes
