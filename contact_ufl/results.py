@@ -210,18 +210,24 @@ class CoulombCheck:
     alignment
         Smallest cosine between the slip increment of the last step and ``lambda_T`` over
         the slipping points (1: slip along the tangential traction, ``V_T . T_T >= 0``).
+    slip_excess
+        ``max |mu lambda_N - |lambda_T||`` over the slipping points, relative to
+        ``max(mu lambda_N)``: where a point slips the traction is on the cone.
     slipping, active
         Numbers of slipping points and of points in contact (all ranks).
     """
 
     excess: float
     alignment: float
+    slip_excess: float
     slipping: int
     active: int
 
 
 def coulomb_law(problem, pair: int = 0) -> CoulombCheck:
-    """Check the Coulomb law on the multipliers of a frictional pair at its current state."""
+    """Check the Coulomb law on the multipliers of a frictional pair at its last converged
+    step (after :meth:`~contact_ufl.problem.ContactProblem.solve`, or from its callback):
+    the slip and the stick/slip state are those the step was solved with."""
     c = problem.contacts[pair]
     comm = problem.comm
     if not hasattr(c, "lambda_T"):
@@ -232,10 +238,10 @@ def coulomb_law(problem, pair: int = 0) -> CoulombCheck:
     radius = float(c.mu.value) * lam_N
     excess = np.linalg.norm(lam_T, axis=1) - radius
     scale = comm.allreduce(radius[active].max(initial=0.0), MPI.MAX)
-    slip = c.slip_at_points()
+    slip = c.last_slip
     slip_norm = np.linalg.norm(slip, axis=1)
     slip_scale = comm.allreduce(slip_norm[active].max(initial=0.0), MPI.MAX)
-    slipping = active & ~c.stick() & (slip_norm > 1e-6 * slip_scale)
+    slipping = active & ~c.last_stick & (slip_norm > 1e-6 * slip_scale)
     lam_norm = np.linalg.norm(lam_T, axis=1)
     cos = np.einsum("pd,pd->p", slip, lam_T)[slipping] / (
         slip_norm[slipping] * np.where(lam_norm[slipping] > 0, lam_norm[slipping], np.inf)
@@ -243,6 +249,7 @@ def coulomb_law(problem, pair: int = 0) -> CoulombCheck:
     return CoulombCheck(
         comm.allreduce(excess[active].max(initial=-np.inf), MPI.MAX) / scale,
         comm.allreduce(cos.min(initial=1.0), MPI.MIN),
+        comm.allreduce(np.abs(excess[slipping]).max(initial=0.0), MPI.MAX) / scale,
         comm.allreduce(int(slipping.sum()), MPI.SUM),
         comm.allreduce(int(active.sum()), MPI.SUM),
     )

@@ -13,9 +13,8 @@
 # ends, overlap in plan with a gap between them. The free tip of the upper beam carries a
 # *follower* force: it stays perpendicular to the deformed end section, so the load turns
 # with the beam. The upper beam bends into large rotations, its tip corner lands on the
-# lower beam and presses it down. Without friction the tip slides along the lower beam,
-# pushed by the slope of the bent beam; with Coulomb friction ($\mu = 0.3$) it sticks and
-# rolls on its corner, and the beams end in a different state.
+# lower beam and presses it down. The tip then slides along the lower beam; Coulomb
+# friction ($\mu = 0.3$) holds it back, and the beams end in a different state.
 #
 # The two beams have their own, non-matching hexahedral meshes. The unknowns are the
 # displacements of both beams and the contact multipliers $\lambda_N$ (and, with friction,
@@ -121,9 +120,11 @@ for mu, problem in problems.items():
         excess = max(law.excess for law in coulomb[mu])
         alignment = min(law.alignment for law in coulomb[mu])
         slipping = sum(law.slipping > 0 for law in coulomb[mu])
+        slip_excess = max(law.slip_excess for law in coulomb[mu])
         say(
             f"  Coulomb law over all steps: max(|lambda_T| - mu lambda_N) = {excess:+.1e} "
-            f"max(mu lambda_N); slip in {slipping} steps, cos(slip, lambda_T) >= {alignment:.4f}"
+            f"max(mu lambda_N); slip in {slipping} steps, cos(slip, lambda_T) >= {alignment:.4f}, "
+            f"|lambda_T| = mu lambda_N where slipping to {slip_excess:.1e}"
         )
     say(f"  wall time {walls[mu]:.1f} s (search {problem.search_time:.2f} s)")
 
