@@ -238,6 +238,7 @@ def coulomb_law(problem, pair: int = 0) -> CoulombCheck:
     radius = float(c.mu.value) * lam_N
     excess = np.linalg.norm(lam_T, axis=1) - radius
     scale = comm.allreduce(radius[active].max(initial=0.0), MPI.MAX)
+    scale = scale if scale > 0.0 else 1.0  # no contact pressure: report absolute values
     slip = c.last_slip
     slip_norm = np.linalg.norm(slip, axis=1)
     slip_scale = comm.allreduce(slip_norm[active].max(initial=0.0), MPI.MAX)
