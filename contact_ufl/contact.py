@@ -312,7 +312,7 @@ class FrictionlessContact:
             metadata={"quadrature_degree": qdeg},
         )
         #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see :func:`macaulay`)
-        self.touching = 1e-12 * 4.0 * self._default_radius()
+        self.touching = 1e-12 * self._surfaces_diameter()
         self._kinematics()
         self.radius = pair.search_radius or self._default_radius()
         self._check_facing()
@@ -397,11 +397,15 @@ class FrictionlessContact:
         """Accept the current state as the converged state of a load step."""
 
     # -- search -------------------------------------------------------------------------
-    def _default_radius(self) -> float:
+    def _surfaces_diameter(self) -> float:
+        """Diagonal of the bounding box of both reference surfaces (all ranks)."""
         comm = self.V.mesh.comm
         pts = [self.slave.X.reshape(-1, self.gdim), self.master.X_nodes.reshape(-1, self.gdim)]
         lo, hi = global_bounds(comm, np.vstack(pts))
-        return 0.25 * float(np.linalg.norm(hi - lo))
+        return float(np.linalg.norm(hi - lo))
+
+    def _default_radius(self) -> float:
+        return 0.25 * self._surfaces_diameter()
 
     def _check_facing(self) -> None:
         """Raise if no slave point faces the master surface in the reference configuration."""
