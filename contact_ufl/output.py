@@ -179,19 +179,6 @@ def plot_contact_state(
     _screenshot(plotter, path, title)
 
 
-def deformed_grid(problem):
-    """The mesh as a pyvista grid, warped by the displacement (gathered on rank 0)."""
-    pv = _pyvista()
-    V = problem.V
-    topology, cell_types, x = dolfinx.plot.vtk_mesh(V)
-    grid = pv.UnstructuredGrid(topology, cell_types, x)
-    gdim = V.mesh.geometry.dim
-    u = np.zeros((x.shape[0], 3))
-    u[:, :gdim] = problem.u.x.array.reshape(-1, gdim)[: x.shape[0]]
-    grid.point_data["displacement"] = u
-    return grid.warp_by_vector("displacement")
-
-
 def plot_pressure_profile(
     x: np.ndarray,
     pressure: np.ndarray,
@@ -220,7 +207,7 @@ def plot_deformed(
     if problem.comm.size > 1:
         raise NotImplementedError("pictures are drawn from a serial run")
     pv = _pyvista()
-    grid = deformed_grid(problem)
+    grid = gathered_grid(problem)
     plotter = pv.Plotter(off_screen=True, window_size=(1000, 700))
     plotter.add_mesh(
         grid,
