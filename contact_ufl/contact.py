@@ -396,6 +396,9 @@ class FrictionlessContact:
     def commit(self, x) -> None:
         """Accept the current state as the converged state of a load step."""
 
+    def begin_step(self) -> None:
+        """Start a load step from the last committed state (history-dependent terms)."""
+
     # -- search -------------------------------------------------------------------------
     def _surfaces_diameter(self) -> float:
         """Diagonal of the bounding box of both reference surfaces (all ranks)."""

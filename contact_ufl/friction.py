@@ -80,6 +80,7 @@ class FrictionalContact(FrictionlessContact):
         self._x_commit = None
         self._xhat_n_commit = None
         self._work = None  # vectors of update_history, allocated once
+        self._committed = None  # the converged state, until the next step begins
         #: Slip increments s_T of the last converged step at the owned slave points, and
         #: which of them stuck.
         self.last_slip = np.zeros((0, self.gdim))
@@ -147,17 +148,38 @@ class FrictionalContact(FrictionlessContact):
         self.xhat_n.x.scatter_forward()
 
     def commit(self, x) -> None:
-        """The converged projection becomes the reference of the next step's slip."""
+        """Remember the converged projection: the reference of the next step's slip.
+
+        The slip reference itself moves only in :meth:`begin_step`, so that until the next
+        step starts everything inspected (slip, stick, tractions, contact force) is that of
+        the converged step.
+        """
         owned = len(self._gather)
         self.last_slip = self.slip_at_points()
         self.last_stick = self.stick()
-        self.last_weak_slip = self.weak_slip(self.last_stick | ~self.active())
-        self._gather_n = self._gather.copy()
-        self._xhat_n_commit = self.xhat.x.array[:owned].copy()
-        self._x_commit = x.copy()
-        self.xi_n.x.array[:] = self.xi0.x.array
-        self.mask_n.x.array[:] = self.mask.x.array
-        self.xhat_n.x.array[:] = self.xhat.x.array
+        self.last_weak_slip = self.weak_slip(self.last_stick)
+        self._committed = (
+            self._gather.copy(),
+            self.xhat.x.array[:owned].copy(),
+            x.copy(),
+            self.xi0.x.array.copy(),
+            self.mask.x.array.copy(),
+            self.xhat.x.array.copy(),
+        )
+
+    def begin_step(self) -> None:
+        """The last committed projection becomes the reference of the slip (idempotent:
+        a step cut back and tried again starts from the same reference)."""
+        if self._committed is None:
+            return
+        gather, xhat_owned, x, xi, mask, xhat = self._committed
+        self._gather_n = gather
+        self._xhat_n_commit = xhat_owned
+        self._x_commit = x
+        self.xi_n.x.array[:] = xi
+        self.mask_n.x.array[:] = mask
+        self.xhat_n.x.array[:] = xhat
+        self._committed = None
 
     # -- inspection -------------------------------------------------------------------
     def slip_at_points(self) -> np.ndarray:
@@ -178,8 +200,10 @@ class FrictionalContact(FrictionlessContact):
 
     def weak_slip(self, stick: np.ndarray) -> float:
         """Largest ``|int s_T phi_i| / int phi_i`` over the multiplier nodes whose whole
-        support sticks (``stick``: mask of the owned points): zero to solver tolerance, the
-        stick condition as the multiplier equation imposes it."""
+        support is in contact and sticks (``stick``: mask of the owned points, see
+        :meth:`stick`): zero to solver tolerance, the stick condition as the multiplier
+        equation imposes it. Nodes touching an open or slipping point are left out (0 when
+        there is no such node)."""
         owned = self.L.dofmap.index_map.size_local
         nodal = self.assemble_nodal(self._slip_form, self.L_T)[: owned * self.gdim]
         stuck = (self.count_at_nodes(~stick) == 0) & (self.nodal_mass > 0)

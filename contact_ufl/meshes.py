@@ -918,20 +918,25 @@ def tag_single_body(
 
 def ironing_2d(
     radius: float = 0.75,
-    punch_height: float = 1.5,
+    chord: float = 1.2,
+    punch_height: float = 0.9,
     block: tuple[float, float] = (12.0, 4.0),
-    x_punch: float = 1.0,
-    gap: float = 0.0,
+    x_punch: float = 0.8,
+    gap: float = 0.2,
     h_punch: float = 0.05,
     h_block: float = 0.2,
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
 ) -> SceneMesh:
-    """The "ironing" scene: a punch with a rounded bottom over a long block.
+    """The "shallow ironing" scene: a punch with a rounded bottom over a long block.
 
-    Block ``[0, w] x [-height, 0]``; punch: a half disc of radius ``radius`` and centre
-    ``(x_punch, radius + gap)`` under a rectangle ``2 radius`` wide and ``punch_height`` tall.
+    The defaults are the published geometry (Yang, Laursen & Meng 2005, as drawn by
+    Yastrebov 2011 and used by the solids4foam ``shallowIroning`` tutorial): block ``[0, w]
+    x [-height, 0]``; punch ``chord`` wide with its axis at ``x_punch``, a rectangle
+    ``punch_height`` tall over a circular segment of radius ``radius`` spanning the whole
+    width (sag ``radius - sqrt(radius^2 - chord^2 / 4)``, 0.3 here), its lowest point
+    ``gap`` above the block.
 
     Returns
     -------
@@ -940,19 +945,24 @@ def ironing_2d(
         vertical sides, 11), ``"punch_top"`` (12), ``"block_contact"`` (top, 13),
         ``"block_bottom"`` (14), ``"block_sides"`` (15).
     """
-    _check_positive(radius=radius, punch_height=punch_height, h_punch=h_punch, h_block=h_block)
+    _check_positive(
+        radius=radius, chord=chord, punch_height=punch_height, h_punch=h_punch, h_block=h_block
+    )
+    if chord > 2.0 * radius:
+        raise ValueError(f"the punch's chord {chord} is wider than its arc's diameter {2 * radius}")
     _check_common(gap, 1)
     width, height = block
+    sag = radius - np.sqrt(radius**2 - chord**2 / 4.0)
 
     def build() -> None:
         geo = gmsh.model.geo
-        R, yc = radius, radius + gap
-        c = geo.addPoint(x_punch, yc, 0.0)
-        p_left = geo.addPoint(x_punch - R, yc, 0.0)
+        half, corner = chord / 2.0, gap + sag
+        c = geo.addPoint(x_punch, gap + radius, 0.0)
+        p_left = geo.addPoint(x_punch - half, corner, 0.0)
         p_bottom = geo.addPoint(x_punch, gap, 0.0)
-        p_right = geo.addPoint(x_punch + R, yc, 0.0)
-        t_right = geo.addPoint(x_punch + R, yc + punch_height, 0.0)
-        t_left = geo.addPoint(x_punch - R, yc + punch_height, 0.0)
+        p_right = geo.addPoint(x_punch + half, corner, 0.0)
+        t_right = geo.addPoint(x_punch + half, corner + punch_height, 0.0)
+        t_left = geo.addPoint(x_punch - half, corner + punch_height, 0.0)
         arc_left = geo.addCircleArc(p_left, c, p_bottom)
         arc_right = geo.addCircleArc(p_bottom, c, p_right)
         side_right = geo.addLine(p_right, t_right)

@@ -219,6 +219,7 @@ class ContactProblem:
         self._update_contact(self.x)
         for c in self.contacts:  # the initial state is the converged state of step 0
             c.commit(self.x)
+            c.begin_step()
         self._state = None
         self._update_contact(self.x)
         self._J = self._assemble_jacobian_matrix(first=True)
@@ -425,6 +426,8 @@ class ContactProblem:
         converged, Newton iterations (of both tries), SNES converged reason (name)
         """
         self.set_time(t)
+        for c in self.contacts:
+            c.begin_step()
         fem_petsc.assign(self.unknowns, self.x)
         start = self.x.copy()
         reason, its = self._newton()

@@ -166,6 +166,48 @@ def _facet_integral(problem, expr, tag: int) -> np.ndarray:
     return problem.comm.allreduce(np.asarray(values), MPI.SUM)
 
 
+def contact_force_parts(problem, pair: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """The contact force on the slave body of pair ``pair``, split into its normal-pressure
+    part ``int t_N nu dS_o`` and its frictional part ``-int P(q) dS_o`` (zero without
+    friction), summed over all ranks.
+
+    On a curved contact the normal part has a component along the sliding direction (the
+    body in front of an indenter pushes back on it), so the global ratio of tangential to
+    normal force exceeds mu even where every point slides with ``|lambda_T| = mu lambda_N``.
+    """
+    c = problem.contacts[pair]
+    frictional = -c.t_T if hasattr(c, "t_T") else None
+    parts = []
+    for expr in (c.t_N * c.nu, frictional):
+        if expr is None:
+            parts.append(np.zeros(c.gdim))
+            continue
+        forms = [
+            dolfinx.fem.form(expr[i] * c.ds, entity_maps=[c.slave.entity_map])
+            for i in range(c.gdim)
+        ]
+        local = np.array([dolfinx.fem.assemble_scalar(f) for f in forms])
+        parts.append(problem.comm.allreduce(local, MPI.SUM))
+    return parts[0], parts[1]
+
+
+def stored_energy(problem) -> float:
+    """Elastic energy ``sum_b int psi_b(F) dV`` of all bodies (reference volume)."""
+    F = ufl.Identity(problem.V.mesh.geometry.dim) + ufl.grad(problem.u)
+    energy = sum(b.material.strain_energy(F) * problem.dx(b.tag) for b in problem.scene.bodies)
+    return problem.comm.allreduce(dolfinx.fem.assemble_scalar(dolfinx.fem.form(energy)))
+
+
+def frictional_dissipation(problem, pair: int = 0) -> float:
+    """Energy dissipated by friction in the last converged step, ``int P(q) . s_T dS_o``
+    (the frictional traction times the slip increment; >= 0 by the Coulomb law)."""
+    c = problem.contacts[pair]
+    if not hasattr(c, "t_T"):
+        return 0.0
+    form = dolfinx.fem.form(ufl.dot(c.t_T, c.slip) * c.ds, entity_maps=[c.slave.entity_map])
+    return problem.comm.allreduce(dolfinx.fem.assemble_scalar(form))
+
+
 def section_motion(problem, tag: int) -> tuple[np.ndarray, np.ndarray]:
     """Mean displacement and deformed unit normal of the facets ``tag`` (e.g. a beam's end).
 

@@ -252,12 +252,13 @@ def ironing(
 ) -> Scene:
     """The 2D "shallow ironing" problem (Yang, Laursen & Meng 2005; Poulios & Renard 2015).
 
-    A Neo-Hookean block 12 x 4 (E = 6.896e8, nu = 0.32) clamped at its bottom, and a stiffer
-    punch (E = 6.896e9) with a rounded bottom of radius 0.75, its axis 1 from the block's
-    left end. The punch's top is pressed down by ``depth`` from t = 0 to 1, then moved along
-    the block by ``slide`` from t = 1 to 2. The slave surface is the punch's arc and sides
-    (the finer mesh), the master surface the block's top, with the smoothed normal by default
-    (the punch slides over many master vertices).
+    A Neo-Hookean block 12 x 4 (E = 6.896e8, nu = 0.32) clamped at its bottom, and a ten
+    times stiffer punch 1.2 wide and 1.2 tall whose bottom is a circular segment of radius
+    0.75 (:func:`contact_ufl.meshes.ironing_2d`), 0.2 above the block and 0.2 from its left
+    end. The punch's top is pressed down by ``depth`` from t = 0 to 1 (0.8 into the block),
+    then moved along the block by ``slide`` from t = 1 to 2. The slave surface is the punch's
+    arc and sides (the finer mesh), the master surface the block's top, with the smoothed
+    normal by default (the punch slides over many master vertices).
     """
     sm = meshes.ironing_2d(h_punch=h_punch, h_block=h_block, comm=comm)
     tags = sm.tags

@@ -179,6 +179,7 @@ def curved_case(dim: int, num_steps: int = 4, mu: float = 0.0, master_normal: st
     if mu > 0:
         contact_state(problem, tag, 0.5 * shift)
         problem.contacts[0].commit(problem.x)
+        problem.contacts[0].begin_step()
     contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
     direction = sliding_direction(problem, tag, np.array(state["slide"]))
     return problem, direction, [state["h0"] * 2.0**-k for k in range(num_steps)]

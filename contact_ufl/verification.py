@@ -7,7 +7,13 @@ import numpy as np
 from contact_ufl import scenes
 from contact_ufl.analytic import CattaneoMindlin2D, Hertz2D
 from contact_ufl.problem import ContactProblem
-from contact_ufl.results import contact_samples, stick_zone_half_width
+from contact_ufl.results import (
+    contact_force_parts,
+    contact_samples,
+    frictional_dissipation,
+    stick_zone_half_width,
+    stored_energy,
+)
 
 
 def cattaneo_mindlin_run(
@@ -72,6 +78,20 @@ IRONING_LITERATURE = {
     "Fischer & Wriggers 2006": 0.53,
 }
 
+#: Reaction forces on the indenter's top (magnitudes, per unit thickness in the units of E
+#: times length) of the shallow ironing problem with mu = 0.3 in the literature:
+#: ``(Fy, Fx)`` at t = 1.0 (end of pressing) and at t = 1.5 (steady sliding), read off the
+#: published curves by the solids4foam tutorial ``shallowIroning`` (Table 2 there; its
+#: newtons on a 1 mm thick domain with lengths in mm are 1e-6 of these units).
+IRONING_FORCES = {
+    "Poulios & Renard 2015": ((2.679e8, 0.553e8), (3.374e8, 1.021e8)),
+    "Batistic et al. 2022": ((3.164e8, 0.550e8), (3.951e8, 1.227e8)),
+    "Code_Aster SSNP153": ((3.320e8, 0.710e8), (4.210e8, 1.433e8)),
+    "Hartmann et al. 2009": ((3.195e8, 0.672e8), (4.084e8, 1.602e8)),
+    "Yastrebov 2011": ((2.897e8, 0.585e8), (3.595e8, 1.708e8)),
+    "Fischer & Wriggers 2006": ((2.979e8, 0.621e8), (3.651e8, 1.888e8)),
+}
+
 
 def ironing_run(
     mu: float,
@@ -88,15 +108,19 @@ def ironing_run(
     ``Fy`` (the force of the support on the indenter's top, which balances the contact
     force), ``newton_iterations`` and ``converged`` (every accepted step converged; a step
     that does not is cut back, and the run stops with :class:`ConvergenceError` when the
-    cut-backs run out), and the problem.
+    cut-backs run out), ``contact_normal`` and ``contact_friction`` (the parts of the
+    contact force on the indenter, :func:`contact_force_parts`), ``top_displacement``,
+    ``stored_energy`` and ``dissipation`` (of the step), and the problem.
     """
-    scene = scenes.ironing(mu=mu, h_punch=h_punch, h_block=h_block)
+    slide, depth = 10.0, 1.0
+    scene = scenes.ironing(mu=mu, h_punch=h_punch, h_block=h_block, depth=depth, slide=slide)
     problem = ContactProblem(scene, verbose=verbose, petsc_options={"snes_max_it": 40})
     top = scene.tags["punch_top"]
     history = []
 
     def record(problem, step):
         F = problem.reaction(top)
+        normal, frictional = contact_force_parts(problem)
         history.append(
             {
                 "time": step.t,
@@ -104,6 +128,11 @@ def ironing_run(
                 "Fy": float(F[1]),
                 "newton_iterations": step.newton_iterations,
                 "converged": True,
+                "contact_normal": normal.tolist(),
+                "contact_friction": frictional.tolist(),
+                "top_displacement": [slide * max(step.t - 1.0, 0.0), -depth * min(step.t, 1.0)],
+                "stored_energy": stored_energy(problem),
+                "dissipation": frictional_dissipation(problem),
             }
         )
 
@@ -120,8 +149,43 @@ def ironing_run(
     return run, problem
 
 
-def steady_ratio(history: list[dict], window: tuple[float, float] = (1.2, 1.7)) -> float:
+def steady_ratio(
+    history: list[dict], window: tuple[float, float] = (1.2, 1.7), part: str | None = None
+) -> float:
     """Mean of |Fx / Fy| over the records of the steady sliding ``window`` of pseudo-time
-    (the indenter away from both ends of the block)."""
-    ratios = [abs(r["Fx"] / r["Fy"]) for r in history if window[0] <= r["time"] <= window[1]]
-    return float(np.mean(ratios))
+    (the indenter away from both ends of the block).
+
+    With ``part="contact_friction"`` or ``"contact_normal"``, the numerator is the sliding
+    component of that part of the contact force (:func:`contact_force_parts`) instead of Fx:
+    the two add up to |Fx / Fy|, the frictional one is mu times the pressure resultant's
+    length over Fy, the normal one the ploughing of the indenter through the block.
+    """
+    records = [r for r in history if window[0] <= r["time"] <= window[1]]
+    if part is None:
+        return float(np.mean([abs(r["Fx"] / r["Fy"]) for r in records]))
+    return float(np.mean([abs(r[part][0] / r["Fy"]) for r in records]))
+
+
+def energy_balance(
+    history: list[dict], window: tuple[float, float] = (1.2, 1.7)
+) -> tuple[float, float, float]:
+    """Work of the indenter's support over the records of ``window`` (trapezoidal in its
+    force), the frictional dissipation and the change of stored energy over it: in a
+    quasi-static run they balance, ``W = D + dPsi``, up to the time discretisation."""
+    records = [r for r in history if window[0] <= r["time"] <= window[1]]
+    work = sum(
+        0.5
+        * np.dot(
+            np.add([a["Fx"], a["Fy"]], [b["Fx"], b["Fy"]]),
+            np.subtract(b["top_displacement"], a["top_displacement"]),
+        )
+        for a, b in zip(records[:-1], records[1:], strict=True)
+    )
+    dissipation = sum(r["dissipation"] for r in records[1:])
+    return work, dissipation, records[-1]["stored_energy"] - records[0]["stored_energy"]
+
+
+def history_at(history: list[dict], t: float, key: str) -> float:
+    """|``key``| of the records, interpolated linearly in pseudo-time at ``t``."""
+    times = np.array([r["time"] for r in history])
+    return float(np.interp(t, times, [abs(r[key]) for r in history]))
