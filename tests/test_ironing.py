@@ -86,3 +86,16 @@ def test_forces_within_the_published_curves(ironing):
         assert low <= history_at(history, t, "Fy") <= high
     low, high = _published(1, 1)
     assert low <= history_at(history, 1.5, "Fx") <= high
+
+
+@pytest.mark.slow
+@pytest.mark.serial
+@pytest.mark.parametrize("ironing", [0.3], indirect=True, ids=["mu=0.3"])
+def test_fine_mesh_changes_the_ratio_little(ironing):
+    """Halving the mesh size (the benchmark's default mesh, about 4 minutes) moves the
+    frictional part of |Fx/Fy| by less than 1% and the total by less than 3%."""
+    fine, _ = ironing_run(ironing["mu"])
+    for part in ("contact_friction", None):
+        coarse_ratio = steady_ratio(ironing["history"], part=part)
+        fine_ratio = steady_ratio(fine["history"], part=part)
+        assert fine_ratio == pytest.approx(coarse_ratio, rel=0.01 if part else 0.03)
