@@ -226,12 +226,13 @@ class FrictionalContact(FrictionlessContact):
         return (np.einsum("pd,pd->p", q, q) <= radius**2) & (radius > 0)
 
     def tangential_traction_at_points(self) -> np.ndarray:
-        """The frictional traction on the slave body at the owned slave points: ``q``
-        projected onto the Coulomb disc of radius ``mu t_N``, ``(n, gdim)``."""
+        """The frictional traction on the slave body at the owned slave points, ``-P(q)``
+        (``q`` projected onto the Coulomb disc of radius ``mu t_N``; the term of
+        :meth:`traction`), ``(n, gdim)``: it opposes the slip."""
         q, radius = self._trial_and_radius()
         norm = np.linalg.norm(q, axis=1)
         scale = np.where(norm <= radius, 1.0, radius / np.where(norm > 0.0, norm, 1.0))
-        return np.where(radius[:, None] > 0.0, scale[:, None] * q, 0.0)
+        return np.where(radius[:, None] > 0.0, -scale[:, None] * q, 0.0)
 
     def traction_at_points(self) -> np.ndarray:
         """Contact traction (normal and frictional) on the slave body at the owned points."""

@@ -522,7 +522,8 @@ class ContactProblem:
 
     # -- results --------------------------------------------------------------------
     def contact_force(self, k: int | None = None) -> np.ndarray:
-        """Resultant contact force on the slave body, ``int t_N nu dS_o`` (all pairs)."""
+        """Resultant contact force on the slave body, ``int (t_N nu - P(q)) dS_o`` (all pairs;
+        the frictional part only with friction)."""
         pairs = range(len(self.contacts)) if k is None else [k]
         total = np.zeros(self.V.mesh.geometry.dim)
         for j in pairs:

@@ -6,6 +6,7 @@ import numpy as np
 
 from contact_ufl import scenes
 from contact_ufl.analytic import CattaneoMindlin2D, Hertz2D
+from contact_ufl.loads import evaluate
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import (
     contact_force_parts,
@@ -112,10 +113,10 @@ def ironing_run(
     contact force on the indenter, :func:`contact_force_parts`), ``top_displacement``,
     ``stored_energy`` and ``dissipation`` (of the step), and the problem.
     """
-    slide, depth = 10.0, 1.0
-    scene = scenes.ironing(mu=mu, h_punch=h_punch, h_block=h_block, depth=depth, slide=slide)
+    scene = scenes.ironing(mu=mu, h_punch=h_punch, h_block=h_block)
     problem = ContactProblem(scene, verbose=verbose, petsc_options={"snes_max_it": 40})
     top = scene.tags["punch_top"]
+    (driven,) = [d for d in scene.dirichlet if d.tag == top]
     history = []
 
     def record(problem, step):
@@ -130,7 +131,7 @@ def ironing_run(
                 "converged": True,
                 "contact_normal": normal.tolist(),
                 "contact_friction": frictional.tolist(),
-                "top_displacement": [slide * max(step.t - 1.0, 0.0), -depth * min(step.t, 1.0)],
+                "top_displacement": evaluate(driven.value, step.t).tolist(),
                 "stored_energy": stored_energy(problem),
                 "dissipation": frictional_dissipation(problem),
             }
@@ -156,9 +157,10 @@ def steady_ratio(
     (the indenter away from both ends of the block).
 
     With ``part="contact_friction"`` or ``"contact_normal"``, the numerator is the sliding
-    component of that part of the contact force (:func:`contact_force_parts`) instead of Fx:
-    the two add up to |Fx / Fy|, the frictional one is mu times the pressure resultant's
-    length over Fy, the normal one the ploughing of the indenter through the block.
+    component of that part of the contact force (:func:`contact_force_parts`) instead of Fx.
+    Where both components have the sign of Fx (steady sliding) the two parts add up to
+    |Fx / Fy|: the frictional one is close to mu where the indenter slides, the normal one
+    is the pressure on the indenter's inclined front (ploughing).
     """
     records = [r for r in history if window[0] <= r["time"] <= window[1]]
     if part is None:
@@ -169,10 +171,18 @@ def steady_ratio(
 def energy_balance(
     history: list[dict], window: tuple[float, float] = (1.2, 1.7)
 ) -> tuple[float, float, float]:
-    """Work of the indenter's support over the records of ``window`` (trapezoidal in its
-    force), the frictional dissipation and the change of stored energy over it: in a
-    quasi-static run they balance, ``W = D + dPsi``, up to the time discretisation."""
+    """Energy balance of the records of :func:`ironing_run` over ``window``.
+
+    Returns
+    -------
+    work, dissipation, stored
+        The work of the indenter's support (trapezoidal in its force), the frictional
+        dissipation and the change of stored energy over the window: in a quasi-static run
+        ``work = dissipation + stored`` up to the time discretisation.
+    """
     records = [r for r in history if window[0] <= r["time"] <= window[1]]
+    if len(records) < 2:
+        raise ValueError(f"fewer than two records in the window {window}")
     work = sum(
         0.5
         * np.dot(

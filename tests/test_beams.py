@@ -72,6 +72,11 @@ def test_large_rotations_and_equilibrium(showcase):
         assert np.degrees(np.arccos(abs(n_tip[0]))) > 25.0  # large rotation of the tip
         assert problem.active_points() > 0
         assert equilibrium_error(problem, SUPPORTS) < 1e-8
+        # the lower beam carries only the contact force: its clamp balances it, so the
+        # reaction equals the contact force on the upper beam (friction included)
+        force = problem.contact_force()
+        reaction = problem.reaction(problem.scene.tags["lower_clamp"])
+        assert np.linalg.norm(reaction - force) < 1e-6 * np.linalg.norm(force)
 
 
 def test_coulomb_law_at_every_step(showcase):

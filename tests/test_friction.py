@@ -64,6 +64,7 @@ def test_block_sticks_then_slides():
 
     def record(problem, step):
         active = c.active()
+        power = np.einsum("pd,pd->p", c.tangential_traction_at_points(), c.last_slip)[active]
         friction = problem.comm.allreduce(
             float(np.sum(np.einsum("pd,pd->p", c.last_slip[active], c.last_slip[active])))
         )
@@ -75,6 +76,8 @@ def test_block_sticks_then_slides():
                 stick=problem.comm.allreduce(int((c.last_stick & active).sum())),
                 weak_slip=c.last_weak_slip,
                 slip2=friction,
+                # the frictional traction on the slave body against its slip
+                power=problem.comm.allreduce(float(np.max(power, initial=-np.inf)), op=MPI.MAX),
             )
         )
 
@@ -92,6 +95,7 @@ def test_block_sticks_then_slides():
     for r in sliding:
         assert r["stick"] == 0 and r["active"] > 0
         assert np.sqrt(r["slip2"]) > 0.1 * increment
+        assert r["power"] < 0.0
 
 
 def test_objectivity_under_a_large_rotation():

@@ -56,8 +56,8 @@ def test_work_is_dissipation_plus_stored_energy(ironing):
     work, dissipation, stored = energy_balance(ironing["history"])
     assert work > 0.0
     assert abs(work - dissipation - stored) < 0.02 * work
-    if ironing["mu"] == 0.0:
-        assert dissipation == 0.0
+    if ironing["mu"] > 0.0:
+        assert dissipation > 0.9 * work  # sliding dissipates, storing little
 
 
 @pytest.mark.serial
