@@ -23,6 +23,7 @@ from contact_ufl.errors import ConvergenceError
 from contact_ufl.friction import FrictionalContact
 from contact_ufl.layout import StackedLayout, chain_operator
 from contact_ufl.loads import BodyForce, evaluate, load_constant
+from contact_ufl.plasticity import J2Plasticity, PlasticHistory
 from contact_ufl.scene import Scene
 from contact_ufl.surfaces import global_bounds
 
@@ -111,6 +112,12 @@ class ContactProblem:
         )
         self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=scene.facet_tags)
         self.t = 0.0
+        #: history of the elastoplastic bodies, by cell tag (moved on each converged step)
+        self.histories = {
+            b.tag: PlasticHistory(b.material, self.u, qdeg)
+            for b in scene.bodies
+            if isinstance(b.material, J2Plasticity)
+        }
         self.contacts = [
             (FrictionalContact if p.mu > 0 else FrictionlessContact)(self.u, scene.facet_tags, p)
             for p in scene.contacts
@@ -124,7 +131,10 @@ class ContactProblem:
 
     # -- forms ------------------------------------------------------------------------
     def first_piola(self, body) -> ufl.core.expr.Expr:
-        """First Piola-Kirchhoff stress of ``body`` at the current displacement."""
+        """First Piola-Kirchhoff stress of ``body`` at the current displacement (and, for an
+        elastoplastic body, the history of the last converged step)."""
+        if body.tag in self.histories:
+            return self.histories[body.tag].first_piola()
         F = ufl.Identity(self.V.mesh.geometry.dim) + ufl.grad(self.u)
         return body.material.first_piola(F)
 
@@ -505,6 +515,8 @@ class ContactProblem:
             self.history.steps.append(record)
             for c in self.contacts:
                 c.commit(self.x)
+            for h in self.histories.values():
+                h.commit()
             self._state = None
             self._print(self._format(record))
             if callback is not None:

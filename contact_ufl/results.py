@@ -198,7 +198,13 @@ def contact_force_parts(problem, pair: int = 0) -> tuple[np.ndarray, np.ndarray]
 
 
 def stored_energy(problem) -> float:
-    """Elastic energy ``sum_b int psi_b(F) dV`` of all bodies (reference volume)."""
+    """Elastic energy ``sum_b int psi_b(F) dV`` of all bodies (reference volume); the
+    hyperelastic bodies only (an elastoplastic one raises)."""
+    if problem.histories:
+        raise ValueError(
+            "stored_energy covers hyperelastic bodies only; this scene has "
+            f"elastoplastic bodies (cell tags {sorted(problem.histories)})"
+        )
     F = ufl.Identity(problem.V.mesh.geometry.dim) + ufl.grad(problem.u)
     energy = sum(b.material.strain_energy(F) * problem.dx(b.tag) for b in problem.scene.bodies)
     return problem.comm.allreduce(dolfinx.fem.assemble_scalar(dolfinx.fem.form(energy)))

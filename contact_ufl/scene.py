@@ -12,6 +12,7 @@ from contact_ufl.contact import ContactPair
 from contact_ufl.errors import collective_check
 from contact_ufl.loads import BodyForce, Dirichlet, FollowerForce, FollowerPressure, Load, evaluate
 from contact_ufl.materials import Hyperelastic
+from contact_ufl.plasticity import J2Plasticity
 
 
 @dataclass(frozen=True)
@@ -19,7 +20,7 @@ class Body:
     """A body: the cells with ``tag`` and their material."""
 
     tag: int
-    material: Hyperelastic
+    material: Hyperelastic | J2Plasticity
     name: str = ""
 
 

@@ -18,6 +18,7 @@ from contact_ufl.analytic import plane_strain_modulus
 from contact_ufl.contact import ContactPair
 from contact_ufl.loads import DeadTraction, Dirichlet, FollowerForce
 from contact_ufl.materials import NeoHookean
+from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.scene import Body, Scene
 
 
@@ -210,6 +211,43 @@ def curved_pair(
         ],
         contacts=[ContactPair(tags[names[2]], tags[names[3]], eps_N=eps_N)],
         tags=tags,
+    )
+
+
+def plastic_indentation(
+    depth: float = 0.02,
+    yield_stress: float | None = 0.01,
+    h_contact: float = 0.01,
+    E_cylinder: float = 10.0,
+    E_block: float = 1.0,
+    nu: float = 0.3,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """A stiff half disc (R = 1) pressed into an elastoplastic block and lifted off again.
+
+    The Hertz geometry (:func:`hertz_2d`); the block is :class:`J2Plasticity` with
+    ``yield_stress`` (perfectly plastic; ``None``: Neo-Hookean, the elastic control). The
+    disc's top moves down by ``depth`` from t = 0 to 1 and back up to its start from t = 1
+    to 2: a plastic block keeps an imprint, an elastic one springs back.
+    """
+    hertz = hertz_2d(
+        h_contact=h_contact, depth=depth, E=E_cylinder, nu=nu, E_flat=E_block, nu_flat=nu, comm=comm
+    )
+    scene, tags = hertz.scene, hertz.scene.tags
+    cylinder, block = scene.bodies
+    if yield_stress is not None:
+        block = Body(block.tag, J2Plasticity(E_block, nu, yield_stress), block.name)
+
+    def lowered(t: float) -> tuple[float, float]:
+        return 0.0, -depth * (t if t <= 1.0 else max(2.0 - t, 0.0))
+
+    return dataclasses.replace(
+        scene,
+        bodies=[cylinder, block],
+        dirichlet=[
+            Dirichlet(tags["block_bottom"], (0.0, 0.0)),
+            Dirichlet(tags["cylinder_top"], lowered),
+        ],
     )
 
 

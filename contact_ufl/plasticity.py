@@ -1,0 +1,165 @@
+"""Finite-strain J2 elastoplasticity (Simo 1988; Simo & Hughes 1998, Box 9.1).
+
+Multiplicative split ``F = F_e F_p``, an uncoupled Neo-Hookean-type elastic energy
+``psi = U(J) + mu/2 (tr bbar_e - 3)`` with ``U(J) = kappa/2 ((J^2 - 1)/2 - ln J)`` and
+``bbar_e = J^(-2/3) F C_p^-1 F^T``, the von Mises yield function
+``f = |s| - sqrt(2/3) (sigma_y + H alpha)`` on the Kirchhoff deviator ``s = mu dev bbar_e``,
+linear isotropic hardening ``H``, and the associative flow rule integrated by the
+radial return of the box:
+
+- trial state: ``bbar_e^tr = J^(-2/3) F C_p,n^-1 F^T``, ``s^tr = mu dev bbar_e^tr``,
+  ``mubar = mu tr(bbar_e^tr) / 3``;
+- where ``f^tr > 0``: ``dgamma = f^tr / (2 mubar (1 + H / (3 mubar)))``,
+  ``s = s^tr - 2 mubar dgamma s^tr / |s^tr|``, ``alpha = alpha_n + sqrt(2/3) dgamma``;
+- Kirchhoff stress ``tau = J U'(J) I + s``; ``P = tau F^-T``;
+- history: ``bbar_e = s / mu + tr(bbar_e^tr)/3 I``, stored as
+  ``C_p^-1 = J^(2/3) F^-1 bbar_e F^-T``.
+
+The return map is closed-form UFL (a conditional on ``f^tr``), so ``ufl.derivative`` of the
+residual is the consistent (algorithmic) tangent. The history lives at the quadrature
+points of the bulk integrals and moves only when a step is committed, so a step that is cut
+back starts again from the same history. Plane strain embeds the 2x2 ``F`` in 3x3 with
+``F_33 = 1``; the history is 3x3 (``C_p,33`` evolves).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import basix.ufl
+import dolfinx
+import numpy as np
+import ufl
+
+from contact_ufl.materials import lame_parameters
+
+
+@dataclass(frozen=True)
+class J2Plasticity:
+    """Finite-strain von Mises plasticity with linear isotropic hardening.
+
+    Parameters
+    ----------
+    E, nu
+        Young's modulus and Poisson's ratio (small-strain limit of the elastic response).
+    yield_stress
+        Initial yield stress ``sigma_y`` (Kirchhoff, uniaxial).
+    hardening
+        Linear isotropic hardening modulus ``H`` (0: perfect plasticity).
+    """
+
+    E: float
+    nu: float
+    yield_stress: float
+    hardening: float = 0.0
+
+    def __post_init__(self) -> None:
+        lame_parameters(self.E, self.nu)
+        if not self.yield_stress > 0.0:
+            raise ValueError(f"the yield stress must be positive, got {self.yield_stress}")
+        if not self.hardening >= 0.0:
+            raise ValueError(f"the hardening modulus must be >= 0, got {self.hardening}")
+
+    @property
+    def mu(self) -> float:
+        """Shear modulus."""
+        return lame_parameters(self.E, self.nu)[0]
+
+    @property
+    def kappa(self) -> float:
+        """Bulk modulus."""
+        mu, lmbda = lame_parameters(self.E, self.nu)
+        return lmbda + 2.0 * mu / 3.0
+
+    def return_map(self, F, Cp_inv_n, alpha_n):
+        """Kirchhoff stress and updated history of the radial return at ``F`` (3x3).
+
+        Returns
+        -------
+        tau, Cp_inv, alpha
+            UFL expressions: the Kirchhoff stress, ``C_p^-1`` and the equivalent plastic
+            strain at the end of the step.
+        """
+        I = ufl.Identity(3)
+        J = ufl.det(F)
+        b_trial = J ** (-2.0 / 3.0) * F * Cp_inv_n * F.T
+        I_e = ufl.tr(b_trial) / 3.0
+        mu, H = self.mu, self.hardening
+        s_trial = mu * (b_trial - I_e * I)
+        mubar = mu * I_e
+        norm = ufl.sqrt(ufl.inner(s_trial, s_trial))
+        f_trial = norm - np.sqrt(2.0 / 3.0) * (self.yield_stress + H * alpha_n)
+        plastic = ufl.gt(f_trial, 0.0)
+        dgamma = ufl.conditional(plastic, f_trial / (2.0 * mubar * (1.0 + H / (3.0 * mubar))), 0.0)
+        # the radial return scales s_trial; |s_trial| only enters where it is > 0
+        scale = ufl.conditional(plastic, 1.0 - 2.0 * mubar * dgamma / norm, 1.0)
+        s = scale * s_trial
+        tau = 0.5 * self.kappa * (J**2 - 1.0) * I + s
+        b_e = s / mu + I_e * I
+        F_inv = ufl.inv(F)
+        Cp_inv = J ** (2.0 / 3.0) * F_inv * b_e * F_inv.T
+        return tau, Cp_inv, alpha_n + np.sqrt(2.0 / 3.0) * dgamma
+
+
+def _embed(F):
+    """The 3x3 deformation gradient of a 2x2 (plane strain) or 3x3 one."""
+    if F.ufl_shape[0] == 3:
+        return F
+    return ufl.as_matrix([[F[0, 0], F[0, 1], 0.0], [F[1, 0], F[1, 1], 0.0], [0.0, 0.0, 1.0]])
+
+
+class PlasticHistory:
+    """History of a :class:`J2Plasticity` body at the quadrature points of the bulk rule.
+
+    Parameters
+    ----------
+    material
+        The material.
+    u
+        The displacement.
+    quadrature_degree
+        Degree of the bulk quadrature rule (the history's points are that rule's).
+    """
+
+    def __init__(self, material: J2Plasticity, u: dolfinx.fem.Function, quadrature_degree: int):
+        mesh = u.function_space.mesh
+        cell = mesh.basix_cell()
+
+        def space(shape):
+            element = basix.ufl.quadrature_element(
+                cell, value_shape=shape, degree=quadrature_degree
+            )
+            return dolfinx.fem.functionspace(mesh, element)
+
+        self.material = material
+        self.u = u
+        self.Cp_inv = dolfinx.fem.Function(space((3, 3)), name="Cp_inv")
+        self.Cp_inv.x.array.reshape(-1, 9)[:] = np.eye(3).ravel()
+        self.alpha = dolfinx.fem.Function(space(()), name="equivalent_plastic_strain")
+        gdim = mesh.geometry.dim
+        self.F3 = _embed(ufl.Identity(gdim) + ufl.grad(u))
+        self.tau, Cp_inv, alpha = material.return_map(self.F3, self.Cp_inv, self.alpha)
+        points = self.Cp_inv.function_space.element.interpolation_points
+        self._updates = [
+            (self.Cp_inv, dolfinx.fem.Expression(Cp_inv, points)),
+            (self.alpha, dolfinx.fem.Expression(alpha, points)),
+        ]
+
+    def first_piola(self) -> ufl.core.expr.Expr:
+        """First Piola-Kirchhoff stress ``tau F^-T`` (``gdim x gdim``) at the current
+        displacement and the committed history."""
+        P = self.tau * ufl.inv(self.F3).T
+        gdim = self.u.function_space.mesh.geometry.dim
+        return ufl.as_matrix([[P[i, j] for j in range(gdim)] for i in range(gdim)])
+
+    def commit(self) -> None:
+        """The return map at the converged displacement becomes the history (every field
+        evaluated from the old history before any is overwritten)."""
+        mesh = self.u.function_space.mesh
+        cells = np.arange(mesh.topology.index_map(mesh.topology.dim).size_local, dtype=np.int32)
+        values = [expr.eval(mesh, cells) for _, expr in self._updates]
+        for (target, _), value in zip(self._updates, values, strict=True):
+            bs = target.function_space.dofmap.index_map_bs
+            dofs = target.function_space.dofmap.list[cells]
+            target.x.array.reshape(-1, bs)[dofs.ravel()] = value.reshape(-1, bs)
+            target.x.scatter_forward()
