@@ -21,8 +21,9 @@ class ResultWriter:
     problem
         The contact problem.
     folder
-        Output folder; ``displacement.bp`` and ``contact_<k>.bp`` (the multipliers of pair
-        ``k``) are written there.
+        Output folder; ``displacement.bp``, ``contact_<k>.bp`` (the multipliers of pair
+        ``k``) and, for each elastoplastic body, ``plastic_strain_<tag>.bp`` (the cell means
+        of its equivalent plastic strain) are written there.
     """
 
     def __init__(self, problem, folder: str | Path):
@@ -35,9 +36,15 @@ class ResultWriter:
         for k, c in enumerate(problem.contacts):
             multipliers = [c.lambda_N] + ([c.lambda_T] if hasattr(c, "lambda_T") else [])
             self.writers.append(dolfinx.io.VTXWriter(comm, folder / f"contact_{k}.bp", multipliers))
+        self.histories = list(problem.histories.values())
+        for tag, h in problem.histories.items():
+            path = folder / f"plastic_strain_{tag}.bp"
+            self.writers.append(dolfinx.io.VTXWriter(comm, path, [h.plastic_strain]))
 
     def write(self, t: float) -> None:
         """Write the current state at pseudo-time ``t``."""
+        for h in self.histories:
+            h.update_plastic_strain()
         for w in self.writers:
             w.write(t)
 

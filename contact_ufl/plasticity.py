@@ -24,6 +24,7 @@ back starts again from the same history. Plane strain embeds the 2x2 ``F`` in 3x
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import basix.ufl
@@ -151,6 +152,30 @@ class PlasticHistory:
         P = self.tau * ufl.inv(self.F3).T
         gdim = self.u.function_space.mesh.geometry.dim
         return ufl.as_matrix([[P[i, j] for j in range(gdim)] for i in range(gdim)])
+
+    @functools.cached_property
+    def _cell_mean_forms(self) -> tuple[dolfinx.fem.Form, dolfinx.fem.Form]:
+        mesh = self.u.function_space.mesh
+        v = ufl.TestFunction(self.plastic_strain.function_space)
+        dx = ufl.dx(domain=mesh)
+        return dolfinx.fem.form(self.alpha * v * dx), dolfinx.fem.form(v * dx)
+
+    @functools.cached_property
+    def plastic_strain(self) -> dolfinx.fem.Function:
+        """The cell means of the equivalent plastic strain (DG0, for output; see
+        :meth:`update_plastic_strain`)."""
+        DG0 = dolfinx.fem.functionspace(self.u.function_space.mesh, ("DG", 0))
+        return dolfinx.fem.Function(DG0, name="equivalent_plastic_strain")
+
+    def update_plastic_strain(self) -> dolfinx.fem.Function:
+        """Set :attr:`plastic_strain` to ``int_cell alpha dV / |cell|`` of the committed
+        history and return it."""
+        integral, volume = (dolfinx.fem.assemble_vector(f).array for f in self._cell_mean_forms)
+        out = self.plastic_strain
+        n = out.function_space.dofmap.index_map.size_local
+        out.x.array[:n] = integral[:n] / volume[:n]
+        out.x.scatter_forward()
+        return out
 
     def commit(self) -> None:
         """The return map at the converged displacement becomes the history (every field

@@ -11,6 +11,7 @@ from mpi4py import MPI
 from contact_ufl import scenes
 from contact_ufl.loads import Dirichlet
 from contact_ufl.meshes import tag_single_body
+from contact_ufl.output import ResultWriter
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import contact_samples, stored_energy
@@ -162,3 +163,19 @@ def test_indentation_leaves_an_imprint():
         assert problem.t == pytest.approx(2.0)
         assert problem.active_points() == 0
         assert np.linalg.norm(problem.contact_force()) == 0.0
+
+
+def test_plastic_strain_is_written(tmp_path_factory):
+    """The results writer writes the cell means of the equivalent plastic strain; in the
+    homogeneous bar they equal the history at every point."""
+    folder = tmp_path_factory.mktemp("plastic") if MPI.COMM_WORLD.rank == 0 else None
+    folder = MPI.COMM_WORLD.bcast(folder)
+    problem = bar(J2Plasticity(E, NU, SIGMA_Y, hardening=0.1), lambda t: 0.1 * t)
+    writer = ResultWriter(problem, folder)
+    problem.solve(num_steps=2, t_end=1.0, callback=writer)
+    writer.close()
+    history = problem.histories[1]
+    alpha = problem.comm.allreduce(history.alpha.x.array.max(initial=-np.inf), op=MPI.MAX)
+    assert alpha > 0.0
+    assert np.allclose(history.plastic_strain.x.array, alpha, rtol=1e-7)
+    assert (folder / "plastic_strain_1.bp").exists()
