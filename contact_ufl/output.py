@@ -65,12 +65,14 @@ def _pyvista():
     return pyvista
 
 
-def gathered_grid(problem, deformed: bool = True):
+def gathered_grid(
+    problem, deformed: bool = True, cell_data: dict[str, dolfinx.fem.Function] | None = None
+):
     """The mesh of all ranks as one pyvista grid on rank 0 (``None`` on the other ranks).
 
     Each rank contributes its owned cells; the point data hold the displacement, and the
-    cell data ``"body"`` the cell tag of each cell. With ``deformed`` the grid is warped by
-    the displacement.
+    cell data ``"body"`` the cell tag of each cell, plus the cellwise (DG0) functions of
+    ``cell_data`` under their keys. With ``deformed`` the grid is warped by the displacement.
     """
     pv = _pyvista()
     V = problem.V
@@ -85,11 +87,15 @@ def gathered_grid(problem, deformed: bool = True):
     tags = problem.scene.cell_tags
     local = tags.indices < owned
     body[tags.indices[local]] = tags.values[local]
-    parts = problem.comm.gather((cells, cell_types[:owned], x, u, body), root=0)
+    fields = {
+        name: f.x.array[f.function_space.dofmap.list[:owned, 0]]
+        for name, f in (cell_data or {}).items()
+    }
+    parts = problem.comm.gather((cells, cell_types[:owned], x, u, body, fields), root=0)
     if problem.comm.rank != 0:
         return None
     offset, all_cells = 0, []
-    for c, _, xx, _, _ in parts:
+    for c, _, xx, *_ in parts:
         shifted = c.copy()
         shifted[:, 1:] += offset
         all_cells.append(shifted)
@@ -101,6 +107,8 @@ def gathered_grid(problem, deformed: bool = True):
     )
     grid.point_data["displacement"] = np.concatenate([p[3] for p in parts])
     grid.cell_data["body"] = np.concatenate([p[4] for p in parts])
+    for name in fields:
+        grid.cell_data[name] = np.concatenate([p[5][name] for p in parts])
     return grid.warp_by_vector("displacement") if deformed else grid
 
 
@@ -207,21 +215,48 @@ def plot_pressure_profile(
     plotter.close()
 
 
-def plot_deformed(
-    problem, path: str | Path, zoom: float = 1.0, focus: tuple[float, float, float] | None = None
+def plot_curves(
+    curves: dict[str, tuple[np.ndarray, np.ndarray]],
+    path: str | Path,
+    x_label: str,
+    y_label: str,
+    title: str = "",
 ) -> None:
-    """The deformed bodies coloured by the displacement magnitude (2D: seen from +z)."""
+    """A line chart of the ``curves`` (label: ``(x, y)``)."""
+    pv = _pyvista()
+    chart = pv.Chart2D(x_label=x_label, y_label=y_label)
+    chart.title = title
+    colours = ["tab:blue", "tab:red", "tab:green", "tab:orange"]
+    for k, (name, (x, y)) in enumerate(curves.items()):
+        chart.line(x, y, color=colours[k % len(colours)], width=2.0, label=name)
+    plotter = pv.Plotter(off_screen=True, window_size=(900, 600))
+    plotter.add_chart(chart)
+    plotter.screenshot(str(path))
+    plotter.close()
+
+
+def plot_deformed(
+    problem,
+    path: str | Path,
+    zoom: float = 1.0,
+    focus: tuple[float, float, float] | None = None,
+    cell_field: dolfinx.fem.Function | None = None,
+    label: str = "|u|",
+) -> None:
+    """The deformed bodies coloured by the displacement magnitude, or by the cellwise
+    (DG0) ``cell_field`` with the colour bar title ``label`` (2D: seen from +z)."""
     if problem.comm.size > 1:
         raise NotImplementedError("pictures are drawn from a serial run")
     pv = _pyvista()
-    grid = gathered_grid(problem)
+    cells = {} if cell_field is None else {label: cell_field}
+    grid = gathered_grid(problem, cell_data=cells)
     plotter = pv.Plotter(off_screen=True, window_size=(1000, 700))
     plotter.add_mesh(
         grid,
-        scalars="displacement",
+        scalars="displacement" if cell_field is None else label,
         show_edges=True,
         cmap="viridis",
-        scalar_bar_args={"title": "|u|"},
+        scalar_bar_args={"title": label},
     )
     if problem.V.mesh.geometry.dim == 2:
         plotter.view_xy()

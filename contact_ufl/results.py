@@ -221,6 +221,18 @@ def frictional_dissipation(problem, pair: int = 0) -> float:
     return problem.comm.allreduce(dolfinx.fem.assemble_scalar(form))
 
 
+def lowest_displacement(problem, tag: int | str, component: int = -1) -> float:
+    """Smallest ``component`` of the displacement over the nodes of the facets ``tag``
+    (or its name in ``problem.scene.tags``), all ranks: e.g. the depth of an imprint is
+    minus that of the indented surface."""
+    tag = problem.scene.tags[tag] if isinstance(tag, str) else tag
+    mesh = problem.V.mesh
+    facets = problem.scene.facet_tags.find(tag)
+    dofs = dolfinx.fem.locate_dofs_topological(problem.V, mesh.topology.dim - 1, facets)
+    values = problem.u.x.array.reshape(-1, mesh.geometry.dim)[dofs, component]
+    return problem.comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
+
+
 def section_motion(problem, tag: int) -> tuple[np.ndarray, np.ndarray]:
     """Mean displacement and deformed unit normal of the facets ``tag`` (e.g. a beam's end).
 

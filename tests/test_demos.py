@@ -46,6 +46,23 @@ def test_beams_demo_runs(tmp_path):
     assert (out / "beams_mu0" / "contact_0.bp").is_dir()
 
 
+@pytest.mark.serial
+def test_plastic_indentation_demo_runs(tmp_path):
+    out = tmp_path / "out"
+    result = subprocess.run(
+        [sys.executable, str(DEMOS / "plastic_indentation.py"), "--steps", "4", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+    )
+    assert result.returncode == 0, result.stderr
+    assert "plastic: peak pressure" in result.stdout and "imprint" in result.stdout
+    for name in ("indentation_force.png", "indentation_plastic_strain.png"):
+        assert (out / name).stat().st_size > 10_000
+    assert (out / "indentation_plastic" / "plastic_strain_2.bp").is_dir()
+
+
 @pytest.mark.parametrize("demo", sorted(DEMOS.glob("*.py")), ids=lambda p: p.name)
 def test_demo_is_a_notebook(demo):
     notebook = jupytext.read(demo)
