@@ -318,6 +318,7 @@ class FrictionlessContact:
         self._check_facing()
         self.search_time = 0.0
         self.projection: Projection | None = None
+        self._surface_forms: dict[str, list[dolfinx.fem.Form]] = {}
         #: Freeze the projected point inside a Newton iteration (drop its variation from the
         #: tangent, as many codes do): Newton then converges only linearly. For comparisons.
         self.frozen_projection = False
@@ -378,6 +379,23 @@ class FrictionlessContact:
     def traction(self) -> ufl.core.expr.Expr:
         """Contact traction on the slave surface, ``T = t_N nu`` (frictionless)."""
         return self.t_N * self.nu
+
+    def surface_integrands(self) -> dict[str, ufl.core.expr.Expr]:
+        """Named integrands over the slave surface for :meth:`integrate`: ``"normal"``, the
+        normal-pressure traction ``t_N nu``."""
+        return {"normal": self.t_N * self.nu}
+
+    def integrate(self, name: str) -> np.ndarray:
+        """``int integrand dS_o`` over the slave surface, summed over all ranks, of the
+        integrand ``name`` of :meth:`surface_integrands` (its forms compiled once)."""
+        if name not in self._surface_forms:
+            expr = self.surface_integrands()[name]
+            parts = [expr[i] for i in range(expr.ufl_shape[0])] if expr.ufl_shape else [expr]
+            self._surface_forms[name] = [
+                dolfinx.fem.form(e * self.ds, entity_maps=[self.slave.entity_map]) for e in parts
+            ]
+        local = np.array([dolfinx.fem.assemble_scalar(f) for f in self._surface_forms[name]])
+        return self.V.mesh.comm.allreduce(local, MPI.SUM)
 
     def residuals(self, v: ufl.Argument) -> tuple[ufl.Form, list[ufl.Form]]:
         """Contact part of the displacement residual, and the residuals of :attr:`fields`."""

@@ -114,6 +114,15 @@ class FrictionalContact(FrictionlessContact):
         """Contact traction on the slave surface, ``T = t_N nu - P(q)``."""
         return self.t_N * self.nu - self.t_T
 
+    def surface_integrands(self) -> dict[str, ufl.core.expr.Expr]:
+        """Those of :class:`FrictionlessContact`, and ``"friction"``, the frictional
+        traction on the slave body ``-P(q)``, and ``"dissipation"``, ``P(q) . s_T``."""
+        return {
+            **super().surface_integrands(),
+            "friction": -self.t_T,
+            "dissipation": ufl.dot(self.t_T, self.slip),
+        }
+
     def residuals(self, v: ufl.Argument) -> tuple[ufl.Form, list[ufl.Form]]:
         F_u, (F_x, F_l) = super().residuals(v)
         lambda_test = ufl.TestFunction(self.L_T)

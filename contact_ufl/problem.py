@@ -112,6 +112,7 @@ class ContactProblem:
         )
         self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=scene.facet_tags)
         self.t = 0.0
+        self._energy_form = None
         #: history of the elastoplastic bodies, by cell tag (moved on each converged step)
         self.histories = {
             b.tag: PlasticHistory(b.material, self.u, qdeg)
@@ -544,6 +545,20 @@ class ContactProblem:
                 for f in self._contact_force_forms[j]
             ]
         return total
+
+    def stored_energy(self) -> float:
+        """Elastic energy ``sum_b int psi_b(F) dV`` of all bodies (reference volume), for
+        hyperelastic bodies (an elastoplastic one raises)."""
+        if self.histories:
+            raise ValueError(
+                "stored_energy covers hyperelastic bodies only; this scene has "
+                f"elastoplastic bodies (cell tags {sorted(self.histories)})"
+            )
+        if self._energy_form is None:
+            F = ufl.Identity(self.V.mesh.geometry.dim) + ufl.grad(self.u)
+            energy = sum(b.material.strain_energy(F) * self.dx(b.tag) for b in self.scene.bodies)
+            self._energy_form = dolfinx.fem.form(energy)
+        return self.comm.allreduce(dolfinx.fem.assemble_scalar(self._energy_form))
 
     def active_points(self) -> int:
         """Number of slave quadrature points in contact (all pairs)."""

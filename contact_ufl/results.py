@@ -182,32 +182,14 @@ def contact_force_parts(problem, pair: int = 0) -> tuple[np.ndarray, np.ndarray]
         The two parts, ``(gdim,)`` each.
     """
     c = problem.contacts[pair]
-    frictional = -c.t_T if hasattr(c, "t_T") else None
-    parts = []
-    for expr in (c.t_N * c.nu, frictional):
-        if expr is None:
-            parts.append(np.zeros(c.gdim))
-            continue
-        forms = [
-            dolfinx.fem.form(expr[i] * c.ds, entity_maps=[c.slave.entity_map])
-            for i in range(c.gdim)
-        ]
-        local = np.array([dolfinx.fem.assemble_scalar(f) for f in forms])
-        parts.append(problem.comm.allreduce(local, MPI.SUM))
-    return parts[0], parts[1]
+    frictional = c.integrate("friction") if hasattr(c, "t_T") else np.zeros(c.gdim)
+    return c.integrate("normal"), frictional
 
 
 def stored_energy(problem) -> float:
     """Elastic energy ``sum_b int psi_b(F) dV`` of all bodies (reference volume); the
     hyperelastic bodies only (an elastoplastic one raises)."""
-    if problem.histories:
-        raise ValueError(
-            "stored_energy covers hyperelastic bodies only; this scene has "
-            f"elastoplastic bodies (cell tags {sorted(problem.histories)})"
-        )
-    F = ufl.Identity(problem.V.mesh.geometry.dim) + ufl.grad(problem.u)
-    energy = sum(b.material.strain_energy(F) * problem.dx(b.tag) for b in problem.scene.bodies)
-    return problem.comm.allreduce(dolfinx.fem.assemble_scalar(dolfinx.fem.form(energy)))
+    return problem.stored_energy()
 
 
 def frictional_dissipation(problem, pair: int = 0) -> float:
@@ -215,10 +197,7 @@ def frictional_dissipation(problem, pair: int = 0) -> float:
     (the frictional traction times the slip increment; >= 0 by the Coulomb law). Valid
     after the step and in its callback, before the next step moves the slip reference."""
     c = problem.contacts[pair]
-    if not hasattr(c, "t_T"):
-        return 0.0
-    form = dolfinx.fem.form(ufl.dot(c.t_T, c.slip) * c.ds, entity_maps=[c.slave.entity_map])
-    return problem.comm.allreduce(dolfinx.fem.assemble_scalar(form))
+    return float(c.integrate("dissipation")[0]) if hasattr(c, "t_T") else 0.0
 
 
 def lowest_displacement(problem, tag: int | str, component: int = -1) -> float:
