@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import dolfinx
 import numpy as np
+
+if TYPE_CHECKING:
+    import pyvista
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
@@ -67,7 +71,7 @@ def _pyvista():
 
 def gathered_grid(
     problem, deformed: bool = True, cell_data: dict[str, dolfinx.fem.Function] | None = None
-):
+) -> pyvista.UnstructuredGrid | None:
     """The mesh of all ranks as one pyvista grid on rank 0 (``None`` on the other ranks).
 
     Each rank contributes its owned cells; the point data hold the displacement, and the

@@ -72,14 +72,26 @@ class J2Plasticity:
         mu, lmbda = lame_parameters(self.E, self.nu)
         return lmbda + 2.0 * mu / 3.0
 
-    def return_map(self, F, Cp_inv_n, alpha_n):
-        """Kirchhoff stress and updated history of the radial return at ``F`` (3x3).
+    def return_map(
+        self, F: ufl.core.expr.Expr, Cp_inv_n: ufl.core.expr.Expr, alpha_n: ufl.core.expr.Expr
+    ) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr, ufl.core.expr.Expr]:
+        """Kirchhoff stress and updated history of the radial return.
+
+        Parameters
+        ----------
+        F
+            Deformation gradient (3x3) at the end of the step.
+        Cp_inv_n, alpha_n
+            History of the last converged step: ``C_p^-1`` (3x3) and the equivalent
+            plastic strain.
 
         Returns
         -------
         tau, Cp_inv, alpha
             UFL expressions: the Kirchhoff stress, ``C_p^-1`` and the equivalent plastic
-            strain at the end of the step.
+            strain at the end of the step. The spherical part of the updated ``bbar_e`` is
+            corrected so that ``det bbar_e = 1`` (Simo & Hughes 1998, 9.3.2): the plastic
+            flow keeps the volume (``det C_p = 1``), and the stress is unchanged.
         """
         I = ufl.Identity(3)
         J = ufl.det(F)
@@ -96,13 +108,26 @@ class J2Plasticity:
         scale = ufl.conditional(plastic, 1.0 - 2.0 * mubar * dgamma / norm, 1.0)
         s = scale * s_trial
         tau = 0.5 * self.kappa * (J**2 - 1.0) * I + s
-        b_e = s / mu + I_e * I
+        b_e = _unimodular(s / mu, I_e)
         F_inv = ufl.inv(F)
         Cp_inv = J ** (2.0 / 3.0) * F_inv * b_e * F_inv.T
         return tau, Cp_inv, alpha_n + np.sqrt(2.0 / 3.0) * dgamma
 
 
-def _embed(F):
+def _unimodular(d: ufl.core.expr.Expr, guess: ufl.core.expr.Expr, iterations: int = 4):
+    """``d + c I`` with the scalar ``c`` such that ``det(d + c I) = 1`` (``d`` deviatoric),
+    by Newton's method from ``c = guess`` (a closed-form UFL expression: ``iterations``
+    Newton steps, quadratic from a guess off by the plastic increment times the elastic
+    strain)."""
+    I = ufl.Identity(3)
+    c = guess
+    for _ in range(iterations):
+        b = d + c * I
+        c = c - (ufl.det(b) - 1.0) / ufl.tr(ufl.cofac(b))
+    return d + c * I
+
+
+def _embed(F: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
     """The 3x3 deformation gradient of a 2x2 (plane strain) or 3x3 one."""
     if F.ufl_shape[0] == 3:
         return F
@@ -120,10 +145,30 @@ class PlasticHistory:
         The displacement.
     quadrature_degree
         Degree of the bulk quadrature rule (the history's points are that rule's).
+    cells
+        The body's cells (local indices; the owned ones are committed). The history of
+        other cells stays at its initial value (no plastic strain).
+
+    Attributes
+    ----------
+    Cp_inv, alpha
+        The history: ``C_p^-1`` (3x3) and the equivalent plastic strain, quadrature
+        functions on the whole mesh.
+    F3, tau
+        UFL expressions: the 3x3 deformation gradient and the Kirchhoff stress of the
+        return map from the history.
     """
 
-    def __init__(self, material: J2Plasticity, u: dolfinx.fem.Function, quadrature_degree: int):
+    def __init__(
+        self,
+        material: J2Plasticity,
+        u: dolfinx.fem.Function,
+        quadrature_degree: int,
+        cells: np.ndarray,
+    ):
         mesh = u.function_space.mesh
+        owned = mesh.topology.index_map(mesh.topology.dim).size_local
+        self._cells = np.asarray(cells, dtype=np.int32)[np.asarray(cells) < owned]
         cell = mesh.basix_cell()
 
         def space(shape):
@@ -180,8 +225,7 @@ class PlasticHistory:
     def commit(self) -> None:
         """The return map at the converged displacement becomes the history (every field
         evaluated from the old history before any is overwritten)."""
-        mesh = self.u.function_space.mesh
-        cells = np.arange(mesh.topology.index_map(mesh.topology.dim).size_local, dtype=np.int32)
+        mesh, cells = self.u.function_space.mesh, self._cells
         values = [expr.eval(mesh, cells) for _, expr in self._updates]
         for (target, _), value in zip(self._updates, values, strict=True):
             bs = target.function_space.dofmap.index_map_bs

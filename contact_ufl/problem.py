@@ -8,6 +8,7 @@ onto the unknowns ``[u, lambda_1, ...]`` -> SNES.
 from __future__ import annotations
 
 import time
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -58,6 +59,16 @@ class History:
 
     steps: list[StepRecord] = field(default_factory=list)
     cutbacks: list[tuple[float, str]] = field(default_factory=list)
+
+
+def _weakly(method: Callable) -> Callable:
+    """A callback calling the bound ``method`` through a weak reference to its object."""
+    ref = weakref.WeakMethod(method)
+
+    def call(*args):
+        return ref()(*args)
+
+    return call
 
 
 def _nonempty(form: ufl.Form) -> ufl.Form | None:
@@ -115,7 +126,7 @@ class ContactProblem:
         self._energy_form = None
         #: history of the elastoplastic bodies, by cell tag (moved on each converged step)
         self.histories = {
-            b.tag: PlasticHistory(b.material, self.u, qdeg)
+            b.tag: PlasticHistory(b.material, self.u, qdeg, scene.cell_tags.find(b.tag))
             for b in scene.bodies
             if isinstance(b.material, J2Plasticity)
         }
@@ -243,8 +254,10 @@ class ContactProblem:
             **options,
         }.items():
             opts[f"{prefix}{key}"] = value
-        self.snes.setFunction(self._residual, self._R)
-        self.snes.setJacobian(self._jacobian, self._J)
+        # weak callbacks: the solver must not keep the problem (and its meshes, spaces and
+        # communicators) alive through a reference cycle that Python's collector cannot see
+        self.snes.setFunction(_weakly(self._residual), self._R)
+        self.snes.setJacobian(_weakly(self._jacobian), self._J)
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
 

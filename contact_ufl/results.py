@@ -68,7 +68,13 @@ def traction_mismatch(problem, pair: int = 0) -> float:
     """Relative L2 distance on the slave surface between the bulk traction ``Pi N`` and the
     contact traction of the multipliers ``lambda_N nu`` (property (c) of the formulation)."""
     c = problem.contacts[pair]
-    Pi = problem.first_piola(slave_body(problem, pair))
+    body = slave_body(problem, pair)
+    if body.tag in problem.histories:
+        # its stress lives at the cell quadrature points, not on the facets
+        raise NotImplementedError(
+            f"traction_mismatch needs a hyperelastic slave body; body {body.tag} is elastoplastic"
+        )
+    Pi = problem.first_piola(body)
     N = ufl.FacetNormal(problem.V.mesh)
     diff = Pi * N - c.lambda_N * c.nu
     forms = [ufl.dot(diff, diff) * c.ds, c.lambda_N**2 * c.ds]
@@ -201,9 +207,23 @@ def frictional_dissipation(problem, pair: int = 0) -> float:
 
 
 def lowest_displacement(problem, tag: int | str, component: int = -1) -> float:
-    """Smallest ``component`` of the displacement over the nodes of the facets ``tag``
-    (or its name in ``problem.scene.tags``), all ranks: e.g. the depth of an imprint is
-    minus that of the indented surface."""
+    """Smallest component of the displacement over the nodes of some facets, all ranks.
+
+    Parameters
+    ----------
+    problem
+        The contact problem.
+    tag
+        Facet tag, or its name in ``problem.scene.tags``.
+    component
+        Displacement component (default: the last, vertical in 2D).
+
+    Returns
+    -------
+    float
+        The smallest value: e.g. the depth of an imprint is minus that of the indented
+        surface.
+    """
     tag = problem.scene.tags[tag] if isinstance(tag, str) else tag
     mesh = problem.V.mesh
     facets = problem.scene.facet_tags.find(tag)

@@ -11,7 +11,7 @@
 #
 # A stiff Neo-Hookean half disc ($R = 1$, $E = 10$) is pressed $0.02$ into a block and
 # lifted off again. The block is either Neo-Hookean ($E = 1$) or made of finite-strain
-# J2 plasticity (`contact_ufl.plasticity.J2Plasticity`: the same elasticity, von Mises
+# J2 plasticity (`contact_ufl.plasticity.J2Plasticity`: the same small-strain elasticity, von Mises
 # yield stress $\sigma_y = 0.01$, no hardening). The contact is the augmented-Lagrangian
 # mixed form of `contact_ufl`, frictionless; the tangent of the plastic return map comes
 # from `ufl.derivative` like the rest.
@@ -66,14 +66,13 @@ for name, yield_stress in blocks.items():
     writer = output.ResultWriter(problem, out / f"indentation_{name}")
     curve = [(0.0, 0.0)]
 
-    def record(problem, step, curve=curve, disc=disc, writer=writer, name=name):
+    def record(problem, step, curve=curve, disc=disc, writer=writer):
         curve.append((-evaluate(disc.value, step.t)[1], problem.contact_force()[1]))
         writer(problem, step)
-        if step.t == 1.0:
-            peaks[name] = contact_samples(problem).pressure.max()
 
     start = time.perf_counter()
     problem.solve(num_steps=args.steps, t_end=1.0, callback=record)
+    peaks[name] = contact_samples(problem).pressure.max()
     problem.solve(num_steps=args.steps, t_end=2.0, callback=record)
     writer.close()
     say(f"{name}: {len(problem.history.steps)} steps, {time.perf_counter() - start:.1f} s")

@@ -1,5 +1,7 @@
 """Shared fixtures: solved verification problems, built once per session."""
 
+import gc
+
 import pytest
 from mpi4py import MPI
 
@@ -50,3 +52,12 @@ def symmetric_square(material, loads, n: int = 4, cell_type=None, dirichlet=()):
     mesh, cells, facets = tagged_unit_square(n, cell_type)
     supports = [Dirichlet(1, 0.0, component=0), Dirichlet(3, 0.0, component=1), *dirichlet]
     return Scene(mesh, cells, facets, [Body(1, material)], dirichlet=supports, loads=list(loads))
+
+
+@pytest.fixture(autouse=True)
+def _free_finished_problems():
+    """Collect the garbage of every test on all ranks at the same point: meshes, spaces
+    and solvers each hold MPI communicators, and MPICH runs out of them (a few thousand)
+    when finished problems linger in reference cycles until a later collection."""
+    yield
+    gc.collect()

@@ -1,5 +1,8 @@
 """Load stepping: cut-back of diverging steps, a clear error when cut-backs run out."""
 
+import gc
+import weakref
+
 import pytest
 
 from contact_ufl import scenes
@@ -34,3 +37,14 @@ def test_cutbacks_run_out_with_a_clear_error():
         problem.solve(num_steps=1, t_end=1.0, max_cutbacks=2)
     assert problem.history.steps[: len(accepted)] == accepted  # nothing accepted is lost
     assert problem.t == pytest.approx(accepted[-1].t)  # state restored to the last accepted
+
+
+def test_a_dropped_problem_is_freed():
+    """The solver holds its callbacks weakly: a problem nobody references is collected, with
+    its meshes, spaces and MPI communicators (MPICH has only a few thousand)."""
+    problem = ContactProblem(scenes.pushed_block(), verbose=False)
+    problem.solve(num_steps=1, t_end=0.5)
+    ref = weakref.ref(problem)
+    del problem
+    gc.collect()
+    assert ref() is None
