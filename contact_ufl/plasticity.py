@@ -12,7 +12,8 @@ radial return of the box:
 - where ``f^tr > 0``: ``dgamma = f^tr / (2 mubar (1 + H / (3 mubar)))``,
   ``s = s^tr - 2 mubar dgamma s^tr / |s^tr|``, ``alpha = alpha_n + sqrt(2/3) dgamma``;
 - Kirchhoff stress ``tau = J U'(J) I + s``; ``P = tau F^-T``;
-- history: ``bbar_e = s / mu + tr(bbar_e^tr)/3 I``, stored as
+- history: ``bbar_e = s / mu + c I`` with ``c`` (close to ``tr(bbar_e^tr) / 3``) such that
+  ``det bbar_e = 1`` (the flow keeps the volume), stored as
   ``C_p^-1 = J^(2/3) F^-1 bbar_e F^-T``.
 
 The return map is closed-form UFL (a conditional on ``f^tr``), so ``ufl.derivative`` of the
