@@ -10,18 +10,24 @@ import pytest
 DEMOS = Path(__file__).parents[1] / "demos"
 
 
+def run_demo(name: str, args: list[str], cwd: Path, timeout: int = 300) -> str:
+    """Run ``demos/<name>`` as a script; its standard output (it must succeed)."""
+    result = subprocess.run(
+        [sys.executable, str(DEMOS / name), *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=cwd,
+    )
+    assert result.returncode == 0, result.stderr
+    return result.stdout
+
+
 @pytest.mark.serial
 def test_hertz_demo_runs(tmp_path):
     out = tmp_path / "out"
-    result = subprocess.run(
-        [sys.executable, str(DEMOS / "hertz.py"), "--h", "0.01", "--out", str(out)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=tmp_path,
-    )
-    assert result.returncode == 0, result.stderr
-    assert "half-width" in result.stdout
+    stdout = run_demo("hertz.py", ["--h", "0.01", "--out", str(out)], tmp_path)
+    assert "half-width" in stdout
     for name in ("hertz_pressure.png", "hertz_deformed.png"):
         assert (out / name).stat().st_size > 10_000
     assert (out / "hertz" / "displacement.bp").is_dir()
@@ -31,16 +37,9 @@ def test_hertz_demo_runs(tmp_path):
 def test_beams_demo_runs(tmp_path):
     out = tmp_path / "out"
     args = ["--divisions", "3", "--mu", "0", "--load", "2", "--steps", "8", "--out", str(out)]
-    result = subprocess.run(
-        [sys.executable, str(DEMOS / "beams.py"), *args],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=tmp_path,
-    )
-    assert result.returncode == 0, result.stderr
+    stdout = run_demo("beams.py", args, tmp_path, timeout=600)
     for text in ("tip displacement", "contact force", "wall time"):
-        assert text in result.stdout
+        assert text in stdout
     for name in ("beams_reference.png", "beams_reference_xz.png", "beams_mu0_iso.png"):
         assert (out / name).stat().st_size > 10_000
     assert (out / "beams_mu0" / "contact_0.bp").is_dir()
@@ -49,15 +48,8 @@ def test_beams_demo_runs(tmp_path):
 @pytest.mark.serial
 def test_plastic_indentation_demo_runs(tmp_path):
     out = tmp_path / "out"
-    result = subprocess.run(
-        [sys.executable, str(DEMOS / "plastic_indentation.py"), "--steps", "4", "--out", str(out)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=tmp_path,
-    )
-    assert result.returncode == 0, result.stderr
-    assert "plastic: peak pressure" in result.stdout and "imprint" in result.stdout
+    stdout = run_demo("plastic_indentation.py", ["--steps", "4", "--out", str(out)], tmp_path)
+    assert "plastic: peak pressure" in stdout and "imprint" in stdout
     for name in ("indentation_force.png", "indentation_plastic_strain.png"):
         assert (out / name).stat().st_size > 10_000
     assert (out / "indentation_plastic" / "plastic_strain_2.bp").is_dir()
