@@ -381,9 +381,10 @@ class FrictionlessContact:
         return self.t_N * self.nu
 
     def surface_integrands(self) -> dict[str, ufl.core.expr.Expr]:
-        """Named integrands over the slave surface for :meth:`integrate`: ``"normal"``, the
-        normal-pressure traction ``t_N nu``."""
-        return {"normal": self.t_N * self.nu}
+        """Named integrands over the slave surface for :meth:`integrate`: ``"traction"``, the
+        whole contact traction (:meth:`traction`), and ``"normal"``, its normal-pressure
+        part ``t_N nu``."""
+        return {"traction": self.traction(), "normal": self.t_N * self.nu}
 
     def integrate(self, name: str) -> np.ndarray:
         """``int integrand dS_o`` over the slave surface, summed over all ranks, of the

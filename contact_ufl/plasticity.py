@@ -33,6 +33,7 @@ import dolfinx
 import numpy as np
 import ufl
 
+from contact_ufl.loads import deformation_gradient
 from contact_ufl.materials import lame_parameters
 
 
@@ -183,8 +184,7 @@ class PlasticHistory:
         self.Cp_inv = dolfinx.fem.Function(space((3, 3)), name="Cp_inv")
         self.Cp_inv.x.array.reshape(-1, 9)[:] = np.eye(3).ravel()
         self.alpha = dolfinx.fem.Function(space(()), name="equivalent_plastic_strain")
-        gdim = mesh.geometry.dim
-        self.F3 = _embed(ufl.Identity(gdim) + ufl.grad(u))
+        self.F3 = _embed(deformation_gradient(u))
         self.tau, Cp_inv, alpha = material.return_map(self.F3, self.Cp_inv, self.alpha)
         points = self.Cp_inv.function_space.element.interpolation_points
         self._updates = [

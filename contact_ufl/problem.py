@@ -23,7 +23,7 @@ from contact_ufl.contact import FrictionlessContact
 from contact_ufl.errors import ConvergenceError
 from contact_ufl.friction import FrictionalContact
 from contact_ufl.layout import StackedLayout, chain_operator
-from contact_ufl.loads import BodyForce, evaluate, load_constant
+from contact_ufl.loads import BodyForce, deformation_gradient, evaluate, load_constant
 from contact_ufl.plasticity import J2Plasticity, PlasticHistory
 from contact_ufl.scene import Scene
 from contact_ufl.surfaces import global_bounds
@@ -147,8 +147,7 @@ class ContactProblem:
         elastoplastic body, the history of the last converged step)."""
         if body.tag in self.histories:
             return self.histories[body.tag].first_piola()
-        F = ufl.Identity(self.V.mesh.geometry.dim) + ufl.grad(self.u)
-        return body.material.first_piola(F)
+        return body.material.first_piola(deformation_gradient(self.u))
 
     def _build_forms(self) -> None:
         u, v = self.u, ufl.TestFunction(self.V)
@@ -189,13 +188,6 @@ class ContactProblem:
         self.layout = StackedLayout([f.function_space for f in unknowns])
         self._r = fem_petsc.create_vector(spaces, kind="mpi")
         self._K = fem_petsc.create_matrix(self.jacobian_form, kind="mpi")
-        self._contact_force_forms = [
-            [
-                dolfinx.fem.form(c.traction()[i] * c.ds, entity_maps=[c.slave.entity_map])
-                for i in range(self.V.mesh.geometry.dim)
-            ]
-            for c in self.contacts
-        ]
 
     def _build_dirichlet(self) -> None:
         mesh, fdim = self.V.mesh, self.V.mesh.topology.dim - 1
@@ -550,14 +542,8 @@ class ContactProblem:
     def contact_force(self, k: int | None = None) -> np.ndarray:
         """Resultant contact force on the slave body, ``int (t_N nu - P(q)) dS_o`` (all pairs;
         the frictional part only with friction)."""
-        pairs = range(len(self.contacts)) if k is None else [k]
-        total = np.zeros(self.V.mesh.geometry.dim)
-        for j in pairs:
-            total += [
-                self.comm.allreduce(dolfinx.fem.assemble_scalar(f), MPI.SUM)
-                for f in self._contact_force_forms[j]
-            ]
-        return total
+        pairs = self.contacts if k is None else [self.contacts[k]]
+        return sum((c.integrate("traction") for c in pairs), np.zeros(self.V.mesh.geometry.dim))
 
     def stored_energy(self) -> float:
         """Elastic energy ``sum_b int psi_b(F) dV`` of all bodies (reference volume), for
@@ -568,7 +554,7 @@ class ContactProblem:
                 f"elastoplastic bodies (cell tags {sorted(self.histories)})"
             )
         if self._energy_form is None:
-            F = ufl.Identity(self.V.mesh.geometry.dim) + ufl.grad(self.u)
+            F = deformation_gradient(self.u)
             energy = sum(b.material.strain_energy(F) * self.dx(b.tag) for b in self.scene.bodies)
             self._energy_form = dolfinx.fem.form(energy)
         return self.comm.allreduce(dolfinx.fem.assemble_scalar(self._energy_form))
