@@ -15,7 +15,7 @@ from contact_ufl.taylor import curved_case, taylor_test
 
 def run(dim: int, frozen: bool) -> dict:
     problem, dz, steps = curved_case(dim, num_steps=5)
-    problem.contacts[0].frozen_projection = frozen
+    problem.contacts[0].kinematics.frozen_projection = frozen
     result = taylor_test(problem, dz, steps)
     return {
         "dim": dim,

@@ -38,7 +38,7 @@ class ResultWriter:
         comm = problem.comm
         self.writers = [dolfinx.io.VTXWriter(comm, folder / "displacement.bp", [problem.u])]
         for k, c in enumerate(problem.contacts):
-            multipliers = [c.lambda_N] + ([c.lambda_T] if hasattr(c, "lambda_T") else [])
+            multipliers = [c.lambda_N] + ([c.friction.lambda_T] if c.friction else [])
             self.writers.append(dolfinx.io.VTXWriter(comm, folder / f"contact_{k}.bp", multipliers))
         self.histories = list(problem.histories.values())
         for tag, h in problem.histories.items():

@@ -19,14 +19,13 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from contact_ufl.contact import FrictionlessContact
+from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.errors import ConvergenceError
-from contact_ufl.friction import FrictionalContact
 from contact_ufl.layout import StackedLayout, chain_operator
 from contact_ufl.loads import BodyForce, deformation_gradient, evaluate, load_constant
+from contact_ufl.mpi import global_bounds
 from contact_ufl.plasticity import J2Plasticity, PlasticHistory
 from contact_ufl.scene import Scene
-from contact_ufl.surfaces import global_bounds
 
 DEFAULT_PETSC_OPTIONS = {
     "snes_type": "newtonls",
@@ -69,6 +68,22 @@ def _weakly(method: Callable) -> Callable:
         return ref()(*args)
 
     return call
+
+
+def softer_modulus(scene: Scene, pair: ContactPair) -> float:
+    """The smallest Young's modulus of the bodies whose cells hold the facets of ``pair``."""
+    mesh = scene.mesh
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    facets = np.concatenate([scene.facet_tags.find(pair.slave), scene.facet_tags.find(pair.master)])
+    cells = f2c.array[f2c.offsets[facets]]
+    num_cells = mesh.topology.index_map(tdim).size_local + mesh.topology.index_map(tdim).num_ghosts
+    cell_tag = np.full(num_cells, -1, dtype=np.int64)
+    cell_tag[scene.cell_tags.indices] = scene.cell_tags.values
+    found = mesh.comm.allreduce(set(cell_tag[cells].tolist()), MPI.BOR)
+    moduli = [b.material.E for b in scene.bodies if b.tag in found]
+    return min(moduli) if moduli else float("nan")
 
 
 def _nonempty(form: ufl.Form) -> ufl.Form | None:
@@ -131,7 +146,7 @@ class ContactProblem:
             if isinstance(b.material, J2Plasticity)
         }
         self.contacts = [
-            (FrictionalContact if p.mu > 0 else FrictionlessContact)(self.u, scene.facet_tags, p)
+            ContactInterface(self.u, scene.facet_tags, p, softer_modulus(scene, p))
             for p in scene.contacts
         ]
         self._build_forms()

@@ -76,7 +76,7 @@ def traction_mismatch(problem, pair: int = 0) -> float:
         )
     Pi = problem.first_piola(body)
     N = ufl.FacetNormal(problem.V.mesh)
-    diff = Pi * N - c.lambda_N * c.nu
+    diff = Pi * N - c.lambda_N * c.kinematics.nu
     forms = [ufl.dot(diff, diff) * c.ds, c.lambda_N**2 * c.ds]
     values = [
         problem.comm.allreduce(
@@ -117,19 +117,20 @@ def weak_contact_law(problem, pair: int = 0) -> tuple[float, float]:
     second (both zero up to solver tolerance).
     """
     c = problem.contacts[pair]
-    mu = ufl.TestFunction(c.L)
-    owned = c.L.dofmap.index_map.size_local
+    slave = c.slave
+    mu = ufl.TestFunction(slave.P1)
+    owned = slave.P1.dofmap.index_map.size_local
 
     def nodal(expr):
         form = dolfinx.fem.form(expr * mu * c.ds, entity_maps=[c.slave.entity_map])
-        return c.assemble_nodal(form, c.L)[:owned]
+        return slave.assemble_nodal(form, slave.P1)[:owned]
 
     active = c.active()
-    opened, touched = c.count_at_nodes(~active), c.count_at_nodes(active)
-    mass = c.nodal_mass
+    opened, touched = slave.count_at_nodes(~active), slave.count_at_nodes(active)
+    mass = slave.nodal_mass
     closed = (opened == 0) & (touched > 0)
     open_ = (touched == 0) & (opened > 0)
-    gap = np.abs(nodal(c.gap)[closed] / mass[closed])
+    gap = np.abs(nodal(c.kinematics.gap)[closed] / mass[closed])
     lam = np.abs(nodal(c.lambda_N)[open_] / mass[open_])
     comm = problem.comm
     return (
@@ -147,8 +148,8 @@ def stick_zone_half_width(problem, pair: int = 0) -> float:
     c = problem.contacts[pair]
     x = c.slave.positions(problem.u).reshape(-1, c.gdim)[:, 0]
     active = c.active()
-    stick = c.last_stick & active
-    slip = ~c.last_stick & active
+    stick = c.friction.last_stick & active
+    slip = ~c.friction.last_stick & active
     comm = problem.comm
     xs = np.concatenate(comm.allgather(x[stick]))
     xl = np.concatenate(comm.allgather(x[slip]))
@@ -188,7 +189,7 @@ def contact_force_parts(problem, pair: int = 0) -> tuple[np.ndarray, np.ndarray]
         The two parts, ``(gdim,)`` each.
     """
     c = problem.contacts[pair]
-    frictional = c.integrate("friction") if hasattr(c, "t_T") else np.zeros(c.gdim)
+    frictional = c.integrate("friction") if c.friction else np.zeros(c.gdim)
     return c.integrate("normal"), frictional
 
 
@@ -203,7 +204,7 @@ def frictional_dissipation(problem, pair: int = 0) -> float:
     (the frictional traction times the slip increment; >= 0 by the Coulomb law). Valid
     after the step and in its callback, before the next step moves the slip reference."""
     c = problem.contacts[pair]
-    return float(c.integrate("dissipation")[0]) if hasattr(c, "t_T") else 0.0
+    return float(c.integrate("dissipation")[0]) if c.friction else 0.0
 
 
 def lowest_displacement(problem, tag: int | str, component: int = -1) -> float:
@@ -304,19 +305,20 @@ def coulomb_law(problem, pair: int = 0) -> CoulombCheck:
     """
     c = problem.contacts[pair]
     comm = problem.comm
-    if not hasattr(c, "lambda_T"):
+    if c.friction is None:
         raise ValueError(f"contact pair {pair} is frictionless")
+    friction = c.friction
     active = c.active()
     lam_N = c.multiplier_at_points()
-    lam_T = c.tangential_multiplier_at_points()
-    radius = float(c.mu.value) * lam_N
+    lam_T = friction.tangential_multiplier_at_points()
+    radius = float(friction.mu.value) * lam_N
     excess = np.linalg.norm(lam_T, axis=1) - radius
     scale = comm.allreduce(radius[active].max(initial=0.0), MPI.MAX)
     scale = scale if scale > 0.0 else 1.0  # no contact pressure: report absolute values
-    slip = c.last_slip
+    slip = friction.last_slip
     slip_norm = np.linalg.norm(slip, axis=1)
     slip_scale = comm.allreduce(slip_norm[active].max(initial=0.0), MPI.MAX)
-    slipping = active & ~c.last_stick & (slip_norm > 1e-6 * slip_scale)
+    slipping = active & ~friction.last_stick & (slip_norm > 1e-6 * slip_scale)
     lam_norm = np.linalg.norm(lam_T, axis=1)
     cos = np.einsum("pd,pd->p", slip, lam_T)[slipping] / (
         slip_norm[slipping] * np.where(lam_norm[slipping] > 0, lam_norm[slipping], np.inf)

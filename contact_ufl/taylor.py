@@ -34,9 +34,7 @@ class TaylorResult:
 
 def _signature(problem) -> tuple[list, list]:
     facets = [c.projection.facet.copy() for c in problem.contacts]
-    status = [
-        c.active().astype(int) + (c.stick() if hasattr(c, "stick") else 0) for c in problem.contacts
-    ]
+    status = [c.active().astype(int) + (c.stick() if c.friction else 0) for c in problem.contacts]
     return facets, status
 
 
@@ -113,8 +111,8 @@ def contact_state(
     )
     for c in problem.contacts:
         c.lambda_N.interpolate(lambda x: multiplier * (1.0 + 0.2 * np.sin(5.0 * x[0])))
-        if hasattr(c, "lambda_T"):
-            c.lambda_T.interpolate(
+        if c.friction:
+            c.friction.lambda_T.interpolate(
                 lambda x: tangential * np.vstack([np.sin(3.0 * x[0] + k) for k in range(gdim)])
             )
     dolfinx.fem.petsc.assign(problem.unknowns, problem.x)
@@ -140,7 +138,7 @@ def sliding_direction(
     )
     fields.append(du)
     for c in problem.contacts:
-        dl = dolfinx.fem.Function(c.L)
+        dl = dolfinx.fem.Function(c.normal.L)
         dl.interpolate(lambda x: multiplier * np.cos(4.0 * x[0] + 0.3))
         fields.append(dl)
     dz = problem.x.duplicate()

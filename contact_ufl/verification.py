@@ -56,7 +56,7 @@ def shear_error(problem, exact: CattaneoMindlin2D, pair: int = 0) -> float:
     c = problem.contacts[pair]
     comm = problem.comm
     samples = contact_samples(problem, pair)
-    shear = np.linalg.norm(c.tangential_multiplier_at_points(), axis=1)
+    shear = np.linalg.norm(c.friction.tangential_multiplier_at_points(), axis=1)
     shear = np.concatenate(comm.allgather(shear / c.slave.area_ratio(problem.u).ravel()))
     pressed = samples.x[samples.lambda_N > 0, 0]
     centre = 0.5 * (pressed.min() + pressed.max())

@@ -7,7 +7,7 @@ import pytest
 from mpi4py import MPI
 
 from contact_ufl import scenes
-from contact_ufl.friction import FrictionalContact
+from contact_ufl.contact.coulomb import CoulombLaw
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scenes import curved_pair
 from contact_ufl.taylor import curved_case, taylor_test
@@ -33,7 +33,8 @@ def test_friction_unknowns_only_with_mu():
     assert len(frictionless.unknowns) == 2  # u, lambda_N
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=0.3)
     frictional = ContactProblem(scene, verbose=False)
-    assert isinstance(frictional.contacts[0], FrictionalContact)
+    assert isinstance(frictional.contacts[0].friction, CoulombLaw)
+    assert frictionless.contacts[0].friction is None
     assert len(frictional.unknowns) == 3  # u, lambda_N, lambda_T
     assert frictional.layout.global_size > frictionless.layout.global_size
 
@@ -42,8 +43,8 @@ def test_no_nan_where_q_vanishes():
     """lambda_T = 0 and no slip: q = 0 at every point, the residual and tangent are finite."""
     problem, _, _ = curved_case(2, mu=0.3)
     c = problem.contacts[0]
-    c.lambda_T.x.array[:] = 0.0
-    c.mask_n.x.array[:] = 0.0  # no slip history
+    c.friction.lambda_T.x.array[:] = 0.0
+    c.friction.mask_n.x.array[:] = 0.0  # no slip history
     problem.forget_state()
     import dolfinx.fem.petsc
 
@@ -64,17 +65,27 @@ def test_block_sticks_then_slides():
 
     def record(problem, step):
         active = c.active()
-        power = np.einsum("pd,pd->p", c.tangential_traction_at_points(), c.last_slip)[active]
+        power = np.einsum(
+            "pd,pd->p",
+            c.friction.traction_at_points(c.normal_traction_at_points()),
+            c.friction.last_slip,
+        )[active]
         friction = problem.comm.allreduce(
-            float(np.sum(np.einsum("pd,pd->p", c.last_slip[active], c.last_slip[active])))
+            float(
+                np.sum(
+                    np.einsum(
+                        "pd,pd->p", c.friction.last_slip[active], c.friction.last_slip[active]
+                    )
+                )
+            )
         )
         log.append(
             dict(
                 t=step.t,
                 ratio=abs(step.contact_force[0]) / step.contact_force[1],
                 active=problem.comm.allreduce(int(active.sum())),
-                stick=problem.comm.allreduce(int((c.last_stick & active).sum())),
-                weak_slip=c.last_weak_slip,
+                stick=problem.comm.allreduce(int((c.friction.last_stick & active).sum())),
+                weak_slip=c.friction.last_weak_slip,
                 slip2=friction,
                 # the frictional traction on the slave body against its slip
                 power=problem.comm.allreduce(float(np.max(power, initial=-np.inf)), op=MPI.MAX),

@@ -47,7 +47,7 @@ def test_hertz_contact_law(hertz_moderate):
     P = problem.contact_force()[1]
     exact = Hertz2D(P, hertz.radius, hertz.E_star)
     a, p0, xc = fit_elliptic_profile(s.x[:, 0], s.pressure)
-    eps_N = float(problem.contacts[0].eps_N.value)
+    eps_N = float(problem.contacts[0].normal.eps_N.value)
     weak_gap, weak_lambda = weak_contact_law(problem)
     assert weak_gap < 1e-8 * p0 / eps_N
     assert weak_lambda < 1e-8 * p0

@@ -1,4 +1,4 @@
-"""Tests of the closest-point projection (`contact_ufl.projection`)."""
+"""Tests of the closest-point projection (`contact_ufl.contact.projection`)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from contact_ufl.projection import closest_points, shape_functions
+from contact_ufl.contact.projection import closest_points, shape_functions
 
 # -- random master surfaces ------------------------------------------------------------------
 

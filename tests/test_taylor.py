@@ -26,7 +26,7 @@ def test_taylor_second_order(dim):
 def test_taylor_detects_a_frozen_projection():
     """Dropping the variation of the projected point leaves a first-order remainder."""
     problem, dz, steps = curved_case(2)
-    problem.contacts[0].frozen_projection = True
+    problem.contacts[0].kinematics.frozen_projection = True
     result = taylor_test(problem, dz, steps)
     assert np.all(np.abs(result.slopes - 1.0) < 0.1), result.slopes
 
@@ -37,7 +37,7 @@ def test_taylor_smoothed_master_normal(mu):
     chained through their gathered dofs, is still exact (second order)."""
     problem, dz, steps = curved_case(2, mu=mu, master_normal="smoothed")
     c = problem.contacts[0]
-    assert c.nx == 4 and problem.active_points() > 10
+    assert c.kinematics.nx == 4 and problem.active_points() > 10
     facet = curved_case(2, mu=mu)[0].contacts[0]
     change = np.abs(facet.projection.normal - c.projection.normal).max(initial=0.0)
     assert problem.comm.allreduce(change, op=MPI.MAX) > 1e-6  # another normal indeed

@@ -1,6 +1,6 @@
 """Coulomb friction: the tangential multiplier, the slip increment and the disc projection.
 
-Adds to the frictionless terms of :mod:`contact_ufl.contact` (``formulation.md``):
+With the normal law of :mod:`.normal` (``formulation.md``):
 
     traction   T = <lambda_N + eps_N g> nu - P(q),   q = lambda_T + eps_T s_T
     - int_{S_oc} T . (U1* - U2*(Y)) dS_o
@@ -36,14 +36,9 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from contact_ufl.contact import (
-    ContactPair,
-    FrictionlessContact,
-    _interpolate,
-    master_shape_functions,
-)
-from contact_ufl.errors import collective_check
-from contact_ufl.projection import shape_functions
+from contact_ufl.contact.kinematics import MeshKinematics
+from contact_ufl.contact.projection import shape_functions
+from contact_ufl.contact.slave import SlaveSurface
 
 
 def disc_projection(q, radius):
@@ -58,24 +53,35 @@ def disc_projection(q, radius):
     return ufl.conditional(stick, q, radius / safe_norm * q)
 
 
-class FrictionalContact(FrictionlessContact):
-    """Contact terms with Coulomb friction of one contact pair (``pair.mu > 0``)."""
+class CoulombLaw:
+    """Coulomb friction of a contact pair: ``lambda_T``, the slip and its history.
 
-    def __init__(
-        self, u: dolfinx.fem.Function, facet_tags: dolfinx.mesh.MeshTags, pair: ContactPair
-    ):
-        super().__init__(u, facet_tags, pair)
-        mesh = u.function_space.mesh
-        collective_check(mesh.comm, pair.mu > 0.0, "FrictionalContact needs mu > 0")
-        sub = self.slave.submesh
-        self.L_T = dolfinx.fem.functionspace(sub, ("Lagrange", 1, (self.gdim,)))
+    Parameters
+    ----------
+    kinematics
+        The pair's contact kinematics (normal, projected point, gathered master nodes).
+    t_N
+        The normal contact traction (UFL, from the normal law).
+    mu
+        Friction coefficient (> 0).
+    eps_T
+        Tangential augmentation parameter (> 0).
+    """
+
+    def __init__(self, kinematics: MeshKinematics, t_N, mu: float, eps_T: float):
+        self.kinematics = k = kinematics
+        self.slave: SlaveSurface = k.slave
+        self.gdim = k.gdim
+        mesh = k.u.function_space.mesh
+        self.L_T = dolfinx.fem.functionspace(self.slave.submesh, ("Lagrange", 1, (self.gdim,)))
         self.lambda_T = dolfinx.fem.Function(self.L_T, name="lambda_T")
-        self.mu = dolfinx.fem.Constant(mesh, float(pair.mu))
-        self.eps_T = dolfinx.fem.Constant(mesh, float(pair.eps_T or pair.eps_N))
-        self.xhat_n = dolfinx.fem.Function(self.Qx, name="master_nodes_last_step")
-        self.xi_n = dolfinx.fem.Function(self.xi0.function_space)
-        self.mask_n = dolfinx.fem.Function(self.mask.function_space)
-        self._zero = dolfinx.fem.Function(self.mask.function_space)
+        self.mu = dolfinx.fem.Constant(mesh, float(mu))
+        self.eps_T = dolfinx.fem.Constant(mesh, float(eps_T))
+        self.xhat_n = dolfinx.fem.Function(k.Qx, name="master_nodes_last_step")
+        self.xi_n = dolfinx.fem.Function(k.xi0.function_space)
+        self.mask_n = dolfinx.fem.Function(k.mask.function_space)
+        self._zero = dolfinx.fem.Function(k.mask.function_space)
+        self._gather = None  # the gather of the current projection, set by the interface
         self._gather_n = None
         self._x_commit = None
         self._xhat_n_commit = None
@@ -86,65 +92,63 @@ class FrictionalContact(FrictionlessContact):
         self.last_slip = np.zeros((0, self.gdim))
         self.last_stick = np.zeros(0, dtype=bool)
         self.last_weak_slip = 0.0
-        self._friction_kinematics()
-
-    def _friction_kinematics(self) -> None:
-        gdim, nn = self.gdim, self.nn
-        nodes = ufl.as_matrix([[self.xhat_n[a * gdim + i] for i in range(gdim)] for a in range(nn)])
-        N_n, _ = master_shape_functions(nn, self.xi_n)
-        self.y_n = _interpolate(N_n, nodes, gdim)
-        nu = self.nu
+        self._t_N = t_N
+        y_n = k.master_point(self.xi_n, k.nodes(self.xhat_n))
+        nu = k.nu
 
         def tangential(w):
             return w - ufl.dot(w, nu) * nu
 
-        self.slip = self.mask_n * tangential(self.x - self.y_n)
+        self.y_n = y_n
+        self.slip = self.mask_n * tangential(k.x - y_n)
         self.q = tangential(self.lambda_T) + self.eps_T * self.slip
-        self.t_T = disc_projection(self.q, self.mu * self.t_N)
+        self.t_T = disc_projection(self.q, self.mu * t_N)
 
     @property
     def fields(self) -> list[dolfinx.fem.Function]:
-        return [self.xhat, self.lambda_N, self.lambda_T, self.xhat_n]
+        """Fields of the assembled system the law adds: ``lambda_T`` and the last step's
+        master nodes (gathered from the displacement)."""
+        return [self.lambda_T, self.xhat_n]
 
     @property
     def unknowns(self) -> list[dolfinx.fem.Function]:
-        return [self.lambda_N, self.lambda_T]
+        """Unknowns the law adds: ``lambda_T``."""
+        return [self.lambda_T]
 
     def traction(self) -> ufl.core.expr.Expr:
-        """Contact traction on the slave surface, ``T = t_N nu - P(q)``."""
-        return self.t_N * self.nu - self.t_T
+        """The frictional traction on the slave surface, ``-P(q)``."""
+        return -self.t_T
 
-    def surface_integrands(self) -> dict[str, ufl.core.expr.Expr]:
-        """Those of :class:`FrictionlessContact`, and ``"friction"``, the frictional
-        traction on the slave body ``-P(q)``, and ``"dissipation"``, ``P(q) . s_T``."""
-        return {
-            **super().surface_integrands(),
-            "friction": -self.t_T,
-            "dissipation": ufl.dot(self.t_T, self.slip),
-        }
-
-    def residuals(self, v: ufl.Argument) -> tuple[ufl.Form, list[ufl.Form]]:
-        F_u, (F_x, F_l) = super().residuals(v)
-        lambda_test = ufl.TestFunction(self.L_T)
-        # times eps_T, like the normal multiplier equation (see FrictionlessContact)
-        F_t = -ufl.dot(self.lambda_T - self.t_T, lambda_test) * self.ds
+    def residuals(self) -> list[ufl.Form]:
+        """The ``lambda_T`` equation (times eps_T, like the normal one) and the zero residual
+        of ``xhat_n``."""
+        ds = self.slave.ds
+        F_t = -ufl.dot(self.lambda_T - self.t_T, ufl.TestFunction(self.L_T)) * ds
         # xhat_n has no equation of its own: a zero residual, present so that derivatives
         # with respect to it are assembled and chained onto the displacement by T
-        F_n = self._zero * ufl.dot(self.xhat_n, ufl.TestFunction(self.Qx)) * self.ds
-        return F_u, [F_x, F_l, F_t, F_n]
+        F_n = self._zero * ufl.dot(self.xhat_n, ufl.TestFunction(self.kinematics.Qx)) * ds
+        return [F_t, F_n]
 
-    def update(self, layout):
-        gathers = super().update(layout)
+    def surface_integrands(self) -> dict[str, ufl.core.expr.Expr]:
+        """``"friction"``, the frictional traction on the slave body ``-P(q)``, and
+        ``"dissipation"``, ``P(q) . s_T``."""
+        return {"friction": -self.t_T, "dissipation": ufl.dot(self.t_T, self.slip)}
+
+    def gathers(self, gather: np.ndarray) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """The gathered fields of the law, given the gather of the current projection."""
+        self._gather = gather
         if self._gather_n is None:
-            self._gather_n = np.full_like(self._gather, -1)
-        return [*gathers, (self.xhat_n, self._gather_n)]
+            self._gather_n = np.full_like(gather, -1)
+        return [(self.xhat_n, self._gather_n)]
 
+    # -- the step protocol ------------------------------------------------------------
     def update_history(self, T, x, block_slice) -> None:
         """Current positions of the last step's master facet nodes: ``xhat_n,commit +
         P_n (u - u_commit)``, evaluated through T (the nodes may live on any rank)."""
+        xhat = self.kinematics.xhat
         owned = len(self._gather_n)
         if self._x_commit is None:
-            self.xhat_n.x.array[:owned] = self.xhat.x.array[:owned]
+            self.xhat_n.x.array[:owned] = xhat.x.array[:owned]
         else:
             if self._work is None:
                 self._work = (x.duplicate(), T.createVecLeft())
@@ -156,24 +160,25 @@ class FrictionalContact(FrictionlessContact):
             self.xhat_n.x.array[:owned] = self._xhat_n_commit + moved
         self.xhat_n.x.scatter_forward()
 
-    def commit(self, x) -> None:
+    def commit(self, x, normal_traction: np.ndarray) -> None:
         """Remember the converged projection: the reference of the next step's slip.
 
         The slip reference itself moves only in :meth:`begin_step`, so that until the next
         step starts everything inspected (slip, stick, tractions, contact force) is that of
-        the converged step.
+        the converged step. ``normal_traction``: ``t_N`` at the owned points.
         """
+        k = self.kinematics
         owned = len(self._gather)
         self.last_slip = self.slip_at_points()
-        self.last_stick = self.stick()
+        self.last_stick = self.stick(normal_traction)
         self.last_weak_slip = self.weak_slip(self.last_stick)
         self._committed = (
             self._gather.copy(),
-            self.xhat.x.array[:owned].copy(),
+            k.xhat.x.array[:owned].copy(),
             x.copy(),
-            self.xi0.x.array.copy(),
-            self.mask.x.array.copy(),
-            self.xhat.x.array.copy(),
+            k.xi0.x.array.copy(),
+            k.mask.x.array.copy(),
+            k.xhat.x.array.copy(),
         )
 
     def begin_step(self) -> None:
@@ -193,17 +198,17 @@ class FrictionalContact(FrictionlessContact):
     # -- inspection -------------------------------------------------------------------
     def slip_at_points(self) -> np.ndarray:
         """Slip increment s_T since the last converged step at the owned slave points."""
-        gdim = self.gdim
-        x = self.slave.positions(self.u).reshape(-1, gdim)
-        nodes = self._values(self.xhat_n).reshape(len(x), self.nx, gdim)[:, : self.nn]
-        N_n = shape_functions(self.nn, gdim, self._values(self.xi_n))[0]
-        s = (x - np.einsum("pa,pad->pd", N_n, nodes)) * self._values(self.mask_n)
+        k, slave, gdim = self.kinematics, self.slave, self.gdim
+        x = slave.positions(k.u).reshape(-1, gdim)
+        nodes = slave.at_points(self.xhat_n).reshape(len(x), k.nx, gdim)[:, : k.nn]
+        N_n = shape_functions(k.nn, gdim, slave.at_points(self.xi_n))[0]
+        s = (x - np.einsum("pa,pad->pd", N_n, nodes)) * slave.at_points(self.mask_n)
         return self._tangential(s)
 
     @functools.cached_property
     def _slip_form(self) -> dolfinx.fem.Form:
         return dolfinx.fem.form(
-            ufl.dot(self.slip, ufl.TestFunction(self.L_T)) * self.ds,
+            ufl.dot(self.slip, ufl.TestFunction(self.L_T)) * self.slave.ds,
             entity_maps=[self.slave.entity_map],
         )
 
@@ -213,49 +218,38 @@ class FrictionalContact(FrictionlessContact):
         :meth:`stick`): zero to solver tolerance, the stick condition as the multiplier
         equation imposes it. Nodes touching an open or slipping point are left out (0 when
         there is no such node)."""
-        owned = self.L.dofmap.index_map.size_local
-        nodal = self.assemble_nodal(self._slip_form, self.L_T)[: owned * self.gdim]
-        stuck = (self.count_at_nodes(~stick) == 0) & (self.nodal_mass > 0)
+        slave = self.slave
+        owned = slave.P1.dofmap.index_map.size_local
+        nodal = slave.assemble_nodal(self._slip_form, self.L_T)[: owned * self.gdim]
+        stuck = (slave.count_at_nodes(~stick) == 0) & (slave.nodal_mass > 0)
         values = np.linalg.norm(nodal.reshape(-1, self.gdim)[stuck], axis=1)
-        local = (values / self.nodal_mass[stuck]).max(initial=0.0)
-        return self.u.function_space.mesh.comm.allreduce(local, op=MPI.MAX)
+        local = (values / slave.nodal_mass[stuck]).max(initial=0.0)
+        return slave.V.mesh.comm.allreduce(local, op=MPI.MAX)
 
     def tangential_multiplier_at_points(self) -> np.ndarray:
         """Tangential part of lambda_T at the owned slave points."""
-        return self._tangential(self._vector_at_points(self.lambda_T))
+        return self._tangential(self.slave.p1_at_points(self.lambda_T))
 
-    def _trial_and_radius(self) -> tuple[np.ndarray, np.ndarray]:
+    def _trial_and_radius(self, normal_traction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The trial traction ``q = lambda_T + eps_T s_T`` and the disc radius ``mu t_N``."""
         q = self.tangential_multiplier_at_points() + float(self.eps_T.value) * self.slip_at_points()
-        return q, float(self.mu.value) * self.normal_traction_at_points()
+        return q, float(self.mu.value) * normal_traction
 
-    def stick(self) -> np.ndarray:
-        """Mask of the owned slave points in stick (``|q| <= mu t_N``), of those in contact."""
-        q, radius = self._trial_and_radius()
+    def stick(self, normal_traction: np.ndarray) -> np.ndarray:
+        """Mask of the owned slave points in stick (``|q| <= mu t_N``), of those in contact;
+        ``normal_traction``: ``t_N`` at the owned points."""
+        q, radius = self._trial_and_radius(normal_traction)
         return (np.einsum("pd,pd->p", q, q) <= radius**2) & (radius > 0)
 
-    def tangential_traction_at_points(self) -> np.ndarray:
+    def traction_at_points(self, normal_traction: np.ndarray) -> np.ndarray:
         """The frictional traction on the slave body at the owned slave points, ``-P(q)``
         (``q`` projected onto the Coulomb disc of radius ``mu t_N``; the term of
         :meth:`traction`), ``(n, gdim)``: it opposes the slip."""
-        q, radius = self._trial_and_radius()
+        q, radius = self._trial_and_radius(normal_traction)
         norm = np.linalg.norm(q, axis=1)
         scale = np.where(norm <= radius, 1.0, radius / np.where(norm > 0.0, norm, 1.0))
         return np.where(radius[:, None] > 0.0, -scale[:, None] * q, 0.0)
 
-    def traction_at_points(self) -> np.ndarray:
-        """Contact traction (normal and frictional) on the slave body at the owned points."""
-        return super().traction_at_points() + self.tangential_traction_at_points()
-
     def _tangential(self, w: np.ndarray) -> np.ndarray:
-        nu = self.projection.normal
+        nu = self.kinematics.projection.normal
         return w - np.einsum("pd,pd->p", w, nu)[:, None] * nu
-
-    def _values(self, f: dolfinx.fem.Function) -> np.ndarray:
-        bs = f.function_space.dofmap.index_map_bs
-        return f.x.array.reshape(-1, bs)[self._owned_blocks(f.function_space)]
-
-    def _vector_at_points(self, f: dolfinx.fem.Function) -> np.ndarray:
-        dofs = f.function_space.dofmap.list[: self.slave.num_cells]
-        values = f.x.array.reshape(-1, self.gdim)[dofs]  # (nc, ndofs, gdim)
-        return np.einsum("qn,cnd->cqd", self._phi_lambda, values).reshape(-1, self.gdim)

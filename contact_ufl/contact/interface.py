@@ -1,0 +1,258 @@
+"""One contact pair's terms of the weak form, composed of its parts.
+
+A :class:`ContactInterface` is what the problem assembles for one :class:`.ContactPair`:
+
+* the slave side (:class:`.SlaveSurface`): the slave facets, their quadrature points and the
+  data carried at them;
+* the master side (:class:`.MeshMaster`): a meshed master surface;
+* the search (:class:`.ClosestPointSearch`): the Python closest-point mapping;
+* the kinematics (:class:`.MeshKinematics`): the projected point, the normal, the gap and
+  the master virtual displacement in UFL;
+* the normal law (:class:`.NormalLaw`) and, where ``mu > 0``, the Coulomb law
+  (:class:`.CoulombLaw`).
+
+Its terms (``formulation.md``, times -1 so that the bulk term reads ``+ int Pi : Grad U*``):
+
+    - int_{S_oc} T . (U1* - U2*(Y)) dS_o,     T = t_N nu - P(q)
+    - int_{S_oc} (lambda_N - t_N) lambda_N* dS_o  [ - int (lambda_T - P(q)) . lambda_T* dS_o ]
+
+assembled over the fields ``[xhat, lambda_N (, lambda_T, xhat_n)]`` after the displacement;
+the problem maps them to the unknowns through the chain operator (:mod:`contact_ufl.layout`).
+"""
+
+from __future__ import annotations
+
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from contact_ufl.contact.coulomb import CoulombLaw
+from contact_ufl.contact.kinematics import MeshKinematics
+from contact_ufl.contact.master import MeshMaster
+from contact_ufl.contact.normal import NormalLaw
+from contact_ufl.contact.pair import ContactPair
+from contact_ufl.contact.projection import Projection
+from contact_ufl.contact.search import ClosestPointSearch
+from contact_ufl.contact.slave import SlaveSurface
+from contact_ufl.errors import collective_check
+from contact_ufl.layout import StackedLayout
+from contact_ufl.mpi import global_diameter
+
+
+class ContactInterface:
+    """The contact terms of one pair, and what its converged state says.
+
+    Parameters
+    ----------
+    u
+        The displacement (one function over the mesh of all bodies).
+    facet_tags
+        Facet tags of the mesh.
+    pair
+        The contact pair (integer tags).
+    modulus
+        Young's modulus of the softer of the two bodies: the scale of the default ``eps_N``
+        (needed only when ``pair.eps_N`` is ``None``).
+    """
+
+    def __init__(
+        self,
+        u: dolfinx.fem.Function,
+        facet_tags: dolfinx.mesh.MeshTags,
+        pair: ContactPair,
+        modulus: float | None = None,
+    ):
+        V = u.function_space
+        mesh = V.mesh
+        comm = mesh.comm
+        pair.validate(comm)
+        self.u, self.V, self.pair = u, V, pair
+        self.gdim = gdim = mesh.geometry.dim
+        degree = V.ufl_element().embedded_superdegree
+        # the master surface is interpolated from its vertices: exact for P1/Q1 only
+        geometry_degree = mesh.geometry.cmaps[0].degree
+        collective_check(
+            comm,
+            degree == 1 and geometry_degree == 1,
+            f"contact needs degree-1 displacement and geometry (got {degree} and "
+            f"{geometry_degree}): higher-order master surfaces are not implemented",
+        )
+        smoothed = pair.master_normal == "smoothed"
+        collective_check(
+            comm,
+            not smoothed or gdim == 2,
+            "master_normal='smoothed' is implemented for 2D (segment) master surfaces only",
+        )
+        qdeg = pair.quadrature_degree or 2 * degree + 1
+        self.slave = SlaveSurface(
+            V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions, pair.quadrature_rule
+        )
+        self.master = MeshMaster(V, facet_tags, pair.master, smoothed)
+        size = global_diameter(
+            comm,
+            np.vstack([self.slave.X.reshape(-1, gdim), self.master.X_nodes.reshape(-1, gdim)]),
+        )
+        #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see ``macaulay``)
+        self.touching = 1e-12 * size
+        radius = pair.search_radius or 0.25 * size
+        self.search = ClosestPointSearch(self.slave, self.master, radius, self.touching)
+        self.search.check_facing(
+            f"slave surface (tag {pair.slave}) of the pair with master surface (tag {pair.master})"
+        )
+        self.kinematics = MeshKinematics(u, self.slave, self.master)
+        eps_N = pair.eps_N if pair.eps_N is not None else default_eps(self.slave, modulus)
+        self.normal = NormalLaw(self.slave, eps_N, self.touching)
+        self.t_N = self.normal.traction(self.kinematics.gap, self.kinematics.mask)
+        #: the Coulomb law, or ``None`` for a frictionless pair
+        self.friction = (
+            CoulombLaw(self.kinematics, self.t_N, pair.mu, pair.eps_T or eps_N)
+            if pair.frictional
+            else None
+        )
+        self._surface_forms: dict[str, list[dolfinx.fem.Form]] = {}
+        self._gather = None
+
+    # -- what the problem assembles ----------------------------------------------------
+    @property
+    def fields(self) -> list[dolfinx.fem.Function]:
+        """Fields of the assembled system this pair adds (after the displacement)."""
+        own = [self.kinematics.xhat, self.normal.lambda_N]
+        return own + (self.friction.fields if self.friction else [])
+
+    @property
+    def unknowns(self) -> list[dolfinx.fem.Function]:
+        """Unknowns this pair adds (after the displacement)."""
+        own = [self.normal.lambda_N]
+        return own + (self.friction.unknowns if self.friction else [])
+
+    def traction(self) -> ufl.core.expr.Expr:
+        """Contact traction on the slave surface, ``T = t_N nu - P(q)`` (``-P(q)`` only with
+        friction)."""
+        T = self.t_N * self.kinematics.nu
+        return T + self.friction.traction() if self.friction else T
+
+    def residuals(self, v: ufl.Argument) -> tuple[ufl.Form, list[ufl.Form]]:
+        """Contact part of the displacement residual, and the residuals of :attr:`fields`."""
+        ds = self.slave.ds
+        vhat = ufl.TestFunction(self.kinematics.Qx)
+        traction = self.traction()
+        F_u = -ufl.dot(traction, v) * ds
+        F_x = ufl.dot(traction, self.kinematics.test_at_projection(vhat)) * ds
+        own = [F_x, self.normal.residual(self.t_N)]
+        return F_u, own + (self.friction.residuals() if self.friction else [])
+
+    def update(self, layout: StackedLayout) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """Search, and refresh the point data of the kinematics.
+
+        Parameters
+        ----------
+        layout
+            Layout of the unknowns; block 0 is the displacement.
+
+        Returns
+        -------
+        The gathered fields: pairs of a field and, for every owned dof of it (unrolled, local
+        order), the stacked index of the displacement unknown it gathers, or -1.
+        """
+        pairing = self.search.pair(self.u, layout)
+        self.kinematics.set_pairing(pairing)
+        npts = len(pairing.points)
+        self._gather = self.slave.unrolled(
+            self.kinematics.Qx, pairing.columns.reshape(npts, -1), fill=-1
+        )
+        gathers = [(self.kinematics.xhat, self._gather)]
+        return gathers + (self.friction.gathers(self._gather) if self.friction else [])
+
+    # -- the step protocol --------------------------------------------------------------
+    def update_history(self, T, x, block_slice) -> None:
+        """Refresh the data that needs the chain operator (the slip reference)."""
+        if self.friction:
+            self.friction.update_history(T, x, block_slice)
+
+    def begin_step(self) -> None:
+        """Start a load step from the last committed state."""
+        if self.friction:
+            self.friction.begin_step()
+
+    def commit(self, x) -> None:
+        """Accept the current state as the converged state of a load step."""
+        if self.friction:
+            self.friction.commit(x, self.normal.traction_at_points(self.projection))
+
+    # -- results ------------------------------------------------------------------------
+    @property
+    def projection(self) -> Projection:
+        """The closest points of the last search."""
+        return self.kinematics.projection
+
+    @property
+    def search_time(self) -> float:
+        """Seconds spent in the closest-point search so far."""
+        return self.search.time
+
+    @property
+    def lambda_N(self) -> dolfinx.fem.Function:
+        """The normal multiplier."""
+        return self.normal.lambda_N
+
+    @property
+    def ds(self) -> ufl.Measure:
+        """The contact measure over the slave facets."""
+        return self.slave.ds
+
+    def surface_integrands(self) -> dict[str, ufl.core.expr.Expr]:
+        """Named integrands over the slave surface for :meth:`integrate`: ``"traction"``, the
+        whole contact traction (:meth:`traction`), ``"normal"``, its normal-pressure part
+        ``t_N nu``, and with friction ``"friction"`` and ``"dissipation"``
+        (:meth:`.CoulombLaw.surface_integrands`)."""
+        own = {"traction": self.traction(), "normal": self.t_N * self.kinematics.nu}
+        return own | (self.friction.surface_integrands() if self.friction else {})
+
+    def integrate(self, name: str) -> np.ndarray:
+        """``int integrand dS_o`` over the slave surface, summed over all ranks, of the
+        integrand ``name`` of :meth:`surface_integrands` (its forms compiled once)."""
+        if name not in self._surface_forms:
+            expr = self.surface_integrands()[name]
+            parts = [expr[i] for i in range(expr.ufl_shape[0])] if expr.ufl_shape else [expr]
+            self._surface_forms[name] = [
+                dolfinx.fem.form(e * self.ds, entity_maps=[self.slave.entity_map]) for e in parts
+            ]
+        local = np.array([dolfinx.fem.assemble_scalar(f) for f in self._surface_forms[name]])
+        return self.V.mesh.comm.allreduce(local, MPI.SUM)
+
+    def multiplier_at_points(self) -> np.ndarray:
+        """lambda_N at the owned slave quadrature points, ``(ncells * nq,)``."""
+        return self.normal.multiplier_at_points()
+
+    def active(self) -> np.ndarray:
+        """Mask of the owned slave quadrature points in contact (``lambda_N + eps_N g > 0``,
+        or within round-off of it)."""
+        return self.normal.in_contact(self.projection)
+
+    def normal_traction_at_points(self) -> np.ndarray:
+        """``t_N = <lambda_N + eps_N g>`` at the owned slave points (0 where unpaired)."""
+        return self.normal.traction_at_points(self.projection)
+
+    def traction_at_points(self) -> np.ndarray:
+        """Contact traction on the slave body at the owned slave points, ``(n, gdim)``: the
+        integrand of :meth:`traction` (nominal, per unit reference area)."""
+        t_N = self.normal_traction_at_points()
+        T = t_N[:, None] * self.projection.normal
+        return T + self.friction.traction_at_points(t_N) if self.friction else T
+
+    def stick(self) -> np.ndarray:
+        """Mask of the owned points in stick (with friction; see :meth:`.CoulombLaw.stick`)."""
+        return self.friction.stick(self.normal_traction_at_points())
+
+
+def default_eps(slave: SlaveSurface, modulus: float | None) -> float:
+    """The default ``eps_N = E / L``: ``E`` the Young's modulus of the softer body of the
+    pair, ``L`` the diameter of the slave surface (a length of the scene, not of the mesh)."""
+    comm = slave.V.mesh.comm
+    collective_check(
+        comm,
+        modulus is not None and modulus > 0.0,
+        "the default eps_N needs the Young's modulus of the bodies of the pair",
+    )
+    return modulus / global_diameter(comm, slave.X.reshape(-1, slave.V.mesh.geometry.dim))

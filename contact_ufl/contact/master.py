@@ -1,0 +1,244 @@
+"""The master side of a contact pair: a meshed master surface.
+
+The master surface S_oc^(2) is a set of oriented facets whose nodes are displacement dofs;
+its current geometry is interpolated from those nodes, so the closest-point projection and
+the master virtual displacement U2*(Y) use one and the same surface. What the search needs
+of it (:meth:`MeshMaster.candidates`) is the current nodes of every facet, the stacked
+indices of the unknowns they gather, and per-facet data (keys for the tie-break, boundary
+edges, and for the smoothed normal the neighbouring nodes).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import basix
+import dolfinx
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+from contact_ufl.contact.facets import (
+    FACET_EDGES,
+    basix_cell,
+    exterior_facet_cells,
+    facet_normals,
+    tagged_facets,
+)
+from contact_ufl.layout import StackedLayout
+
+
+class MeshMaster:
+    """A meshed master surface: oriented facets whose nodes are displacement dofs.
+
+    Facet nodes are the vertices of the facets (linear segments, triangles, bilinear
+    quadrilaterals), ordered so that the normal of ``contact_ufl.projection`` points out of
+    the master body.
+
+    Attributes
+    ----------
+    nodes
+        Local block index (displacement dof block) of each facet node, ``(nf, nn)``.
+    X_nodes
+        Reference positions of the nodes, ``(nf, nn, gdim)``.
+    global_nodes
+        Global block index of each node in the displacement index map, ``(nf, nn)``.
+    keys
+        Sorted input (mesh file) indices of the vertices of each facet, ``(nf, nn)``: the
+        same on any number of ranks and in any rigidly moved copy of the scene.
+    boundary_edges
+        For each facet, which of its :data:`FACET_EDGES` lie on the boundary of the master
+        surface (2D: which of its two nodes are end points of the surface), ``(nf, ne)``.
+    """
+
+    def __init__(self, V: dolfinx.fem.FunctionSpace, facet_tags, tag: int, smoothed: bool):
+        self.V, self.facet_tags, self.tag, self.smoothed = V, facet_tags, tag, smoothed
+        self._build()
+        #: nodes of a facet (the largest over the ranks: a rank may have no facet)
+        self.nn = int(V.mesh.comm.allreduce(self.nodes.shape[1], MPI.MAX))
+        #: nodes carried to a slave point: the facet's, and (smoothed) its two neighbours
+        self.nx = self.nn + (2 if smoothed else 0)
+        if smoothed:
+            self._neighbours, self._has_neighbour = segment_neighbours(
+                V.mesh.comm, self.global_nodes
+            )
+
+    def candidates(self, u: dolfinx.fem.Function, layout: StackedLayout) -> MasterCandidates:
+        """This rank's facets at the displacement ``u`` (collective with ``smoothed``)."""
+        comm = self.V.mesh.comm
+        bs = self.V.dofmap.index_map_bs
+        current = self.current_nodes(u)
+        global_nodes = self.global_nodes.astype(np.int64)
+        flags = np.zeros((len(current), 0), dtype=np.int64)
+        if self.smoothed:  # carry the neighbour nodes of every segment along
+            before_after = gathered_node_positions(comm, global_nodes, current, self._neighbours)
+            current = np.concatenate([current, before_after], axis=1)
+            global_nodes = np.hstack([global_nodes, self._neighbours])
+            flags = self._has_neighbour.astype(np.int64)
+        columns = layout.from_block_global(0, global_nodes * bs)
+        return MasterCandidates(
+            current, columns, self.keys.astype(np.int64), self.boundary_edges, flags
+        )
+
+    def _build(self) -> None:
+        mesh = self.V.mesh
+        tdim, fdim = mesh.topology.dim, mesh.topology.dim - 1
+        facets = tagged_facets(self.facet_tags, self.tag, "master")
+        num_owned = mesh.topology.index_map(fdim).size_local
+        facets = facets[facets < num_owned]
+        cells, local = exterior_facet_cells(mesh, facets, "master")
+        layout = self.V.dofmap.dof_layout
+        reference_facets = basix.topology(basix_cell(mesh, tdim))[fdim]
+        nv = len(reference_facets[0])
+        # the vertex dofs of each reference facet (vertices come first in the closure)
+        closure = np.array(
+            [layout.entity_closure_dofs(fdim, f)[:nv] for f in range(len(reference_facets))]
+        )
+        cell_dofs = self.V.dofmap.list[cells]
+        nodes = np.take_along_axis(cell_dofs, closure[local], axis=1)
+        coords = self.V.tabulate_dof_coordinates()[:, : mesh.geometry.dim]
+        X = coords[nodes]
+        # orient: the normal must point away from the cell
+        cell_centre = coords[cell_dofs].mean(axis=1)
+        flip = np.einsum("fd,fd->f", facet_normals(X), X.mean(axis=1) - cell_centre) < 0.0
+        swap = (0, 1) if nv == 2 else (1, 2)
+        nodes[flip, swap[0]], nodes[flip, swap[1]] = nodes[flip, swap[1]], nodes[flip, swap[0]]
+        self.nodes = nodes
+        self.X_nodes = coords[nodes]
+        imap = self.V.dofmap.index_map
+        self.global_nodes = imap.local_to_global(nodes.ravel().astype(np.int32)).reshape(
+            nodes.shape
+        )
+        # a key of each facet independent of the partition and of rigid motions: the sorted
+        # input (file) indices of its vertices, to break ties between equidistant facets
+        geometry_nodes = np.take_along_axis(
+            mesh.geometry.dofmaps[0][cells], np.array(reference_facets)[local], axis=1
+        )
+        node_keys = mesh.geometry.input_global_indices[geometry_nodes]
+        self.keys = np.sort(node_keys, axis=1)
+        self.boundary_edges = _boundary_edges(self.V.mesh.comm, node_keys, nodes, flip, swap)
+
+    @property
+    def num_facets(self) -> int:
+        """Owned master facets on this rank."""
+        return len(self.nodes)
+
+    def current_nodes(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Current node positions ``(nf, nn, gdim)``."""
+        bs = self.V.dofmap.index_map_bs
+        return self.X_nodes + u.x.array.reshape(-1, bs)[self.nodes]
+
+
+def _boundary_edges(comm: MPI.Comm, node_keys: np.ndarray, nodes: np.ndarray, flip, swap):
+    """Which facet edges (end points in 2D) belong to one master facet only, over all ranks.
+
+    ``node_keys`` are the input indices of the facet nodes before the orientation swap
+    ``swap`` applied to the facets ``flip``; they are swapped the same way here.
+    """
+    keys = node_keys.copy()
+    keys[flip, swap[0]], keys[flip, swap[1]] = node_keys[flip, swap[1]], node_keys[flip, swap[0]]
+    nn = nodes.shape[1]
+    edges = FACET_EDGES[nn]
+    width = len(edges[0])
+    local = np.stack([np.sort(keys[:, list(e)], axis=1) for e in edges], axis=1)  # (nf, ne, w)
+    everything = np.concatenate(comm.allgather(local.reshape(-1, width)))
+    unique, counts = np.unique(everything, axis=0, return_counts=True)
+    once = unique[counts == 1]
+    flat = local.reshape(-1, width)
+    if len(once) == 0 or len(flat) == 0:
+        return np.zeros(local.shape[:2], dtype=bool)
+    return _rows_in(flat, once).reshape(local.shape[:2])
+
+
+def _rows_in(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Which rows of the integer array ``a`` are rows of ``b`` (vectorised)."""
+    row = np.dtype([("", a.dtype)] * a.shape[1])
+    a_rows = np.ascontiguousarray(a).view(row).ravel()
+    b_rows = np.ascontiguousarray(b.astype(a.dtype)).view(row).ravel()
+    return np.isin(a_rows, b_rows)
+
+
+def segment_neighbours(
+    comm: MPI.Comm, global_nodes: np.ndarray
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.bool_]]:
+    """The nodes before and after each oriented master segment (2D), over all ranks.
+
+    Oriented segments ``(a, b)`` of one surface follow each other: the segment before ends at
+    ``a``, the one after starts at ``b``. Returns, for each segment, the global node index of
+    the node before ``a`` and of the node after ``b``, ``(nf, 2)``, and whether they exist
+    (at an end of the surface the node itself stands in, flagged ``False``).
+    """
+    everything = np.concatenate(comm.allgather(global_nodes.astype(np.int64))).reshape(-1, 2)
+    first, second = everything[:, 0], everything[:, 1]
+    by_second, by_first = np.argsort(second), np.argsort(first)
+    a, b = global_nodes[:, 0].astype(np.int64), global_nodes[:, 1].astype(np.int64)
+
+    def lookup(keys, sorted_order, values, query):
+        pos = np.searchsorted(keys[sorted_order], query)
+        pos = np.minimum(pos, max(len(keys) - 1, 0))
+        found = len(keys) > 0
+        hit = keys[sorted_order][pos] == query if found else np.zeros(len(query), bool)
+        return np.where(hit, values[sorted_order][pos], query), hit
+
+    before, has_before = lookup(second, by_second, first, a)
+    after, has_after = lookup(first, by_first, second, b)
+    return np.stack([before, after], axis=1), np.stack([has_before, has_after], axis=1)
+
+
+def gathered_node_positions(
+    comm: MPI.Comm, global_nodes: np.ndarray, positions: np.ndarray, wanted: np.ndarray
+) -> np.ndarray:
+    """Positions of the nodes ``wanted`` (global indices, any shape) from the nodes
+    ``global_nodes`` with ``positions`` (``(..., gdim)``) of all ranks."""
+    gdim = positions.shape[-1]
+    keys = np.concatenate(comm.allgather(global_nodes.reshape(-1).astype(np.int64)))
+    values = np.concatenate(comm.allgather(positions.reshape(-1, gdim)))
+    keys, first = np.unique(keys, return_index=True)
+    pos = np.searchsorted(keys, wanted.reshape(-1))
+    return values[first][pos].reshape(*wanted.shape, gdim)
+
+
+@dataclass
+class MasterCandidates:
+    """The master facets of one rank, as the search exchanges them.
+
+    Attributes
+    ----------
+    nodes
+        Current positions of the gathered nodes of each facet, ``(nf, nx, gdim)``: the facet's
+        own ``nn`` nodes first, then (smoothed normal) the nodes before and after it.
+    columns
+        Stacked index of the first displacement unknown of each gathered node, ``(nf, nx)``.
+    keys
+        Rank-independent keys of the facets (tie-break), ``(nf, nn)``.
+    boundary
+        Which facet edges lie on the boundary of the master surface, ``(nf, ne)``.
+    flags
+        (smoothed normal) whether the neighbour before / after exists, ``(nf, 2)``, else
+        ``(nf, 0)``.
+    """
+
+    nodes: np.ndarray
+    columns: np.ndarray
+    keys: np.ndarray
+    boundary: np.ndarray
+    flags: np.ndarray
+
+
+def smoothed_normals(xi: np.ndarray, nodes: np.ndarray, flags: np.ndarray) -> np.ndarray:
+    """NumPy twin of :func:`contact_ufl.contact.kinematics.smoothed_normal` for paired
+    points: ``xi (n, 1)``, ``nodes (n, 4, 2)``, ``flags (n, 2)``; returns unit normals
+    ``(n, 2)``."""
+    a, b, before, after = (nodes[:, k] for k in range(4))
+    segment = b - a
+    incoming = np.where(flags[:, :1], a - before, segment)
+    outgoing = np.where(flags[:, 1:], after - b, segment)
+
+    def unit_perp(t):
+        perp = np.stack([t[:, 1], -t[:, 0]], axis=1)
+        return perp / np.linalg.norm(perp, axis=1, keepdims=True)
+
+    n = (1.0 - xi) * (unit_perp(incoming) + unit_perp(segment)) + xi * (
+        unit_perp(segment) + unit_perp(outgoing)
+    )
+    return n / np.linalg.norm(n, axis=1, keepdims=True)

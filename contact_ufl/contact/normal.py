@@ -1,0 +1,82 @@
+"""The normal contact law: the Macaulay bracket and the equation of the normal multiplier.
+
+    t_N = <lambda_N + eps_N g>
+    - int_{S_oc} (lambda_N - t_N) lambda_N* dS_o        (the seed's equation times eps_N)
+
+Discrete multiplier: ``lambda_N`` is continuous piecewise linear on the slave submesh (P1).
+It interpolates a continuous contact pressure with the same resolution as the slave trace
+of a P1 displacement, so the active set and the gap condition are imposed in the weak
+(mortar) sense at the contact quadrature points, and the multiplier *is* the nodal pressure
+(property (c) of ``formulation.md``). The slave side should be the finer mesh, as usual
+with standard mortar multipliers.
+"""
+
+from __future__ import annotations
+
+import dolfinx
+import numpy as np
+import ufl
+
+from contact_ufl.contact.projection import Projection
+from contact_ufl.contact.slave import SlaveSurface
+
+
+def macaulay(a: ufl.core.expr.Expr, touching: float | ufl.core.expr.Expr = 0.0):
+    """Macaulay bracket ``<a> = max(a, 0)``.
+
+    With ``touching > 0``, the values ``-touching < a <= 0`` count as positive (value ``a``,
+    derivative 1): a point within round-off of touching is in contact. Scenes that start
+    exactly at ``g = 0`` with ``lambda = 0`` sit on the kink of the bracket, where round-off
+    alone would pick a random active set (and a singular tangent) for the first iterate; the
+    value changes by at most ``touching``.
+    """
+    return ufl.conditional(ufl.gt(a, -touching), a, 0.0)
+
+
+class NormalLaw:
+    """Unilateral contact in the normal direction, augmented by ``eps_N``.
+
+    Parameters
+    ----------
+    slave
+        The slave surface (it carries ``lambda_N``).
+    eps_N
+        Normal augmentation parameter.
+    touching
+        A length of round-off: a gap within it of zero counts as touching (:func:`macaulay`).
+    """
+
+    def __init__(self, slave: SlaveSurface, eps_N: float, touching: float):
+        self.slave = slave
+        self.L = slave.P1
+        self.lambda_N = dolfinx.fem.Function(self.L, name="lambda_N")
+        self.eps_N = dolfinx.fem.Constant(slave.V.mesh, float(eps_N))
+        self.touching = touching
+
+    def traction(self, gap: ufl.core.expr.Expr, mask: ufl.core.expr.Expr):
+        """The normal contact traction ``t_N = <lambda_N + eps_N g>`` (0 where ``mask`` is 0)."""
+        return mask * macaulay(self.lambda_N + self.eps_N * gap, self.eps_N * self.touching)
+
+    def residual(self, t_N: ufl.core.expr.Expr) -> ufl.Form:
+        """The multiplier equation, times ``eps_N``: its rows are forces like those of the
+        displacement (one tolerance for all, and conditioning)."""
+        test = ufl.TestFunction(self.L)
+        return -(self.lambda_N - t_N) * test * self.slave.ds
+
+    # -- at the slave points (NumPy) ----------------------------------------------------
+    def multiplier_at_points(self) -> np.ndarray:
+        """lambda_N at the owned slave quadrature points, ``(ncells * nq,)``."""
+        return self.slave.p1_at_points(self.lambda_N)
+
+    def _bracket_argument(self, proj: Projection) -> np.ndarray:
+        eps = float(self.eps_N.value)
+        gap = np.where(proj.facet >= 0, proj.gap, -np.inf)
+        return self.multiplier_at_points() + eps * gap
+
+    def traction_at_points(self, proj: Projection) -> np.ndarray:
+        """``t_N = <lambda_N + eps_N g>`` at the owned slave points (0 where unpaired)."""
+        return np.maximum(self._bracket_argument(proj), 0.0)
+
+    def in_contact(self, proj: Projection) -> np.ndarray:
+        """Mask of the owned points where the bracket counts as positive (:func:`macaulay`)."""
+        return self._bracket_argument(proj) > -float(self.eps_N.value) * self.touching

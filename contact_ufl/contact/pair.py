@@ -1,0 +1,102 @@
+"""What the user writes for a contact pair: the two surfaces, the laws and the rules."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mpi4py import MPI
+
+from contact_ufl.contact.quadrature import QUADRATURE_RULES
+from contact_ufl.errors import check_positive, collective_check
+
+
+@dataclass(frozen=True)
+class ContactPair:
+    """A contact pair of a scene.
+
+    Parameters
+    ----------
+    slave
+        Facet tag (or physical-group name) of the slave (contactor) surface; it carries the
+        multipliers. Make it the finer of the two surfaces.
+    master
+        Facet tag (or physical-group name) of the master (target) surface.
+    eps_N
+        Normal augmentation parameter (> 0). It does not change the exact solution. Default
+        (``None``): ``E / L``, with ``E`` the smaller Young's modulus of the two bodies and
+        ``L`` the diameter of the slave surface: a length of the scene, not of the mesh, so
+        that it does not grow under refinement.
+    mu
+        Coulomb friction coefficient (>= 0). Friction terms and the tangential multiplier
+        exist only where ``mu > 0``.
+    eps_T
+        Tangential augmentation parameter (> 0), defaults to ``eps_N``.
+    search_radius
+        Distance beyond which a slave point is known not to be in contact in a Newton
+        iteration; only master facets within it are searched. Defaults to a quarter of the
+        diagonal of the bounding box of the two surfaces.
+    quadrature_degree
+        Degree of the Gauss rule of the contact integrals (defaults to ``2 p + 1`` for
+        displacement degree ``p``).
+    quadrature_subdivisions
+        Repeat that rule on a uniform split of every slave facet (composite rule): the master
+        facet edges put kinks into the integrand that one Gauss rule resolves poorly.
+    quadrature_rule
+        ``"gauss"`` (default) or ``"lobatto"`` (Gauss-Lobatto-Legendre, intervals and
+        quadrilaterals): the Lobatto points include the vertices of the slave facets, so a
+        slave edge or corner that meets the master surface (the tip of a beam) is itself a
+        contact point and cannot sink into the master between Gauss points.
+    master_normal
+        ``"facet"`` (default): the normal of the master facet. ``"smoothed"`` (2D): the
+        normal interpolated along the segment from averaged nodal normals, continuous from
+        one segment to the next; a slave point sliding over a master vertex then meets no
+        jump of the contact force's direction (large sliding, ironing). The nodal normals
+        depend on the neighbouring nodes, which are gathered with the segment's own.
+    """
+
+    slave: int | str
+    master: int | str
+    eps_N: float | None = None
+    mu: float = 0.0
+    eps_T: float | None = None
+    search_radius: float | None = None
+    quadrature_degree: int | None = None
+    quadrature_subdivisions: int = 1
+    quadrature_rule: str = "gauss"
+    master_normal: str = "facet"
+
+    @property
+    def frictional(self) -> bool:
+        """Whether the pair has Coulomb friction (``mu > 0``)."""
+        return self.mu > 0.0
+
+    def validate(self, comm: MPI.Comm) -> None:
+        """Raise a clear error (on every rank) for invalid parameters."""
+        if self.eps_N is not None:
+            check_positive(comm, eps_N=self.eps_N)
+        collective_check(comm, self.mu >= 0.0, f"mu must be >= 0, got mu = {self.mu}")
+        if self.eps_T is not None:
+            check_positive(comm, eps_T=self.eps_T)
+        if self.search_radius is not None:
+            check_positive(comm, search_radius=self.search_radius)
+        collective_check(
+            comm,
+            int(self.quadrature_subdivisions) >= 1,
+            f"quadrature_subdivisions must be >= 1, got {self.quadrature_subdivisions}",
+        )
+        collective_check(
+            comm,
+            self.quadrature_rule in QUADRATURE_RULES,
+            f"quadrature_rule must be one of {sorted(QUADRATURE_RULES)}, "
+            f"got {self.quadrature_rule!r}",
+        )
+        collective_check(
+            comm,
+            self.master_normal in ("facet", "smoothed"),
+            f"master_normal must be 'facet' or 'smoothed', got {self.master_normal!r}",
+        )
+        collective_check(
+            comm,
+            self.slave != self.master,
+            f"slave and master tags must differ (both {self.slave})",
+        )

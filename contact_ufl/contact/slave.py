@@ -1,0 +1,264 @@
+"""The slave side of a contact pair: the slave surface, its quadrature points and the data
+carried at them.
+
+The slave surface S_oc^(1) is a submesh of the tagged facets. It carries the multipliers (P1
+on the submesh) and the per-quadrature-point data of the contact terms (quadrature elements
+on the submesh).
+
+Two facts of DOLFINx 0.11 fix the layout used here (see ``shared/dolfinx-0.11-notes.md``):
+
+* a quadrature element on the submesh stores values at the quadrature points of each
+  *submesh cell in its own reference orientation*, and a parent ``ds`` integral reads them
+  in that order; so the slave points are computed from the submesh cells, and mapped into
+  the parent cells through a vertex matching;
+* a facet of the parent mesh is on the boundary of exactly one cell, owned by the rank that
+  owns that cell.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+
+import basix
+import basix.ufl
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from contact_ufl.contact.facets import (
+    basix_cell,
+    coordinate_element,
+    exterior_facet_cells,
+    outward_normals,
+    scalar_element,
+    tagged_facets,
+)
+from contact_ufl.contact.quadrature import composite_quadrature
+
+
+@dataclass
+class SlaveSurface:
+    """The slave contact surface and its quadrature points.
+
+    Parameters
+    ----------
+    V
+        Displacement space of the (parent) mesh.
+    facet_tags
+        Facet tags of the mesh.
+    tag
+        Tag of the slave facets.
+    quadrature_degree
+        Degree of the quadrature rule of the contact integrals.
+    subdivisions
+        Repeat that rule on a uniform split of each facet into this many parts per edge.
+    rule
+        ``"gauss"`` or ``"lobatto"`` (:data:`QUADRATURE_RULES`).
+
+    Attributes
+    ----------
+    submesh, entity_map
+        The facet submesh and its map to the parent mesh.
+    points_ref
+        Reference coordinates of the quadrature points in the submesh cell, ``(nq, fdim)``.
+    parent_cells
+        Parent cell of each owned submesh cell.
+    X
+        Reference (undeformed) positions of the quadrature points, ``(ncells, nq, gdim)``.
+    """
+
+    V: dolfinx.fem.FunctionSpace
+    facet_tags: dolfinx.mesh.MeshTags
+    tag: int
+    quadrature_degree: int
+    subdivisions: int = 1
+    rule: str = "gauss"
+    submesh: dolfinx.mesh.Mesh = field(init=False)
+    entity_map: dolfinx.mesh.EntityMap = field(init=False)
+
+    def __post_init__(self) -> None:
+        mesh = self.V.mesh
+        tdim, fdim = mesh.topology.dim, mesh.topology.dim - 1
+        facets = tagged_facets(self.facet_tags, self.tag, "slave")
+        cells, local = exterior_facet_cells(mesh, facets, "slave")
+        self.submesh, self.entity_map = dolfinx.mesh.create_submesh(mesh, fdim, facets)[:2]
+        num_owned = self.submesh.topology.index_map(fdim).size_local
+        sub_cells = np.arange(num_owned, dtype=np.int32)
+        parent = self.entity_map.sub_topology_to_topology(sub_cells, inverse=False)
+        order = np.argsort(facets)
+        pos = order[np.searchsorted(facets, parent, sorter=order)]
+        self.parent_cells = cells[pos]
+        parent_local = local[pos]
+
+        sub_cell = basix_cell(self.submesh, fdim)
+        self.points_ref, self.weights_ref = composite_quadrature(
+            sub_cell, self.quadrature_degree, self.subdivisions, self.rule
+        )
+        self.num_points = len(self.weights_ref)
+        ref = self._parent_reference_points(sub_cell, parent_local, tdim)
+        self._ref = ref
+        nc, nq = len(self.parent_cells), self.num_points
+        flat = ref.reshape(-1, tdim)
+        cmap = coordinate_element(mesh)
+        phi_geom = cmap.tabulate(0, flat)[0, :, :, 0]
+        phi_geom = phi_geom.reshape(nc, nq, phi_geom.shape[-1])
+        xg = mesh.geometry.x[mesh.geometry.dofmaps[0][self.parent_cells], : mesh.geometry.dim]
+        self.X = np.einsum("cqn,cnd->cqd", phi_geom, xg)
+        nv = len(basix.topology(sub_cell)[0])
+        vertices = self.submesh.geometry.x[
+            self.submesh.geometry.dofmaps[0][:nc, :nv], : mesh.geometry.dim
+        ]
+        self.normals = outward_normals(vertices, xg.mean(axis=1))
+        tab_u = scalar_element(self.V).tabulate(1, flat)[..., 0]  # (1 + tdim, npts, ndofs)
+        self._phi_u = tab_u[0].reshape(nc, nq, tab_u.shape[-1])
+        # reference gradients of the displacement basis: Grad phi = J^-T grad_xi phi
+        dgeom = cmap.tabulate(1, flat)[1:, :, :, 0]
+        dgeom = dgeom.reshape(tdim, nc, nq, dgeom.shape[-1])
+        jac = np.einsum("kcqn,cnd->cqdk", dgeom, xg)  # dX/dxi, (nc, nq, gdim, tdim)
+        dphi = tab_u[1:].reshape(tdim, nc, nq, tab_u.shape[-1])
+        self._grad_phi_u = np.einsum("cqkd,kcqn->cqnd", np.linalg.inv(jac), dphi)
+        self._cell_dofs = self.V.dofmap.list[self.parent_cells]
+        #: the contact measure: the parent ``ds`` over the slave facets, with the rule's degree
+        self.ds = ufl.Measure(
+            "ds",
+            domain=mesh,
+            subdomain_data=self.facet_tags,
+            subdomain_id=self.tag,
+            metadata={"quadrature_degree": self.quadrature_degree},
+        )
+        #: the space of the multiplier nodes: continuous P1 on the slave submesh
+        self.P1 = dolfinx.fem.functionspace(self.submesh, ("Lagrange", 1))
+        p1 = self.P1.ufl_element().basix_element
+        self._phi_p1 = p1.tabulate(0, self.points_ref)[0, :, :, 0]  # (nq, nv)
+
+    def _parent_reference_points(self, sub_cell, parent_local, tdim) -> np.ndarray:
+        """Map the submesh quadrature points into the parent reference cells.
+
+        The submesh cell's vertices are a permutation of its parent facet's vertices; matching
+        them by position gives an affine map between the two reference facets.
+        """
+        mesh = self.V.mesh
+        gdim, fdim = mesh.geometry.dim, tdim - 1
+        parent_cell = basix_cell(mesh, tdim)
+        ref_vertices = basix.geometry(parent_cell)
+        facet_vertices = np.array(basix.topology(parent_cell)[fdim])  # (nfacets, nv)
+        nv = facet_vertices.shape[1]
+        # vertex positions of the parent facets (geometry nodes = first nodes are vertices)
+        cell_nodes = mesh.geometry.dofmaps[0][self.parent_cells]
+        local_vertices = facet_vertices[parent_local]  # (nc, nv)
+        xpar = mesh.geometry.x[np.take_along_axis(cell_nodes, local_vertices, axis=1), :gdim]
+        sub_nodes = self.submesh.geometry.dofmaps[0][: len(self.parent_cells), :nv]
+        xsub = self.submesh.geometry.x[sub_nodes, :gdim]
+        dist = np.linalg.norm(xsub[:, :, None, :] - xpar[:, None, :, :], axis=-1)
+        perm = np.argmin(dist, axis=2)  # sub vertex i == parent facet vertex perm[i]
+        vert_ref = ref_vertices[np.take_along_axis(local_vertices, perm, axis=1)]  # (nc, nv, tdim)
+        p1 = basix.create_element(basix.ElementFamily.P, sub_cell, 1)
+        phi = p1.tabulate(0, self.points_ref)[0, :, :, 0]  # (nq, nv)
+        return np.einsum("qv,cvd->cqd", phi, vert_ref)
+
+    @property
+    def num_cells(self) -> int:
+        """Owned submesh cells (slave facets) on this rank."""
+        return len(self.parent_cells)
+
+    def displacement(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Displacement at the quadrature points, ``(ncells, nq, gdim)``."""
+        bs = self.V.dofmap.index_map_bs
+        values = u.x.array.reshape(-1, bs)[self._cell_dofs]  # (nc, ndofs, gdim)
+        return np.einsum("cqn,cnd->cqd", self._phi_u, values)
+
+    def deformation_gradient(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Deformation gradient at the quadrature points, ``(ncells, nq, gdim, gdim)``."""
+        bs = self.V.dofmap.index_map_bs
+        values = u.x.array.reshape(-1, bs)[self._cell_dofs]
+        grad_u = np.einsum("cnd,cqnk->cqdk", values, self._grad_phi_u)
+        return grad_u + np.eye(bs)
+
+    def area_ratio(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Current over reference area ``da/dA = J |F^-T N|`` at the points, ``(ncells, nq)``."""
+        F = self.deformation_gradient(u)
+        N = np.broadcast_to(self.normals[:, None, :], F.shape[:-1])
+        FinvT_N = np.linalg.solve(np.swapaxes(F, -1, -2), N[..., None])[..., 0]
+        return np.linalg.det(F) * np.linalg.norm(FinvT_N, axis=-1)
+
+    def positions(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Current positions x = X + u of the quadrature points, ``(ncells, nq, gdim)``."""
+        return self.X + self.displacement(u)
+
+    def bounding_box(self, x: np.ndarray, comm: MPI.Comm) -> np.ndarray:
+        """Bounding box ``(2, gdim)`` of the points of this rank (inverted if none)."""
+        gdim = self.V.mesh.geometry.dim
+        if x.size == 0:
+            return np.vstack([np.full(gdim, np.inf), np.full(gdim, -np.inf)])
+        pts = x.reshape(-1, gdim)
+        return np.vstack([pts.min(axis=0), pts.max(axis=0)])
+
+    # -- data at the slave points: quadrature elements on the submesh -------------------
+    def point_space(self, shape: tuple[int, ...]) -> dolfinx.fem.FunctionSpace:
+        """A space of values of ``shape`` at the slave quadrature points (quadrature element)."""
+        element = basix.ufl.quadrature_element(
+            self.submesh.basix_cell(),
+            value_shape=shape,
+            points=self.points_ref,
+            weights=self.weights_ref,
+        )
+        return dolfinx.fem.functionspace(self.submesh, element)
+
+    def _owned_blocks(self, Q: dolfinx.fem.FunctionSpace) -> np.ndarray:
+        return Q.dofmap.list[: self.num_cells].ravel()
+
+    def set_at_points(self, f: dolfinx.fem.Function, values: np.ndarray) -> None:
+        """Set the point function ``f`` to ``values`` ``(npoints, ...)`` at the owned points,
+        and update its ghosts."""
+        bs = f.function_space.dofmap.index_map_bs
+        f.x.array.reshape(-1, bs)[self._owned_blocks(f.function_space)] = values.reshape(-1, bs)
+        f.x.scatter_forward()
+
+    def at_points(self, f: dolfinx.fem.Function) -> np.ndarray:
+        """Values of the point function ``f`` at the owned points, ``(npoints, bs)``."""
+        bs = f.function_space.dofmap.index_map_bs
+        return f.x.array.reshape(-1, bs)[self._owned_blocks(f.function_space)]
+
+    def unrolled(self, Q: dolfinx.fem.FunctionSpace, values: np.ndarray, fill) -> np.ndarray:
+        """``values`` ``(npoints, bs)`` of the owned points as an array over the owned dofs of
+        the point space ``Q`` (unrolled, local order), ``fill`` at dofs of no owned point."""
+        bs = Q.dofmap.index_map_bs
+        out = np.full((Q.dofmap.index_map.size_local, bs), fill, dtype=values.dtype)
+        out[self._owned_blocks(Q)] = values
+        return out.ravel()
+
+    # -- the multiplier nodes (P1 on the submesh) ----------------------------------------
+    def p1_at_points(self, f: dolfinx.fem.Function) -> np.ndarray:
+        """A P1 function (scalar or vector) of the submesh at the owned points, ``(npoints,)``
+        or ``(npoints, bs)``."""
+        bs = f.function_space.dofmap.index_map_bs
+        dofs = f.function_space.dofmap.list[: self.num_cells]
+        values = f.x.array.reshape(-1, bs)[dofs]  # (nc, nv, bs)
+        at_points = np.einsum("qn,cnd->cqd", self._phi_p1, values).reshape(-1, bs)
+        return at_points[:, 0] if f.ufl_shape == () else at_points
+
+    def assemble_nodal(self, form: dolfinx.fem.Form, space: dolfinx.fem.FunctionSpace):
+        """Assemble the linear ``form`` over a P1 ``space`` of the submesh; the owned and ghost
+        values, accumulated."""
+        f = dolfinx.fem.Function(space)
+        dolfinx.fem.assemble_vector(f.x.array, form)
+        f.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        return f.x.array
+
+    @functools.cached_property
+    def nodal_mass(self) -> np.ndarray:
+        """``int phi_i dS_o`` of the owned multiplier nodes (the reference surface)."""
+        form = dolfinx.fem.form(ufl.TestFunction(self.P1) * self.ds, entity_maps=[self.entity_map])
+        return self.assemble_nodal(form, self.P1)[: self.P1.dofmap.index_map.size_local].copy()
+
+    def count_at_nodes(self, mask: np.ndarray) -> np.ndarray:
+        """For each owned multiplier node, how many of the (owned) points ``mask`` selects
+        lie in the cells around it, over all ranks."""
+        counts = dolfinx.fem.Function(self.P1)
+        per_cell = mask.reshape(self.num_cells, self.num_points).sum(axis=1)
+        dofs = self.P1.dofmap.list[: self.num_cells]
+        np.add.at(counts.x.array, dofs, per_cell[:, None].astype(float))
+        counts.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        return counts.x.array[: self.P1.dofmap.index_map.size_local]
