@@ -7,7 +7,7 @@ PYTHON  ?= $(shell for p in python3.12 $$HOME/.pyenv/versions/3.12*/bin/python3.
              $$p -c 'import sys; assert sys.version_info[:2] == (3, 12)' 2>/dev/null && { echo $$p; break; }; done)
 PYTEST_TIMEOUT ?= 1500
 
-.PHONY: install test test-serial test-mpi demo lint benchmarks clean
+.PHONY: install test test-serial test-mpi demo notebook lint benchmarks clean
 
 install: $(VENV)/.installed
 
@@ -31,6 +31,11 @@ test-mpi: install
 
 demo: install
 	cd demos && ../$(PY) hertz.py && ../$(PY) plastic_indentation.py && ../$(MPIRUN) -n 2 ../$(PY) beams.py
+
+# demos/hertz.ipynb: the Hertz demo as a notebook, executed (pictures inline, files in demos/output)
+notebook: install
+	$(VENV)/bin/jupytext --to notebook demos/hertz.py
+	$(VENV)/bin/jupyter execute --inplace demos/hertz.ipynb
 
 lint: install
 	$(VENV)/bin/ruff check contact_ufl demos tests benchmarks

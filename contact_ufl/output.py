@@ -1,13 +1,19 @@
-"""Output: VTX files for ParaView, and off-screen pictures with pyvista."""
+"""Output: VTX files for ParaView, and off-screen pictures with pyvista.
+
+Every picture is written as a PNG file; inside a Jupyter (IPython) kernel it is also shown
+inline, by rank 0 only.
+"""
 
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import dolfinx
 import numpy as np
+from mpi4py import MPI
 
 if TYPE_CHECKING:
     import pyvista
@@ -145,12 +151,42 @@ def _view(plotter, view: str) -> None:
     plotter.reset_camera()
 
 
-def _screenshot(plotter, path: str | Path, title: str) -> None:
+def in_jupyter_kernel() -> bool:
+    """Whether this process is a Jupyter (IPython) kernel.
+
+    IPython is not imported: a kernel has imported it already, and without it (or in a
+    terminal IPython, which has no kernel) the answer is ``False``.
+    """
+    ipython = sys.modules.get("IPython")
+    if ipython is None:
+        return False
+    shell = ipython.get_ipython()
+    return getattr(shell, "kernel", None) is not None
+
+
+def show_inline(path: str | Path) -> None:
+    """Show the PNG file ``path`` as a cell output when running inside a Jupyter kernel,
+    on rank 0 only; elsewhere do nothing."""
+    if MPI.COMM_WORLD.rank != 0 or not in_jupyter_kernel():
+        return
+    from IPython.display import Image, display
+
+    display(Image(filename=str(path)))
+
+
+def _save(plotter, path: str | Path) -> None:
+    """Write the plotter's picture to ``path`` (creating its folder), close the plotter
+    and show the picture inline in a Jupyter kernel."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    plotter.add_text(title, font_size=12)
     plotter.screenshot(str(path))
     plotter.close()
+    show_inline(path)
+
+
+def _screenshot(plotter, path: str | Path, title: str) -> None:
+    plotter.add_text(title, font_size=12)
+    _save(plotter, path)
 
 
 def plot_reference(problem, path: str | Path, view: str = "iso", title: str = "") -> None:
@@ -215,8 +251,7 @@ def plot_pressure_profile(
         chart.line(*exact, color="tab:red", width=2.0, label="Hertz")
     plotter = pv.Plotter(off_screen=True, window_size=(900, 600))
     plotter.add_chart(chart)
-    plotter.screenshot(str(path))
-    plotter.close()
+    _save(plotter, path)
 
 
 def plot_curves(
@@ -235,8 +270,7 @@ def plot_curves(
         chart.line(x, y, color=colours[k % len(colours)], width=2.0, label=name)
     plotter = pv.Plotter(off_screen=True, window_size=(900, 600))
     plotter.add_chart(chart)
-    plotter.screenshot(str(path))
-    plotter.close()
+    _save(plotter, path)
 
 
 def plot_deformed(
@@ -267,5 +301,4 @@ def plot_deformed(
     if focus is not None:
         plotter.set_focus(focus)
     plotter.camera.zoom(zoom)
-    plotter.screenshot(str(path))
-    plotter.close()
+    _save(plotter, path)
