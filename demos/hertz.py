@@ -30,10 +30,11 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from contact_ufl import output, scenes
-from contact_ufl.analytic import Hertz2D, fit_elliptic_profile
+from contact_ufl import output
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import contact_samples, traction_mismatch
+from contact_ufl.verification import scenes
+from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--h", type=float, default=0.005, help="element size at the contact")

@@ -1,4 +1,4 @@
-"""Gmsh meshes of two-body contact scenes.
+"""Gmsh meshes of the two-body benchmark scenes (verification; not part of the library).
 
 Each generator builds two disjoint bodies, each meshed on its own (the meshes do not match
 at the contact interface and share no node, even where the bodies touch), and returns them
@@ -12,11 +12,13 @@ Generators
 * :func:`patch_2d`: two stacked rectangles (contact patch test), triangles or quadrilaterals.
 * :func:`patch_3d`: two stacked boxes, tetrahedra or hexahedra.
 * :func:`cylinders_3d`: half cylinder on a block with a cylindrical top of crossed axis.
+* :func:`ironing_2d`: a punch with a rounded bottom over a long block (shallow ironing).
 * :func:`beams_3d`: two cantilever beams clamped at opposite ends, overlapping in plan.
+* :func:`tag_single_body`: tags of a one-body mesh made without gmsh.
 
 Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
 11, 12, ... in the order they are listed in each generator's documentation; always look them
-up by name through :attr:`MeshData.tags`.
+up by name through :attr:`contact_ufl.gmshio.MeshData.tags`.
 """
 
 from __future__ import annotations
@@ -32,18 +34,18 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
-from contact_ufl.gmshio import MeshData, generate_mesh, gmsh_session
+from contact_ufl.gmshio import MeshData, generate_mesh
 
 __all__ = [
-    "MeshData",
-    "gmsh_session",
     "hertz_2d",
     "curved_2d",
     "patch_2d",
     "patch_3d",
     "cylinders_3d",
+    "ironing_2d",
     "BeamPair",
     "beams_3d",
+    "tag_single_body",
 ]
 
 _CELL_TAG0 = 1
