@@ -18,6 +18,7 @@ from contact_ufl.gmshio import gmsh_session, read_gmsh
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerPressure
 from contact_ufl.materials import NeoHookean
 from contact_ufl.problem import ContactProblem
+from contact_ufl.results import equilibrium_error, lowest_displacement, section_motion
 from contact_ufl.scene import Body, Scene
 
 COMM = MPI.COMM_WORLD
@@ -258,20 +259,45 @@ def test_model_without_mesh():
     raises_everywhere("holds no mesh: generate it first", action)
 
 
-def test_named_scene_solves_like_integer_tags(msh):
-    """The same pressed blocks with tags by name and by integer: the same contact force,
-    which carries the applied load (width 1) through the interface."""
-    forces = []
+@pytest.fixture(scope="module")
+def solved(msh):
+    """The pressed blocks solved with tags by name and by integer (one load step)."""
     integer_parts = dict(
         bodies=[Body(1, MATERIAL), Body(2, MATERIAL)],
         contacts=[ContactPair(1, 2, eps_N=10.0)],
         dirichlet=[Dirichlet(4, 0.0, component=1), Dirichlet(5, 0.0, component=0)],
         loads=[DeadTraction(3, lambda t: (0.0, -PRESSURE * t))],
     )
+    problems = []
     for parts in (named_parts(), integer_parts):
         problem = ContactProblem(Scene.from_gmsh(msh, **parts), verbose=False)
         problem.solve(num_steps=1)
-        forces.append(problem.contact_force())
-    named, integer = forces
+        problems.append(problem)
+    return problems
+
+
+def test_named_scene_solves_like_integer_tags(solved):
+    """The same contact force, which carries the applied load (width 1) through the
+    interface."""
+    named, integer = (problem.contact_force() for problem in solved)
     assert abs(named[1] / PRESSURE - 1.0) < 1e-8
     assert np.allclose(named, integer, rtol=1e-12, atol=1e-15)
+
+
+def test_results_helpers_take_names(solved):
+    named, integer = solved
+    support = named.reaction("lower_bottom")
+    assert abs(support[1] / PRESSURE - 1.0) < 1e-8
+    assert np.allclose(support, integer.reaction(4), rtol=1e-12, atol=1e-15)
+    error = equilibrium_error(named, ["lower_bottom", "left"])
+    assert np.isfinite(error) and error == pytest.approx(
+        equilibrium_error(integer, [4, 5]), rel=1e-10
+    )
+    sunk = lowest_displacement(named, "upper_top")
+    assert sunk < 0.0 and sunk == pytest.approx(lowest_displacement(integer, 3), rel=1e-10)
+    motion, normal = section_motion(named, "upper_top")
+    assert np.allclose(motion, section_motion(integer, 3)[0], rtol=1e-12, atol=1e-15)
+    assert normal[1] > 0.99
+    raises_everywhere(
+        "facet tag 'upper': physical group 'upper' has dimension 2", lambda: named.reaction("upper")
+    )
