@@ -247,6 +247,30 @@ def test_unnamed_groups(folder):
     assert integers.groups == {} and [b.tag for b in integers.bodies] == [1, 2]
 
 
+def test_name_used_twice(folder):
+    path = folder / "twice.msh"
+
+    def build():
+        two_blocks()
+        gmsh.model.addPhysicalGroup(1, [1], name="upper")
+
+    write_msh(path, build)
+    raises_everywhere(r"the name 'upper' is used by two physical groups", lambda: read_gmsh(path))
+
+
+def test_plane_mesh_off_its_plane(folder):
+    """A 2D mesh at z = 1: reading it as gdim = 2 would drop z."""
+    path = folder / "lifted.msh"
+
+    def build():
+        two_blocks()
+        gmsh.model.mesh.affineTransform([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1])
+
+    write_msh(path, build)
+    raises_everywhere("the mesh is not in the first 2 coordinate axes", lambda: read_gmsh(path))
+    assert read_gmsh(path, gdim=3).mesh.geometry.dim == 3
+
+
 def test_model_without_mesh():
     def action():
         if COMM.rank == 0:
