@@ -14,7 +14,7 @@ import time
 
 from mpi4py import MPI
 
-from contact_ufl.verification import cattaneo_mindlin_run
+from contact_ufl.verification.runs import cattaneo_mindlin_run
 
 
 def main() -> None:

@@ -13,10 +13,10 @@ import time
 
 from mpi4py import MPI
 
-from contact_ufl import scenes
-from contact_ufl.analytic import Hertz2D, fit_elliptic_profile
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import contact_samples
+from contact_ufl.verification import scenes
+from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
 
 FULL = [0.02, 0.01, 0.005, 0.0025, 0.00125]
 QUICK = [0.02, 0.01, 0.005]

@@ -24,14 +24,8 @@ import time
 
 from mpi4py import MPI
 
-from contact_ufl.verification import (
-    IRONING_FORCES,
-    IRONING_LITERATURE,
-    energy_balance,
-    history_at,
-    ironing_run,
-    steady_ratio,
-)
+from contact_ufl.verification.literature import IRONING_FORCES, IRONING_LITERATURE
+from contact_ufl.verification.runs import energy_balance, history_at, ironing_run, steady_ratio
 
 
 def print_forces(history: list[dict]) -> None:

@@ -10,7 +10,8 @@ import json
 
 from mpi4py import MPI
 
-from contact_ufl.taylor import curved_case, taylor_test
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification.taylor_cases import curved_case
 
 
 def run(dim: int, frozen: bool) -> dict:

@@ -37,14 +37,14 @@ class Dirichlet:
     Parameters
     ----------
     tag
-        Facet tag.
+        Facet tag, or the name of its physical group.
     value
         Displacement vector (or, with ``component``, one component), or a callable of ``t``.
     component
         Constrain only this component.
     """
 
-    tag: int
+    tag: int | str
     value: Value
     component: int | None = None
 
@@ -56,13 +56,13 @@ class DeadTraction:
     Parameters
     ----------
     tag
-        Facet tag of the loaded surface.
+        Facet tag of the loaded surface, or the name of its physical group.
     value
         Traction vector ``T`` (force per unit reference area), or a callable of ``t``. A
         resultant ``P`` spread over a reference area ``A0`` is ``T = P / A0``.
     """
 
-    tag: int
+    tag: int | str
     value: Value
 
     def virtual_work(self, u, v, ds, constant):
@@ -77,12 +77,12 @@ class BodyForce:
     Parameters
     ----------
     tag
-        Cell tag of the loaded body.
+        Cell tag of the loaded body, or the name of its physical group.
     value
         Force vector per unit reference volume, or a callable of ``t``.
     """
 
-    tag: int
+    tag: int | str
     value: Value
 
     def virtual_work(self, u, v, dx, constant):
@@ -113,13 +113,13 @@ class FollowerPressure:
     Parameters
     ----------
     tag
-        Facet tag of the loaded surface.
+        Facet tag of the loaded surface, or the name of its physical group.
     value
         Pressure ``p`` (stress units: force per unit current area), a scalar or a callable of
         the pseudo-time ``t`` returning one.
     """
 
-    tag: int
+    tag: int | str
     value: float | Callable[[float], float]
 
     def traction(self, u: dolfinx.fem.Function, p: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
@@ -153,7 +153,7 @@ class FollowerForce:
     Parameters
     ----------
     tag
-        Facet tag of the loaded surface.
+        Facet tag of the loaded surface, or the name of its physical group.
     value
         Magnitude ``P`` of the resultant force (force units; per unit thickness in plane
         strain), a scalar or a callable of the pseudo-time ``t`` returning one.
@@ -162,7 +162,7 @@ class FollowerForce:
         dimension of the mesh.
     """
 
-    tag: int
+    tag: int | str
     value: float | Callable[[float], float]
     direction: Sequence[float]
 

@@ -338,8 +338,9 @@ class ContactProblem:
         self._T.multTranspose(r, out)
         return out
 
-    def reaction(self, tag: int) -> np.ndarray:
-        """Resultant of the support reaction on the facets ``tag`` at the current state.
+    def reaction(self, tag: int | str) -> np.ndarray:
+        """Resultant of the support reaction on the facets ``tag`` (an integer or the name of
+        a physical group) at the current state.
 
         It is the residual of the displacement equations (internal minus external forces,
         contact included) summed over the dofs of those facets, without the equations that
@@ -348,7 +349,7 @@ class ContactProblem:
         R = self._assemble(self.residual_form, self._R.duplicate())
         gdim = self.V.mesh.geometry.dim
         owned = self.V.dofmap.index_map.size_local
-        facets = self.scene.facet_tags.find(tag)
+        facets = self.scene.facet_tags.find(self.scene.facet_tag(tag))
         blocks = dolfinx.fem.locate_dofs_topological(self.V, gdim - 1, facets)
         blocks = blocks[blocks < owned]
         local = R.array[: owned * gdim].reshape(-1, gdim)[blocks].sum(axis=0)

@@ -215,7 +215,7 @@ def lowest_displacement(problem, tag: int | str, component: int = -1) -> float:
     problem
         The contact problem.
     tag
-        Facet tag, or its name in ``problem.scene.tags``.
+        Facet tag, or the name of its physical group.
     component
         Displacement component (default: the last, vertical in 2D).
 
@@ -225,7 +225,7 @@ def lowest_displacement(problem, tag: int | str, component: int = -1) -> float:
         The smallest value: e.g. the depth of an imprint is minus that of the indented
         surface.
     """
-    tag = problem.scene.tags[tag] if isinstance(tag, str) else tag
+    tag = problem.scene.facet_tag(tag)
     mesh = problem.V.mesh
     facets = problem.scene.facet_tags.find(tag)
     dofs = dolfinx.fem.locate_dofs_topological(problem.V, mesh.topology.dim - 1, facets)
@@ -233,13 +233,15 @@ def lowest_displacement(problem, tag: int | str, component: int = -1) -> float:
     return problem.comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
 
 
-def section_motion(problem, tag: int) -> tuple[np.ndarray, np.ndarray]:
-    """Mean displacement and deformed unit normal of the facets ``tag`` (e.g. a beam's end).
+def section_motion(problem, tag: int | str) -> tuple[np.ndarray, np.ndarray]:
+    """Mean displacement and deformed unit normal of the facets ``tag`` (e.g. a beam's end;
+    an integer or the name of a physical group).
 
     Returns ``(u_mean, n)`` with ``u_mean = int u dS_o / int dS_o`` and ``n`` the direction of
     the deformed area vector ``int J F^-T N dS_o`` (the section's rotation is the angle
     between ``n`` and the reference normal).
     """
+    tag = problem.scene.facet_tag(tag)
     u = problem.u
     mesh = problem.V.mesh
     area = _facet_integral(problem, ufl.as_vector([dolfinx.fem.Constant(mesh, 1.0)]), tag)[0]
@@ -254,10 +256,10 @@ def equilibrium_error(problem, supports: list[str | int]) -> float:
     """Global equilibrium: ``|sum of support reactions + resultant of the loads|``, relative
     to the loads' resultant. The contact forces are internal to the scene and cancel.
 
-    ``supports`` are facet tags (or their names in ``problem.scene.tags``) that carry all
+    ``supports`` are facet tags (or the names of their physical groups) that carry all
     prescribed displacements.
     """
-    tags = [problem.scene.tags[s] if isinstance(s, str) else s for s in supports]
+    tags = [problem.scene.facet_tag(s) for s in supports]
     # reaction() is the residual without the prescribed-displacement equations on the
     # support dofs, internal minus external forces: the force of the support on the body
     reactions = sum(problem.reaction(tag) for tag in tags)

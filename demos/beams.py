@@ -34,9 +34,10 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from contact_ufl import output, scenes
+from contact_ufl import output
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import coulomb_law, equilibrium_error, section_motion
+from contact_ufl.verification import scenes
 
 parser = argparse.ArgumentParser(description="Two beams in contact, follower tip force")
 parser.add_argument("--divisions", type=int, default=3, help="elements through the height")
@@ -56,11 +57,10 @@ def say(text: str) -> None:
 
 # %% [markdown]
 # ## The scene
-# `scenes.beams` meshes the pair with gmsh (`contact_ufl.meshes.beams_3d`): the upper beam
-# (length 10, section 1 x 1) is clamped at its right end; the lower one (section 1.5 x 1.5,
-# wider, with elements 1.25 times larger) at its left end. The follower force grows
-# linearly in pseudo-time to `load` EI/L^2. The reference configuration, in 3D and in the
-# plane of bending:
+# `scenes.beams` meshes the pair with gmsh (`contact_ufl.verification.geometries.beams_3d`): the
+# upper beam (length 10, section 1 x 1) is clamped at its right end; the lower one (section 1.5 x
+# 1.5, wider, with elements 1.25 times larger) at its left end. The follower force grows linearly in
+# pseudo-time to `load` EI/L^2. The reference configuration, in 3D and in the plane of bending:
 
 # %%
 problems = {

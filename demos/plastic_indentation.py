@@ -31,10 +31,11 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from contact_ufl import output, scenes
+from contact_ufl import output
 from contact_ufl.loads import evaluate
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import contact_samples, lowest_displacement
+from contact_ufl.verification import scenes
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--h", type=float, default=0.01, help="element size at the contact")

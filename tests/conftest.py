@@ -5,8 +5,8 @@ import gc
 import pytest
 from mpi4py import MPI
 
-from contact_ufl import scenes
 from contact_ufl.problem import ContactProblem
+from contact_ufl.verification import scenes
 
 
 def solve_hertz(h_contact: float, depth: float = 0.005, comm=MPI.COMM_WORLD, steps: int = 4):
@@ -34,7 +34,7 @@ def tagged_unit_square(n: int = 4, cell_type=None):
     import dolfinx
     import numpy as np
 
-    from contact_ufl.meshes import tag_single_body
+    from contact_ufl.verification.geometries import tag_single_body
 
     cell_type = cell_type or dolfinx.mesh.CellType.triangle
     mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, cell_type)

@@ -9,7 +9,7 @@ from contact_ufl.loads import Dirichlet
 from contact_ufl.materials import NeoHookean
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body
-from contact_ufl.scenes import curved_pair
+from contact_ufl.verification.scenes import curved_pair
 
 
 @pytest.fixture(scope="module")

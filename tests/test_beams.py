@@ -5,13 +5,13 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contact_ufl import meshes, scenes
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import coulomb_law, equilibrium_error, section_motion
+from contact_ufl.verification import geometries, scenes
 
 SUPPORTS = ["upper_clamp", "lower_clamp"]
 #: a small gap: contact starts long before large rotations
-NEAR = meshes.BeamPair(gap=0.1, lower_length=10.0)
+NEAR = geometries.BeamPair(gap=0.1, lower_length=10.0)
 
 
 def solve_near_pair(load: float, comm=MPI.COMM_WORLD):

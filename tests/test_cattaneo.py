@@ -2,7 +2,7 @@
 
 import pytest
 
-from contact_ufl.verification import cattaneo_mindlin_run
+from contact_ufl.verification.runs import cattaneo_mindlin_run
 
 
 @pytest.fixture(scope="module")

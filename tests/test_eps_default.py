@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contact_ufl import scenes
 from contact_ufl.mpi import global_diameter
 from contact_ufl.problem import ContactProblem
+from contact_ufl.verification import scenes
 
 
 def solved(scene):

@@ -10,13 +10,6 @@ import ufl
 from conftest import symmetric_square, tagged_unit_square
 from mpi4py import MPI
 
-from contact_ufl.analytic import (
-    ELASTICA_DEAD_TIP,
-    ELASTICA_FOLLOWER_TIP,
-    bending_stiffness_plane_strain,
-    cantilever_elastica,
-    neo_hookean_pressure_stretch,
-)
 from contact_ufl.errors import ContactInputError
 from contact_ufl.loads import (
     DeadTraction,
@@ -26,10 +19,18 @@ from contact_ufl.loads import (
     load_constant,
 )
 from contact_ufl.materials import NeoHookean
-from contact_ufl.meshes import tag_single_body
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Scene
-from contact_ufl.taylor import smooth_field, taylor_test
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification.analytic import (
+    ELASTICA_DEAD_TIP,
+    ELASTICA_FOLLOWER_TIP,
+    bending_stiffness_plane_strain,
+    cantilever_elastica,
+    neo_hookean_pressure_stretch,
+)
+from contact_ufl.verification.geometries import tag_single_body
+from contact_ufl.verification.taylor_cases import smooth_field
 
 # the cantilever: L / h = 40, Q2 quadrilaterals 80 x 2 (square cells, the node (L, 0) on the
 # mid-line), Neo-Hookean with nu = 0 (plane strain E' = E)

@@ -6,11 +6,12 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contact_ufl import scenes
 from contact_ufl.contact.coulomb import CoulombLaw
 from contact_ufl.problem import ContactProblem
-from contact_ufl.scenes import curved_pair
-from contact_ufl.taylor import curved_case, taylor_test
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification import scenes
+from contact_ufl.verification.scenes import curved_pair
+from contact_ufl.verification.taylor_cases import curved_case
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from contact_ufl.analytic import Hertz2D, fit_elliptic_profile
 from contact_ufl.results import contact_samples, weak_contact_law
+from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
 
 
 def hertz_errors(problem, hertz):

@@ -1,7 +1,7 @@
 """Shallow ironing (large frictional sliding) on coarse meshes, serial (about 90 s).
 
-The published geometry (:func:`contact_ufl.meshes.ironing_2d`): the indenter is pressed 0.8
-into the block and slid 10 along it. Checked against the published force curves and
+The published geometry (:func:`contact_ufl.verification.geometries.ironing_2d`): the indenter
+is pressed 0.8 into the block and slid 10 along it. Checked against the published force curves and
 against two properties no publication is needed for: the frictional part of the force
 ratio is mu, and the work done on the indenter is the frictional dissipation plus the
 change of stored energy.
@@ -10,14 +10,8 @@ change of stored energy.
 import numpy as np
 import pytest
 
-from contact_ufl.verification import (
-    IRONING_FORCES,
-    IRONING_LITERATURE,
-    energy_balance,
-    history_at,
-    ironing_run,
-    steady_ratio,
-)
+from contact_ufl.verification.literature import IRONING_FORCES, IRONING_LITERATURE
+from contact_ufl.verification.runs import energy_balance, history_at, ironing_run, steady_ratio
 
 COARSE = dict(h_punch=0.05, h_block=0.2, slide_steps=100)
 

@@ -20,27 +20,28 @@ import pytest
 import ufl
 from mpi4py import MPI
 
-from contact_ufl import meshes
+from contact_ufl.gmshio import MeshData
+from contact_ufl.verification import geometries
 
 COMM = MPI.COMM_WORLD
 
 # scene key -> (generator, keyword arguments, (slave group, master group), (slave, master) body)
 SCENES = {
-    "hertz_2d": (meshes.hertz_2d, {}, ("cylinder", "block")),
-    "hertz_2d_p2_gap": (meshes.hertz_2d, {"order": 2, "gap": 0.05}, ("cylinder", "block")),
-    "curved_2d": (meshes.curved_2d, {}, ("cylinder", "block")),
+    "hertz_2d": (geometries.hertz_2d, {}, ("cylinder", "block")),
+    "hertz_2d_p2_gap": (geometries.hertz_2d, {"order": 2, "gap": 0.05}, ("cylinder", "block")),
+    "curved_2d": (geometries.curved_2d, {}, ("cylinder", "block")),
     "curved_2d_concave": (
-        meshes.curved_2d,
+        geometries.curved_2d,
         {"lower_radius": -3.0, "gap": 0.02},
         ("cylinder", "block"),
     ),
-    "patch_2d": (meshes.patch_2d, {}, ("upper", "lower")),
-    "patch_2d_quad": (meshes.patch_2d, {"cell": "quadrilateral"}, ("upper", "lower")),
-    "patch_3d": (meshes.patch_3d, {}, ("upper", "lower")),
-    "patch_3d_hex": (meshes.patch_3d, {"cell": "hexahedron", "gap": 0.1}, ("upper", "lower")),
-    "cylinders_3d": (meshes.cylinders_3d, {}, ("upper", "lower")),
+    "patch_2d": (geometries.patch_2d, {}, ("upper", "lower")),
+    "patch_2d_quad": (geometries.patch_2d, {"cell": "quadrilateral"}, ("upper", "lower")),
+    "patch_3d": (geometries.patch_3d, {}, ("upper", "lower")),
+    "patch_3d_hex": (geometries.patch_3d, {"cell": "hexahedron", "gap": 0.1}, ("upper", "lower")),
+    "cylinders_3d": (geometries.cylinders_3d, {}, ("upper", "lower")),
     "cylinders_3d_gap": (
-        meshes.cylinders_3d,
+        geometries.cylinders_3d,
         {"lower_radius": 4.0, "gap": 0.05},
         ("upper", "lower"),
     ),
@@ -48,7 +49,7 @@ SCENES = {
 
 
 @functools.cache
-def scene(key: str) -> meshes.SceneMesh:
+def scene(key: str) -> MeshData:
     """Build each scene once (collectively: every rank runs the tests in the same order)."""
     generator, kwargs, _ = SCENES[key]
     return generator(**kwargs)
@@ -130,7 +131,7 @@ def exact_measures(key: str) -> dict[str, tuple[float, bool]]:
 # --------------------------------------------------------------------------------------------
 
 
-def measure(sm: meshes.SceneMesh, name: str) -> float:
+def measure(sm: MeshData, name: str) -> float:
     """Global length/area/volume of the group ``name``."""
     mesh = sm.mesh
     is_cell = sm.tags[name] < 10
@@ -144,7 +145,7 @@ def measure(sm: meshes.SceneMesh, name: str) -> float:
     return mesh.comm.allreduce(local, op=MPI.SUM)
 
 
-def owned_count(sm: meshes.SceneMesh, name: str) -> int:
+def owned_count(sm: MeshData, name: str) -> int:
     """Global number of entities in the group ``name``."""
     mesh = sm.mesh
     is_cell = sm.tags[name] < 10
@@ -154,7 +155,7 @@ def owned_count(sm: meshes.SceneMesh, name: str) -> int:
     return mesh.comm.allreduce(int(n_owned), op=MPI.SUM)
 
 
-def facet_nodes(sm: meshes.SceneMesh, name: str) -> npt.NDArray[np.float64]:
+def facet_nodes(sm: MeshData, name: str) -> npt.NDArray[np.float64]:
     """Coordinates of all geometry nodes of the facets ``name``, gathered on every rank."""
     mesh = sm.mesh
     tdim = mesh.topology.dim
@@ -169,7 +170,7 @@ def facet_nodes(sm: meshes.SceneMesh, name: str) -> npt.NDArray[np.float64]:
     return np.unique(np.round(x, 14), axis=0)
 
 
-def body_vertices(sm: meshes.SceneMesh, body: str) -> npt.NDArray[np.int64]:
+def body_vertices(sm: MeshData, body: str) -> npt.NDArray[np.int64]:
     """Global indices of the vertices of the cells of ``body``, gathered on every rank."""
     mesh = sm.mesh
     tdim = mesh.topology.dim
@@ -298,7 +299,7 @@ def test_cylinders_contact_is_curved_both_ways() -> None:
 
 def test_msh_file_written(tmp_path: Path) -> None:
     path = COMM.bcast(tmp_path / "meshes" / "patch.msh" if COMM.rank == 0 else None, root=0)
-    sm = meshes.patch_2d(msh_file=path)
+    sm = geometries.patch_2d(msh_file=path)
     assert owned_count(sm, "upper") > 0
     exists = COMM.bcast(path.exists() and path.stat().st_size > 0 if COMM.rank == 0 else None)
     assert exists
@@ -307,14 +308,14 @@ def test_msh_file_written(tmp_path: Path) -> None:
 def test_gmsh_state_restored() -> None:
     was_initialised = gmsh.isInitialized()
     if not was_initialised:
-        meshes.patch_2d()
+        geometries.patch_2d()
         assert not gmsh.isInitialized()
         gmsh.initialize(interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("user_model")
         gmsh.option.setNumber("Mesh.Algorithm", 5)
-        meshes.patch_2d()
+        geometries.patch_2d()
         assert gmsh.isInitialized()
         assert gmsh.model.getCurrent() == "user_model"
         assert gmsh.option.getNumber("Mesh.Algorithm") == 5
@@ -326,14 +327,14 @@ def test_gmsh_state_restored() -> None:
 @pytest.mark.parametrize(
     ("generator", "kwargs"),
     [
-        (meshes.hertz_2d, {"order": 3}),
-        (meshes.hertz_2d, {"gap": -0.1}),
-        (meshes.hertz_2d, {"h_contact": 0.0}),
-        (meshes.curved_2d, {"lower_radius": 1.5}),  # width / 2 > lower radius
-        (meshes.patch_2d, {"cell": "hexahedron"}),
-        (meshes.patch_3d, {"cell": "quadrilateral"}),
-        (meshes.cylinders_3d, {"block": (2.0, 8.0, 0.5)}),
-        (meshes.cylinders_3d, {"lower_radius": -3.0}),
+        (geometries.hertz_2d, {"order": 3}),
+        (geometries.hertz_2d, {"gap": -0.1}),
+        (geometries.hertz_2d, {"h_contact": 0.0}),
+        (geometries.curved_2d, {"lower_radius": 1.5}),  # width / 2 > lower radius
+        (geometries.patch_2d, {"cell": "hexahedron"}),
+        (geometries.patch_3d, {"cell": "quadrilateral"}),
+        (geometries.cylinders_3d, {"block": (2.0, 8.0, 0.5)}),
+        (geometries.cylinders_3d, {"lower_radius": -3.0}),
     ],
 )
 def test_invalid_input_raises_on_every_rank(generator, kwargs) -> None:

@@ -7,7 +7,7 @@ import pytest
 
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import body_resultants
-from contact_ufl.scenes import patch
+from contact_ufl.verification.scenes import patch
 
 PRESSURE = 0.01
 TIGHT = {"snes_rtol": 1e-13, "snes_atol": 1e-15}

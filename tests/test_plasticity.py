@@ -8,15 +8,16 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contact_ufl import scenes
 from contact_ufl.loads import Dirichlet
-from contact_ufl.meshes import tag_single_body
 from contact_ufl.output import ResultWriter
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import contact_samples, lowest_displacement, stored_energy
 from contact_ufl.scene import Body, Scene
-from contact_ufl.taylor import smooth_field, taylor_test
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification import scenes
+from contact_ufl.verification.geometries import tag_single_body
+from contact_ufl.verification.taylor_cases import smooth_field
 
 E, NU, SIGMA_Y = 1.0, 0.3, 0.01
 

@@ -5,9 +5,9 @@ import weakref
 
 import pytest
 
-from contact_ufl import scenes
 from contact_ufl.errors import ConvergenceError
 from contact_ufl.problem import ContactProblem
+from contact_ufl.verification import scenes
 
 
 def hertz_problem(**options):

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contact_ufl.taylor import curved_case, taylor_test
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification.taylor_cases import curved_case
 
 
 @pytest.mark.parametrize("dim", [2, 3])

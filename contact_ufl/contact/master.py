@@ -32,7 +32,7 @@ class MeshMaster:
     """A meshed master surface: oriented facets whose nodes are displacement dofs.
 
     Facet nodes are the vertices of the facets (linear segments, triangles, bilinear
-    quadrilaterals), ordered so that the normal of ``contact_ufl.projection`` points out of
+    quadrilaterals), ordered so that the normal of :mod:`.projection` points out of
     the master body.
 
     Attributes

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from contact_ufl import scenes
-from contact_ufl.analytic import CattaneoMindlin2D, Hertz2D
 from contact_ufl.loads import evaluate
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import (
@@ -15,6 +13,17 @@ from contact_ufl.results import (
     stick_zone_half_width,
     stored_energy,
 )
+from contact_ufl.verification import scenes
+from contact_ufl.verification.analytic import CattaneoMindlin2D, Hertz2D
+
+__all__ = [
+    "cattaneo_mindlin_run",
+    "energy_balance",
+    "history_at",
+    "ironing_run",
+    "shear_error",
+    "steady_ratio",
+]
 
 
 def cattaneo_mindlin_run(
@@ -66,34 +75,6 @@ def shear_error(problem, exact: CattaneoMindlin2D, pair: int = 0) -> float:
     return float(rms / (exact.mu * exact.hertz.p0))
 
 
-#: Global friction coefficients |Fx/Fy| at t = 1.5 of the shallow ironing problem with
-#: mu = 0.3 in the literature, as compiled by the solids4foam tutorial ``shallowIroning``
-#: (Batistic, Cardiff & Tukovic 2022, Table 1 there).
-IRONING_LITERATURE = {
-    "Poulios & Renard 2015": 0.30,
-    "Batistic et al. 2022": 0.32,
-    "Houssein 2022": 0.32,
-    "Code_Aster SSNP153": 0.34,
-    "Hartmann et al. 2009": 0.38,
-    "Yastrebov 2011": 0.47,
-    "Fischer & Wriggers 2006": 0.53,
-}
-
-#: Reaction forces on the indenter's top (magnitudes, per unit thickness in the units of E
-#: times length) of the shallow ironing problem with mu = 0.3 in the literature:
-#: ``(Fy, Fx)`` at t = 1.0 (end of pressing) and at t = 1.5 (steady sliding), read off the
-#: published curves by the solids4foam tutorial ``shallowIroning`` (Table 2 there; its
-#: newtons on a 1 mm thick domain with lengths in mm are 1e-6 of these units).
-IRONING_FORCES = {
-    "Poulios & Renard 2015": ((2.679e8, 0.553e8), (3.374e8, 1.021e8)),
-    "Batistic et al. 2022": ((3.164e8, 0.550e8), (3.951e8, 1.227e8)),
-    "Code_Aster SSNP153": ((3.320e8, 0.710e8), (4.210e8, 1.433e8)),
-    "Hartmann et al. 2009": ((3.195e8, 0.672e8), (4.084e8, 1.602e8)),
-    "Yastrebov 2011": ((2.897e8, 0.585e8), (3.595e8, 1.708e8)),
-    "Fischer & Wriggers 2006": ((2.979e8, 0.621e8), (3.651e8, 1.888e8)),
-}
-
-
 def ironing_run(
     mu: float,
     h_punch: float = 0.025,
@@ -102,8 +83,8 @@ def ironing_run(
     slide_steps: int = 200,
     verbose: bool = False,
 ) -> tuple[dict, ContactProblem]:
-    """The 2D shallow ironing problem of :func:`contact_ufl.scenes.ironing`, pressing then
-    sliding; one record per converged step.
+    """The 2D shallow ironing problem of :func:`~contact_ufl.verification.scenes.ironing`,
+    pressing then sliding; one record per converged step.
 
     Returns ``{"mu", "history", "cutbacks", ...}`` with history records ``time``, ``Fx``,
     ``Fy`` (the force of the support on the indenter's top, which balances the contact

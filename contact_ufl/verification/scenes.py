@@ -1,6 +1,6 @@
 """Ready-made scenes of the verification problems, shared by tests, demos and benchmarks.
 
-Each function meshes its geometry (:mod:`contact_ufl.meshes`) and returns a
+Each function meshes its geometry (:mod:`contact_ufl.verification.geometries`) and returns a
 :class:`~contact_ufl.scene.Scene` with the bodies, supports, loads and contact pair, plus the
 data needed to compare with the analytic solution.
 """
@@ -13,13 +13,13 @@ from dataclasses import dataclass
 import numpy as np
 from mpi4py import MPI
 
-from contact_ufl import meshes
-from contact_ufl.analytic import plane_strain_modulus
 from contact_ufl.contact import ContactPair
 from contact_ufl.loads import DeadTraction, Dirichlet, FollowerForce
 from contact_ufl.materials import NeoHookean
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.scene import Body, Scene
+from contact_ufl.verification import geometries
+from contact_ufl.verification.analytic import plane_strain_modulus
 
 
 def rotation_2d(angle: float) -> np.ndarray:
@@ -87,7 +87,7 @@ def hertz_2d(
         Initial gap between the disc and the block (``depth`` includes it).
     """
     E_flat = E if E_flat is None else E_flat
-    sm = meshes.hertz_2d(h_contact=h_contact, h_far=h_far, gap=gap, comm=comm)
+    sm = geometries.hertz_2d(h_contact=h_contact, h_far=h_far, gap=gap, comm=comm)
     tags = sm.tags
     R = rotation_2d(rotation)
     sm.mesh.geometry.x[:, :2] = sm.mesh.geometry.x[:, :2] @ R.T
@@ -143,7 +143,8 @@ def patch(
     Parameters
     ----------
     dim
-        2 (:func:`contact_ufl.meshes.patch_2d`) or 3 (:func:`contact_ufl.meshes.patch_3d`).
+        2 (:func:`~contact_ufl.verification.geometries.patch_2d`) or 3
+        (:func:`~contact_ufl.verification.geometries.patch_3d`).
     cell
         Cell type of the meshes (default: simplices).
     mu
@@ -152,10 +153,10 @@ def patch(
         Passed to the mesh generator (element sizes).
     """
     if dim == 2:
-        sm = meshes.patch_2d(cell=cell or "triangle", comm=comm, **mesh_options)
+        sm = geometries.patch_2d(cell=cell or "triangle", comm=comm, **mesh_options)
         sides = {0: ("upper_left", "lower_left")}
     else:
-        sm = meshes.patch_3d(cell=cell or "tetrahedron", comm=comm, **mesh_options)
+        sm = geometries.patch_3d(cell=cell or "tetrahedron", comm=comm, **mesh_options)
         sides = {0: ("upper_x0", "lower_x0"), 1: ("upper_y0", "lower_y0")}
     tags = sm.tags
     material = NeoHookean(E, nu)
@@ -195,10 +196,10 @@ def curved_pair(
     above a block with a cylindrical top of crossed axis.
     """
     if dim == 2:
-        sm = meshes.curved_2d(h_contact=0.05, h_far=0.3, comm=comm)
+        sm = geometries.curved_2d(h_contact=0.05, h_far=0.3, comm=comm)
         names = ("cylinder", "block", "cylinder_contact", "block_contact")
     else:
-        sm = meshes.cylinders_3d(h_contact=0.15, h_far=0.4, comm=comm)
+        sm = geometries.cylinders_3d(h_contact=0.15, h_far=0.4, comm=comm)
         names = ("upper", "lower", "upper_contact", "lower_contact")
     tags = sm.tags
     return Scene(
@@ -290,15 +291,15 @@ def ironing(
 ) -> Scene:
     """The 2D "shallow ironing" problem (Yang, Laursen & Meng 2005; Poulios & Renard 2015).
 
-    A Neo-Hookean block 12 x 4 (E = 6.896e8, nu = 0.32) clamped at its bottom, and a ten
-    times stiffer punch 1.2 wide and 1.2 tall whose bottom is a circular segment of radius
-    0.75 (:func:`contact_ufl.meshes.ironing_2d`), 0.2 above the block and 0.2 from its left
-    end. The punch's top is pressed down by ``depth`` from t = 0 to 1 (0.8 into the block),
-    then moved along the block by ``slide`` from t = 1 to 2. The slave surface is the punch's
-    arc and sides (the finer mesh), the master surface the block's top, with the smoothed
-    normal by default (the punch slides over many master vertices).
+    A Neo-Hookean block 12 x 4 (E = 6.896e8, nu = 0.32) clamped at its bottom, and a ten times
+    stiffer punch 1.2 wide and 1.2 tall whose bottom is a circular segment of radius 0.75
+    (:func:`~contact_ufl.verification.geometries.ironing_2d`), 0.2 above the block and 0.2 from its
+    left end. The punch's top is pressed down by ``depth`` from t = 0 to 1 (0.8 into the block),
+    then moved along the block by ``slide`` from t = 1 to 2. The slave surface is the punch's arc
+    and sides (the finer mesh), the master surface the block's top, with the smoothed normal by
+    default (the punch slides over many master vertices).
     """
-    sm = meshes.ironing_2d(h_punch=h_punch, h_block=h_block, comm=comm)
+    sm = geometries.ironing_2d(h_punch=h_punch, h_block=h_block, comm=comm)
     tags = sm.tags
     E_block, E_punch, nu = 6.896e8, 6.896e9, 0.32
     return Scene(
@@ -334,7 +335,7 @@ class BeamsScene:
     """The two-beam showcase scene and the data of its beam-theory estimates."""
 
     scene: Scene
-    geometry: meshes.BeamPair
+    geometry: geometries.BeamPair
     E: float
     nu: float
     load: float
@@ -375,19 +376,19 @@ def beams(
     divisions: int = 4,
     E: float = 1.0e3,
     nu: float = 0.3,
-    geometry: meshes.BeamPair | None = None,
+    geometry: geometries.BeamPair | None = None,
     eps_factor: float = 0.1,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> BeamsScene:
     """Two Neo-Hookean cantilevers, the upper one pushed at its free tip by a follower force.
 
-    The beams of :func:`contact_ufl.meshes.beams_3d` are clamped at opposite ends. The free
-    end section of the upper beam carries the follower force :class:`FollowerForce` of
-    magnitude ``load * t * EI / L^2`` (``t`` the pseudo-time), directed along the carried
-    reference direction ``-e_z``: it stays perpendicular to the deformed beam axis. The upper
-    beam bends down, its tip meets the lower beam and, as it rotates, slides along it.
-    Slave: the bottom of the upper beam above the lower one; master: the top of the lower
-    beam near its free end; ``eps_N = eps_factor E / h`` with ``h`` the upper element size.
+    The beams of :func:`~contact_ufl.verification.geometries.beams_3d` are clamped at opposite ends.
+    The free end section of the upper beam carries the follower force :class:`FollowerForce` of
+    magnitude ``load * t * EI / L^2`` (``t`` the pseudo-time), directed along the carried reference
+    direction ``-e_z``: it stays perpendicular to the deformed beam axis. The upper beam bends down,
+    its tip meets the lower beam and, as it rotates, slides along it. Slave: the bottom of the upper
+    beam above the lower one; master: the top of the lower beam near its free end; ``eps_N =
+    eps_factor E / h`` with ``h`` the upper element size.
 
     Parameters
     ----------
@@ -400,15 +401,15 @@ def beams(
     E, nu
         Neo-Hookean material of both beams.
     geometry
-        Lengths (default :class:`contact_ufl.meshes.BeamPair`).
+        Lengths (default :class:`contact_ufl.verification.geometries.BeamPair`).
     eps_factor
         Scale of the augmentation parameter. The default 0.1 keeps ``eps_N`` nearer the
         stiffness of slender beams than ``E / h`` (which is the stiffness scale of a solid):
         with ``eps_factor = 1`` the first Newton iterate at the first touch penetrates so
         deeply that the active set cycles and the step is cut back.
     """
-    geometry = geometry or meshes.BeamPair()
-    sm = meshes.beams_3d(geometry, divisions=divisions, comm=comm)
+    geometry = geometry or geometries.BeamPair()
+    sm = geometries.beams_3d(geometry, divisions=divisions, comm=comm)
     tags = sm.tags
     material = NeoHookean(E, nu)
     EI = E * geometry.width * geometry.height**3 / 12.0

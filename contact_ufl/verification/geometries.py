@@ -1,9 +1,9 @@
-"""Gmsh meshes of two-body contact scenes.
+"""Gmsh meshes of the two-body benchmark scenes (verification; not part of the library).
 
 Each generator builds two disjoint bodies, each meshed on its own (the meshes do not match
 at the contact interface and share no node, even where the bodies touch), and returns them
 as *one* DOLFINx mesh with named cell and facet tags. The gmsh model is built on rank 0 of
-``comm`` and distributed by :func:`dolfinx.io.gmsh.model_to_mesh`.
+``comm`` and distributed by :func:`contact_ufl.gmshio.generate_mesh`.
 
 Generators
 ----------
@@ -12,123 +12,49 @@ Generators
 * :func:`patch_2d`: two stacked rectangles (contact patch test), triangles or quadrilaterals.
 * :func:`patch_3d`: two stacked boxes, tetrahedra or hexahedra.
 * :func:`cylinders_3d`: half cylinder on a block with a cylindrical top of crossed axis.
+* :func:`ironing_2d`: a punch with a rounded bottom over a long block (shallow ironing).
 * :func:`beams_3d`: two cantilever beams clamped at opposite ends, overlapping in plan.
+* :func:`tag_single_body`: tags of a one-body mesh made without gmsh.
 
 Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
 11, 12, ... in the order they are listed in each generator's documentation; always look them
-up by name through :attr:`SceneMesh.tags`.
+up by name through :attr:`contact_ufl.gmshio.MeshData.tags`.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import dolfinx
-import dolfinx.io.gmsh
 import gmsh
 import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
+from contact_ufl.gmshio import MeshData, generate_mesh
+
 __all__ = [
-    "SceneMesh",
-    "gmsh_session",
     "hertz_2d",
     "curved_2d",
     "patch_2d",
     "patch_3d",
     "cylinders_3d",
+    "ironing_2d",
     "BeamPair",
     "beams_3d",
+    "tag_single_body",
 ]
 
 _CELL_TAG0 = 1
 _FACET_TAG0 = 11
 
 
-@dataclass(frozen=True, eq=False)
-class SceneMesh:
-    """A two-body contact scene in one DOLFINx mesh.
-
-    Attributes
-    ----------
-    mesh
-        The mesh holding both bodies (disjoint, no shared vertex).
-    cell_tags
-        Cell markers; one value per body.
-    facet_tags
-        Facet markers of the named boundary parts.
-    tags
-        Physical name -> tag value, for cells and facets alike (values are unique).
-    """
-
-    mesh: dolfinx.mesh.Mesh
-    cell_tags: dolfinx.mesh.MeshTags
-    facet_tags: dolfinx.mesh.MeshTags
-    tags: dict[str, int]
-
-    def cells(self, name: str) -> npt.NDArray[np.int32]:
-        """Local indices (owned and ghost) of the cells of the group ``name``."""
-        return self.cell_tags.find(self.tags[name])
-
-    def facets(self, name: str) -> npt.NDArray[np.int32]:
-        """Local indices (owned and ghost) of the facets of the group ``name``."""
-        return self.facet_tags.find(self.tags[name])
-
-
 # --------------------------------------------------------------------------------------------
-# gmsh plumbing
+# gmsh helpers of the geometries
 # --------------------------------------------------------------------------------------------
-
-
-@contextmanager
-def gmsh_session(name: str, options: dict[str, float] | None = None) -> Iterator[None]:
-    """Work in a fresh gmsh model, and clean up afterwards.
-
-    Initialises gmsh unless it is initialised already (then finalises it on exit), silences the
-    terminal, adds a model ``name`` and makes it current, and sets the numeric ``options``.
-    On exit the model is removed; if gmsh was initialised by the caller, the options and the
-    previous current model are restored.
-
-    Parameters
-    ----------
-    name
-        Name of the gmsh model.
-    options
-        Numeric gmsh options, e.g. ``{"Mesh.Algorithm": 6}``.
-
-    Yields
-    ------
-    None
-        Use the ``gmsh`` module API inside the block.
-    """
-    initialised_here = not gmsh.isInitialized()
-    if initialised_here:
-        gmsh.initialize(interruptible=False)
-    all_options = {"General.Terminal": 0.0, **(options or {})}
-    saved = {key: gmsh.option.getNumber(key) for key in all_options}
-    previous = gmsh.model.getCurrent() if not initialised_here else None
-    try:
-        for key, value in all_options.items():
-            gmsh.option.setNumber(key, value)
-        gmsh.model.add(name)
-        yield
-    finally:
-        if initialised_here:
-            gmsh.finalize()
-        else:
-            gmsh.model.remove()
-            for key, value in saved.items():
-                gmsh.option.setNumber(key, value)
-            if previous:
-                try:
-                    gmsh.model.setCurrent(previous)
-                except Exception:  # the caller's model may have gone: nothing to restore
-                    pass
 
 
 def _add_groups(groups: list[tuple[str, int, list[int]]], tdim: int) -> None:
@@ -139,65 +65,6 @@ def _add_groups(groups: list[tuple[str, int, list[int]]], tdim: int) -> None:
             raise RuntimeError(f"physical group '{name}' has no geometric entity")
         gmsh.model.addPhysicalGroup(dim, list(entities), tag=next_tag[dim], name=name)
         next_tag[dim] += 1
-
-
-def _check_groups_meshed() -> None:
-    """Raise if a physical group holds no mesh element."""
-    for dim, tag in gmsh.model.getPhysicalGroups():
-        count = 0
-        for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, tag):
-            _, element_tags, _ = gmsh.model.mesh.getElements(dim, entity)
-            count += sum(len(t) for t in element_tags)
-        if count == 0:
-            name = gmsh.model.getPhysicalName(dim, tag)
-            raise RuntimeError(f"physical group '{name}' has no mesh element")
-
-
-def _generate(
-    comm: MPI.Comm,
-    name: str,
-    build: Callable[[], None],
-    gdim: int,
-    options: dict[str, float],
-    msh_file: str | Path | None,
-    ghost_mode: dolfinx.mesh.GhostMode,
-) -> SceneMesh:
-    """Run ``build`` (geometry, fields, groups, meshing) on rank 0 and distribute the mesh.
-
-    Errors on rank 0 are raised on every rank.
-    """
-    error = None
-    with _on_rank0(comm, name, options):
-        if comm.rank == 0:
-            try:
-                build()
-                _check_groups_meshed()
-                if msh_file is not None:
-                    path = Path(msh_file)
-                    path.parent.mkdir(parents=True, exist_ok=True)
-                    gmsh.write(str(path))
-            except Exception as exc:  # made collective just below
-                error = f"{type(exc).__name__}: {exc}"
-        error = comm.bcast(error, root=0)
-        if error is not None:
-            raise RuntimeError(f"building the gmsh model '{name}' failed: {error}")
-        partitioner = dolfinx.mesh.create_cell_partitioner(ghost_mode, 2)
-        data = dolfinx.io.gmsh.model_to_mesh(
-            gmsh.model if comm.rank == 0 else None, comm, 0, gdim=gdim, partitioner=partitioner
-        )
-    data.mesh.name = name
-    tags = {key: int(group.tag) for key, group in data.physical_groups.items()}
-    return SceneMesh(data.mesh, data.cell_tags, data.facet_tags, tags)
-
-
-@contextmanager
-def _on_rank0(comm: MPI.Comm, name: str, options: dict[str, float]) -> Iterator[None]:
-    """A :func:`gmsh_session` on rank 0 of ``comm``, nothing on the other ranks."""
-    if comm.rank == 0:
-        with gmsh_session(name, options):
-            yield
-    else:
-        yield
 
 
 def _mesh_options(order: int) -> dict[str, float]:
@@ -391,7 +258,7 @@ def hertz_2d(
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
     x_disc: float = 0.0,
-) -> SceneMesh:
+) -> MeshData:
     """Plane Hertz scene: a half disc resting on a rectangular block.
 
     The half disc is the lower half of the circle of radius ``radius`` and centre
@@ -429,7 +296,7 @@ def hertz_2d(
 
     Returns
     -------
-    SceneMesh
+    MeshData
         Cell groups ``"cylinder"`` (1), ``"block"`` (2); facet groups ``"cylinder_contact"``
         (lower arc, 11), ``"cylinder_top"`` (diameter, 12), ``"block_contact"`` (top edge, 13),
         ``"block_bottom"`` (14), ``"block_sides"`` (left and right, 15).
@@ -463,7 +330,7 @@ def hertz_2d(
             x_disc,
         )
 
-    return _generate(comm, "hertz_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(comm, "hertz_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
 
 
 def curved_2d(
@@ -479,7 +346,7 @@ def curved_2d(
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
-) -> SceneMesh:
+) -> MeshData:
     """Plane curved-on-curved scene: the half disc of :func:`hertz_2d` on an arched block.
 
     The lower body is ``{-w/2 <= x <= w/2, -height <= y <= top(x)}`` whose top is a circular
@@ -500,7 +367,7 @@ def curved_2d(
 
     Returns
     -------
-    SceneMesh
+    MeshData
         The names and values of :func:`hertz_2d`; ``"block_contact"`` is the top arc.
     """
     h_contact = 0.02 * radius if h_contact is None else h_contact
@@ -539,7 +406,7 @@ def curved_2d(
             order,
         )
 
-    return _generate(comm, "curved_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(comm, "curved_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
 
 
 # --------------------------------------------------------------------------------------------
@@ -558,7 +425,7 @@ def patch_2d(
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
-) -> SceneMesh:
+) -> MeshData:
     """Plane patch test: two stacked rectangles with non-matching meshes.
 
     Lower body ``[0, w] x [-height, 0]``, upper body ``[0, w] x [gap, gap + height]``. Every
@@ -587,7 +454,7 @@ def patch_2d(
 
     Returns
     -------
-    SceneMesh
+    MeshData
         Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"`` (bottom
         of upper, 11), ``"lower_contact"`` (top of lower, 12), ``"upper_top"`` (13),
         ``"lower_bottom"`` (14), ``"upper_left"`` (15), ``"lower_left"`` (16),
@@ -645,7 +512,7 @@ def patch_2d(
         if order > 1:
             gmsh.model.mesh.setOrder(order)
 
-    return _generate(comm, "patch_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(comm, "patch_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
 
 
 def patch_3d(
@@ -659,7 +526,7 @@ def patch_3d(
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
-) -> SceneMesh:
+) -> MeshData:
     """Patch test in 3D: two stacked boxes with non-matching meshes.
 
     Lower body ``[0, w]^2 x [-height, 0]``, upper body ``[0, w]^2 x [gap, gap + height]``.
@@ -687,7 +554,7 @@ def patch_3d(
 
     Returns
     -------
-    SceneMesh
+    MeshData
         Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"`` (11),
         ``"lower_contact"`` (12), ``"upper_top"`` (13), ``"lower_bottom"`` (14), then the
         side faces ``"upper_x0"``, ``"lower_x0"``, ``"upper_y0"``, ``"lower_y0"`` (faces
@@ -754,7 +621,7 @@ def patch_3d(
         if order > 1:
             gmsh.model.mesh.setOrder(order)
 
-    return _generate(comm, "patch_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(comm, "patch_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
 
 
 # --------------------------------------------------------------------------------------------
@@ -776,7 +643,7 @@ def cylinders_3d(
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
-) -> SceneMesh:
+) -> MeshData:
     """3D curved-on-curved scene: a half cylinder on a block with a cylindrical top.
 
     Upper body: the lower half of the cylinder of radius R with axis along y through
@@ -810,7 +677,7 @@ def cylinders_3d(
 
     Returns
     -------
-    SceneMesh
+    MeshData
         Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"``
         (curved face, 11), ``"lower_contact"`` (curved top, 12), ``"upper_top"`` (flat face
         z = R + gap, 13), ``"lower_bottom"`` (14), ``"upper_ends"`` (faces y = +-length/2,
@@ -895,7 +762,7 @@ def cylinders_3d(
         if order > 1:
             gmsh.model.mesh.setOrder(order)
 
-    return _generate(comm, "cylinders_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(comm, "cylinders_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
 
 
 def tag_single_body(
@@ -928,7 +795,7 @@ def ironing_2d(
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
-) -> SceneMesh:
+) -> MeshData:
     """The "shallow ironing" scene: a punch with a rounded bottom over a long block.
 
     The defaults are the published geometry (Yang, Laursen & Meng 2005, as drawn by
@@ -940,7 +807,7 @@ def ironing_2d(
 
     Returns
     -------
-    SceneMesh
+    MeshData
         Cells ``"punch"`` (1), ``"block"`` (2); facets ``"punch_contact"`` (the arc and the
         vertical sides, 11), ``"punch_top"`` (12), ``"block_contact"`` (top, 13),
         ``"block_bottom"`` (14), ``"block_sides"`` (15).
@@ -998,7 +865,7 @@ def ironing_2d(
         )
         gmsh.model.mesh.generate(2)
 
-    return _generate(comm, "ironing_2d", build, 2, _mesh_options(1), msh_file, ghost_mode)
+    return generate_mesh(comm, "ironing_2d", build, 2, _mesh_options(1), msh_file, ghost_mode)
 
 
 # --------------------------------------------------------------------------------------------
@@ -1041,7 +908,7 @@ def beams_3d(
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
-) -> SceneMesh:
+) -> MeshData:
     """Two hexahedral cantilever beams clamped at opposite ends, overlapping in plan.
 
     Structured hexahedra: ``divisions`` elements through the width and the height of the
@@ -1067,7 +934,7 @@ def beams_3d(
 
     Returns
     -------
-    SceneMesh
+    MeshData
         Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"`` (11),
         ``"lower_contact"`` (12), ``"upper_clamp"`` (end x = tip + length, 13),
         ``"lower_clamp"`` (end x = 0, 14), ``"upper_tip"`` (end x = tip, 15).
@@ -1152,4 +1019,4 @@ def beams_3d(
         )
         gmsh.model.mesh.generate(3)
 
-    return _generate(comm, "beams_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)
+    return generate_mesh(comm, "beams_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)

@@ -1,0 +1,28 @@
+"""Published results of the verification problems (shallow ironing, mu = 0.3)."""
+
+#: Global friction coefficients |Fx/Fy| at t = 1.5 of the shallow ironing problem with
+#: mu = 0.3 in the literature, as compiled by the solids4foam tutorial ``shallowIroning``
+#: (Batistic, Cardiff & Tukovic 2022, Table 1 there).
+IRONING_LITERATURE = {
+    "Poulios & Renard 2015": 0.30,
+    "Batistic et al. 2022": 0.32,
+    "Houssein 2022": 0.32,
+    "Code_Aster SSNP153": 0.34,
+    "Hartmann et al. 2009": 0.38,
+    "Yastrebov 2011": 0.47,
+    "Fischer & Wriggers 2006": 0.53,
+}
+
+#: Reaction forces on the indenter's top (magnitudes, per unit thickness in the units of E
+#: times length) of the shallow ironing problem with mu = 0.3 in the literature:
+#: ``(Fy, Fx)`` at t = 1.0 (end of pressing) and at t = 1.5 (steady sliding), read off the
+#: published curves by the solids4foam tutorial ``shallowIroning`` (Table 2 there; its
+#: newtons on a 1 mm thick domain with lengths in mm are 1e-6 of these units).
+IRONING_FORCES = {
+    "Poulios & Renard 2015": ((2.679e8, 0.553e8), (3.374e8, 1.021e8)),
+    "Batistic et al. 2022": ((3.164e8, 0.550e8), (3.951e8, 1.227e8)),
+    "Code_Aster SSNP153": ((3.320e8, 0.710e8), (4.210e8, 1.433e8)),
+    "Hartmann et al. 2009": ((3.195e8, 0.672e8), (4.084e8, 1.602e8)),
+    "Yastrebov 2011": ((2.897e8, 0.585e8), (3.595e8, 1.708e8)),
+    "Fischer & Wriggers 2006": ((2.979e8, 0.621e8), (3.651e8, 1.888e8)),
+}
