@@ -81,7 +81,6 @@ class CoulombLaw:
         self.xi_n = dolfinx.fem.Function(k.xi0.function_space)
         self.mask_n = dolfinx.fem.Function(k.mask.function_space)
         self._zero = dolfinx.fem.Function(k.mask.function_space)
-        self._gather = None  # the gather of the current projection, set by the interface
         self._gather_n = None
         self._x_commit = None
         self._xhat_n_commit = None
@@ -134,11 +133,11 @@ class CoulombLaw:
         ``"dissipation"``, ``P(q) . s_T``."""
         return {"friction": -self.t_T, "dissipation": ufl.dot(self.t_T, self.slip)}
 
-    def gathers(self, gather: np.ndarray) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
-        """The gathered fields of the law, given the gather of the current projection."""
-        self._gather = gather
+    def gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """The gathered fields of the law (after the kinematics' update): the last step's
+        master nodes gather what the converged projection gathered."""
         if self._gather_n is None:
-            self._gather_n = np.full_like(gather, -1)
+            self._gather_n = np.full_like(self.kinematics.gather, -1)
         return [(self.xhat_n, self._gather_n)]
 
     # -- the step protocol ------------------------------------------------------------
@@ -168,12 +167,12 @@ class CoulombLaw:
         the converged step. ``normal_traction``: ``t_N`` at the owned points.
         """
         k = self.kinematics
-        owned = len(self._gather)
+        owned = len(k.gather)
         self.last_slip = self.slip_at_points()
         self.last_stick = self.stick(normal_traction)
         self.last_weak_slip = self.weak_slip(self.last_stick)
         self._committed = (
-            self._gather.copy(),
+            k.gather.copy(),
             k.xhat.x.array[:owned].copy(),
             x.copy(),
             k.xi0.x.array.copy(),

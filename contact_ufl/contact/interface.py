@@ -96,11 +96,12 @@ class ContactInterface:
         #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see ``macaulay``)
         self.touching = 1e-12 * size
         radius = pair.search_radius or 0.25 * size
-        self.search = ClosestPointSearch(self.slave, self.master, radius, self.touching)
-        self.search.check_facing(
+        search = ClosestPointSearch(self.slave, self.master, radius, self.touching)
+        search.check_facing(
             f"slave surface (tag {pair.slave}) of the pair with master surface (tag {pair.master})"
         )
-        self.kinematics = MeshKinematics(u, self.slave, self.master)
+        #: the master side as the laws see it (gap, normal, projected point, master fields)
+        self.kinematics = MeshKinematics(u, self.slave, self.master, search)
         eps_N = pair.eps_N if pair.eps_N is not None else default_eps(self.slave, modulus)
         self.normal = NormalLaw(self.slave, eps_N, self.touching)
         self.t_N = self.normal.traction(self.kinematics.gap, self.kinematics.mask)
@@ -111,13 +112,12 @@ class ContactInterface:
             else None
         )
         self._surface_forms: dict[str, list[dolfinx.fem.Form]] = {}
-        self._gather = None
 
     # -- what the problem assembles ----------------------------------------------------
     @property
     def fields(self) -> list[dolfinx.fem.Function]:
         """Fields of the assembled system this pair adds (after the displacement)."""
-        own = [self.kinematics.xhat, self.normal.lambda_N]
+        own = [*self.kinematics.fields, self.normal.lambda_N]
         return own + (self.friction.fields if self.friction else [])
 
     @property
@@ -134,12 +134,9 @@ class ContactInterface:
 
     def residuals(self, v: ufl.Argument) -> tuple[ufl.Form, list[ufl.Form]]:
         """Contact part of the displacement residual, and the residuals of :attr:`fields`."""
-        ds = self.slave.ds
-        vhat = ufl.TestFunction(self.kinematics.Qx)
         traction = self.traction()
-        F_u = -ufl.dot(traction, v) * ds
-        F_x = ufl.dot(traction, self.kinematics.test_at_projection(vhat)) * ds
-        own = [F_x, self.normal.residual(self.t_N)]
+        F_u = -ufl.dot(traction, v) * self.slave.ds
+        own = [*self.kinematics.master_residuals(traction), self.normal.residual(self.t_N)]
         return F_u, own + (self.friction.residuals() if self.friction else [])
 
     def update(self, layout: StackedLayout) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
@@ -155,14 +152,8 @@ class ContactInterface:
         The gathered fields: pairs of a field and, for every owned dof of it (unrolled, local
         order), the stacked index of the displacement unknown it gathers, or -1.
         """
-        pairing = self.search.pair(self.u, layout)
-        self.kinematics.set_pairing(pairing)
-        npts = len(pairing.points)
-        self._gather = self.slave.unrolled(
-            self.kinematics.Qx, pairing.columns.reshape(npts, -1), fill=-1
-        )
-        gathers = [(self.kinematics.xhat, self._gather)]
-        return gathers + (self.friction.gathers(self._gather) if self.friction else [])
+        gathers = self.kinematics.update(layout)
+        return gathers + (self.friction.gathers() if self.friction else [])
 
     # -- the step protocol --------------------------------------------------------------
     def update_history(self, T, x, block_slice) -> None:
@@ -189,7 +180,7 @@ class ContactInterface:
     @property
     def search_time(self) -> float:
         """Seconds spent in the closest-point search so far."""
-        return self.search.time
+        return self.kinematics.search.time
 
     @property
     def lambda_N(self) -> dolfinx.fem.Function:

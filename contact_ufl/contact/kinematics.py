@@ -28,8 +28,9 @@ import numpy as np
 import ufl
 
 from contact_ufl.contact.master import MeshMaster
-from contact_ufl.contact.search import Pairing
+from contact_ufl.contact.search import ClosestPointSearch, Pairing
 from contact_ufl.contact.slave import SlaveSurface
+from contact_ufl.layout import StackedLayout
 
 
 def master_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
@@ -93,12 +94,22 @@ def smoothed_normal(xi, nodes, flags, mask) -> ufl.core.expr.Expr:
 class MeshKinematics:
     """Gap, normal and projected point of the slave points on a meshed master side.
 
+    This is the master side as the rest of a contact pair sees it: UFL expressions of the
+    slave point ``x``, the projected point ``y``, the normal ``nu`` and the proximity
+    ``gap`` (and ``mask``, where a point has a master); the assembled fields it adds
+    (:attr:`fields`) with their residuals (:meth:`master_residuals`, the master virtual work
+    of the contact traction), and :meth:`update`, which runs the search and returns what
+    the fields gather from the unknowns. Another master side (a rigid obstacle, a membrane)
+    provides the same.
+
     Parameters
     ----------
     u
         The displacement.
     slave, master
         The two sides of the pair.
+    search
+        The closest-point search of the slave points on ``master``.
 
     Attributes
     ----------
@@ -111,8 +122,14 @@ class MeshKinematics:
         The gathered master nodes (a field of the assembled system).
     """
 
-    def __init__(self, u: dolfinx.fem.Function, slave: SlaveSurface, master: MeshMaster):
-        self.u, self.slave, self.master = u, slave, master
+    def __init__(
+        self,
+        u: dolfinx.fem.Function,
+        slave: SlaveSurface,
+        master: MeshMaster,
+        search: ClosestPointSearch,
+    ):
+        self.u, self.slave, self.master, self.search = u, slave, master, search
         self.gdim = u.function_space.mesh.geometry.dim
         self.fdim = self.gdim - 1
         self.nn, self.nx = master.nn, master.nx
@@ -131,6 +148,9 @@ class MeshKinematics:
         self.frozen_projection = False
         #: the closest points of the last search
         self.projection = None
+        #: for every owned dof of ``xhat`` (unrolled), the stacked index of the unknown it
+        #: gathers, or -1 (set by :meth:`update`)
+        self.gather = None
         self._build()
 
     def nodes(self, f) -> ufl.core.expr.Expr:
@@ -174,6 +194,27 @@ class MeshKinematics:
     def test_at_projection(self, vhat: ufl.Argument) -> ufl.core.expr.Expr:
         """The master virtual displacement ``U2*(Y(X)) = sum_a N_a(xi) vhat_a``."""
         return interpolate(self.N, self.nodes(vhat), self.gdim)
+
+    @property
+    def fields(self) -> list[dolfinx.fem.Function]:
+        """Fields of the assembled system the master side adds: the gathered nodes."""
+        return [self.xhat]
+
+    def master_residuals(self, traction: ufl.core.expr.Expr) -> list[ufl.Form]:
+        """The residuals of :attr:`fields`: the virtual work of the contact traction on the
+        master side, ``int T . U2*(Y) dS_o`` (action and reaction)."""
+        vhat = ufl.TestFunction(self.Qx)
+        return [ufl.dot(traction, self.test_at_projection(vhat)) * self.slave.ds]
+
+    def update(self, layout: StackedLayout) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """Search, refresh the point data, and return the gathered fields: pairs of a field
+        and, for every owned dof of it (unrolled, local order), the stacked index of the
+        displacement unknown it gathers, or -1."""
+        pairing = self.search.pair(self.u, layout)
+        self.set_pairing(pairing)
+        npts = len(pairing.points)
+        self.gather = self.slave.unrolled(self.Qx, pairing.columns.reshape(npts, -1), fill=-1)
+        return [(self.xhat, self.gather)]
 
     def set_pairing(self, pairing: Pairing) -> None:
         """Make the point data those of a new search result (value of xi, M, nodes...)."""
