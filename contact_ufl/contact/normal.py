@@ -44,6 +44,12 @@ class NormalLaw:
         Normal augmentation parameter.
     touching
         A length of round-off: a gap within it of zero counts as touching (:func:`macaulay`).
+
+    Attributes
+    ----------
+    closing
+        The length within which an open point counts as in contact (a constant of the
+        forms): ``touching``, except in a closing iterate (:meth:`closing_iterate`).
     """
 
     def __init__(self, slave: SlaveSurface, eps_N: float, touching: float):
@@ -52,10 +58,11 @@ class NormalLaw:
         self.lambda_N = dolfinx.fem.Function(self.L, name="lambda_N")
         self.eps_N = dolfinx.fem.Constant(slave.V.mesh, float(eps_N))
         self.touching = touching
+        self.closing = dolfinx.fem.Constant(slave.V.mesh, float(touching))
 
     def traction(self, gap: ufl.core.expr.Expr, mask: ufl.core.expr.Expr):
         """The normal contact traction ``t_N = <lambda_N + eps_N g>`` (0 where ``mask`` is 0)."""
-        return mask * macaulay(self.lambda_N + self.eps_N * gap, self.eps_N * self.touching)
+        return mask * macaulay(self.lambda_N + self.eps_N * gap, self.eps_N * self.closing)
 
     def residual(self, t_N: ufl.core.expr.Expr) -> ufl.Form:
         """The multiplier equation, times ``eps_N``: its rows are forces like those of the
@@ -79,4 +86,5 @@ class NormalLaw:
 
     def in_contact(self, proj: Projection) -> np.ndarray:
         """Mask of the owned points where the bracket counts as positive (:func:`macaulay`)."""
-        return self._bracket_argument(proj) > -float(self.eps_N.value) * self.touching
+        closing = float(self.closing.value)
+        return self._bracket_argument(proj) > -float(self.eps_N.value) * closing
