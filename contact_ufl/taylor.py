@@ -52,19 +52,19 @@ def taylor_test(problem, direction: PETSc.Vec, steps: Sequence[float]) -> Taylor
     any slave point changed master facet or contact status over the steps (the remainder
     then has a kink and no order can be expected).
     """
-    comm = problem.comm
-    z = problem.x.copy()
-    problem.forget_state()
-    R0 = problem.evaluate_residual(z)
+    comm, solver = problem.comm, problem.solver
+    z = solver.x.copy()
+    solver.forget_state()
+    R0 = solver.evaluate_residual(z)
     facets0, active0 = _signature(problem)
     Jdz = R0.duplicate()
-    problem.evaluate_jacobian(z).mult(direction, Jdz)
+    solver.evaluate_jacobian(z).mult(direction, Jdz)
     zeroth, first = [], []
     facets_changed = active_changed = False
     for h in steps:
         zh = z.copy()
         zh.axpy(h, direction)
-        Rh = problem.evaluate_residual(zh)
+        Rh = solver.evaluate_residual(zh)
         facets, active = _signature(problem)
         facets_changed |= not _same(facets, facets0, comm)
         active_changed |= not _same(active, active0, comm)
@@ -72,7 +72,7 @@ def taylor_test(problem, direction: PETSc.Vec, steps: Sequence[float]) -> Taylor
         zeroth.append(Rh.norm())
         Rh.axpy(-h, Jdz)
         first.append(Rh.norm())
-    problem.evaluate_residual(z)
+    solver.evaluate_residual(z)
     return TaylorResult(
         np.asarray(steps, float), np.array(zeroth), np.array(first), facets_changed, active_changed
     )
@@ -117,9 +117,10 @@ def contact_state(
             c.lambda_T.interpolate(
                 lambda x: tangential * np.vstack([np.sin(3.0 * x[0] + k) for k in range(gdim)])
             )
-    dolfinx.fem.petsc.assign(problem.unknowns, problem.x)
-    problem.forget_state()
-    problem.evaluate_residual(problem.x)
+    solver = problem.solver
+    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
+    solver.forget_state()
+    solver.evaluate_residual(solver.x)
 
 
 def sliding_direction(
@@ -143,7 +144,7 @@ def sliding_direction(
         dl = dolfinx.fem.Function(c.L)
         dl.interpolate(lambda x: multiplier * np.cos(4.0 * x[0] + 0.3))
         fields.append(dl)
-    dz = problem.x.duplicate()
+    dz = problem.solver.x.duplicate()
     dolfinx.fem.petsc.assign(fields, dz)
     return dz
 
@@ -173,12 +174,13 @@ def curved_case(dim: int, num_steps: int = 4, mu: float = 0.0, master_normal: st
     scene = curved_pair(dim)
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu, master_normal=master_normal)
     problem = ContactProblem(scene, verbose=False)
+    solver = problem.solver  # made at the reference state, the converged state of step 0
     state = CURVED_STATES[dim]
     tag = scene.bodies[0].tag
     shift = np.array(state["shift"])
     if mu > 0:
         contact_state(problem, tag, 0.5 * shift)
-        problem.contacts[0].commit(problem.x)
+        problem.contacts[0].commit(solver.x)
         problem.contacts[0].begin_step()
     contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
     direction = sliding_direction(problem, tag, np.array(state["slide"]))

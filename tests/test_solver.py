@@ -32,7 +32,7 @@ def test_cutbacks_run_out_with_a_clear_error():
     problem = hertz_problem()
     problem.solve(num_steps=2, t_end=0.5)
     accepted = list(problem.history.steps)
-    problem.snes.setTolerances(max_it=1)  # now no step can converge
+    problem.solver.snes.setTolerances(max_it=1)  # now no step can converge
     with pytest.raises(ConvergenceError, match=r"load step from t = .* did not converge"):
         problem.solve(num_steps=1, t_end=1.0, max_cutbacks=2)
     assert problem.history.steps[: len(accepted)] == accepted  # nothing accepted is lost
