@@ -50,10 +50,12 @@ def _weakly(method: Callable) -> Callable:
 class NewtonSolver:
     """PETSc SNES Newton over the unknowns of a :class:`~contact_ufl.problem.ContactProblem`.
 
-    Usually made by :attr:`ContactProblem.solver <contact_ufl.problem.ContactProblem.solver>`
-    (one solver per problem). Making it searches the contacts at the current state and
-    commits that state as the converged state of step 0 (:meth:`ContactProblem.commit
-    <contact_ufl.problem.ContactProblem.commit>`).
+    Usually made on first use of :attr:`ContactProblem.solver
+    <contact_ufl.problem.ContactProblem.solver>`. Making it searches the contacts at the
+    current state and commits that state as the converged state of step 0
+    (:meth:`ContactProblem.commit <contact_ufl.problem.ContactProblem.commit>`); it then
+    becomes the problem's :attr:`~contact_ufl.problem.ContactProblem.solver` (one solver per
+    problem: a second one would commit the contacts and plastic histories again).
 
     Parameters
     ----------
@@ -82,6 +84,8 @@ class NewtonSolver:
         petsc_options: dict | None = None,
         petsc_options_prefix: str = "contact_",
     ):
+        if problem._solver is not None:
+            raise ValueError("this problem has a solver already (problem.solver)")
         self.problem = problem
         self.comm = problem.comm
         spaces = [f.function_space for f in problem.fields]
@@ -104,6 +108,7 @@ class NewtonSolver:
         self._J = self._assemble_jacobian_matrix(first=True)
         self.snes = self._create_snes(petsc_options or {}, petsc_options_prefix)
         self.fallback_linesearch: str | None = "bt"
+        problem._solver = self  # the solver of the problem's results that need T
 
     def _create_snes(self, options: dict, prefix: str) -> PETSc.SNES:
         snes = PETSc.SNES().create(self.comm)

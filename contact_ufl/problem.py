@@ -4,8 +4,10 @@ pseudo-time and the step protocol of everything with history.
 Data flow: scene -> forms (bulk in UFL, contact terms of :mod:`contact_ufl.contact`) over
 the assembled fields ``[u, xhat_1, lambda_1, ...]`` -> the Newton solver of
 :mod:`contact_ufl.newton` (chain rule onto the unknowns ``[u, lambda_1, ...]``) -> load
-stepping of :mod:`contact_ufl.stepping` -> results. The problem knows neither the solver nor
-the stepping; :meth:`ContactProblem.solve` makes them on first use (a convenience).
+stepping of :mod:`contact_ufl.stepping` -> results. This module imports neither:
+:attr:`ContactProblem.solver` and :meth:`ContactProblem.solve` make them on first use (a
+convenience), and the results that need the chain rule (:meth:`ContactProblem.reaction`,
+:meth:`ContactProblem.contact_residual`) ask the solver, which owns it.
 """
 
 from __future__ import annotations
@@ -246,7 +248,8 @@ class ContactProblem:
     def solver(self) -> NewtonSolver:
         """The :class:`~contact_ufl.newton.NewtonSolver` of this problem, made on first use
         with :attr:`petsc_options` (the state it starts from is the converged state of step
-        0). One solver per problem: its search state is the contacts' state."""
+        0), or the one made directly for it. One solver per problem: it owns the search
+        state of the contacts and the chain operator T."""
         if self._solver is None:
             from contact_ufl.newton import NewtonSolver
 

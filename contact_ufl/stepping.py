@@ -82,7 +82,8 @@ class LoadStepper:
     solver
         Its Newton solver.
     verbose
-        Print one line per load step on rank 0 (default: the problem's ``verbose``).
+        Print one line per load step on rank 0 (``None``: as the problem's ``verbose``
+        says at the time).
 
     Attributes
     ----------
@@ -93,7 +94,7 @@ class LoadStepper:
     def __init__(self, problem: ContactProblem, solver: NewtonSolver, verbose: bool | None = None):
         self.problem = problem
         self.solver = solver
-        self.verbose = problem.verbose if verbose is None else verbose
+        self.verbose = verbose
         self.history = History()
 
     def solve(
@@ -164,7 +165,8 @@ class LoadStepper:
         self.solver.forget_state()
 
     def _print(self, text: str) -> None:
-        if self.verbose and self.problem.comm.rank == 0:
+        verbose = self.problem.verbose if self.verbose is None else self.verbose
+        if verbose and self.problem.comm.rank == 0:
             print(text, flush=True)
 
 
