@@ -32,6 +32,7 @@ import basix.ufl
 import dolfinx
 import numpy as np
 import ufl
+from petsc4py import PETSc
 
 from contact_ufl.loads import deformation_gradient
 from contact_ufl.materials import lame_parameters
@@ -223,9 +224,20 @@ class PlasticHistory:
         out.x.scatter_forward()
         return out
 
-    def commit(self) -> None:
+    def begin_step(self) -> None:
+        """Begin a load step (step protocol): nothing to do, the history moves only in
+        :meth:`commit`, so a step cut back begins again from the same history."""
+
+    def commit(self, x: PETSc.Vec | None = None) -> None:
         """The return map at the converged displacement becomes the history (every field
-        evaluated from the old history before any is overwritten)."""
+        evaluated from the old history before any is overwritten).
+
+        Parameters
+        ----------
+        x
+            The converged unknowns (step protocol; unused: the return map reads the
+            displacement function).
+        """
         mesh, cells = self.u.function_space.mesh, self._cells
         values = [expr.eval(mesh, cells) for _, expr in self._updates]
         for (target, _), value in zip(self._updates, values, strict=True):

@@ -1,73 +1,36 @@
-"""The contact problem: forms of a scene, PETSc SNES Newton, load stepping with cut-back.
+"""The contact problem: the fields, unknowns and UFL forms of a scene, its Dirichlet data,
+pseudo-time and the step protocol of everything with history.
 
-Data flow: scene -> forms (bulk in UFL, contact terms of :mod:`contact_ufl.contact`) ->
-assembled system over ``[u, xhat_1, lambda_1, ...]`` -> chain rule ``T^T r``, ``T^T K T``
-onto the unknowns ``[u, lambda_1, ...]`` -> SNES.
+Data flow: scene -> forms (bulk in UFL, contact terms of :mod:`contact_ufl.contact`) over
+the assembled fields ``[u, xhat_1, lambda_1, ...]`` -> the Newton solver of
+:mod:`contact_ufl.newton` (chain rule onto the unknowns ``[u, lambda_1, ...]``) -> load
+stepping of :mod:`contact_ufl.stepping` -> results. This module imports neither:
+:attr:`ContactProblem.solver` and :meth:`ContactProblem.solve` make them on first use (a
+convenience), and the results that need the chain rule (:meth:`ContactProblem.reaction`,
+:meth:`ContactProblem.contact_residual`) ask the solver, which owns it.
 """
 
 from __future__ import annotations
 
-import time
-import weakref
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import dolfinx
-import dolfinx.fem.petsc as fem_petsc
 import numpy as np
 import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
 from contact_ufl.contact import ContactInterface, ContactPair
-from contact_ufl.errors import ConvergenceError
-from contact_ufl.layout import StackedLayout, chain_operator
+from contact_ufl.layout import StackedLayout
 from contact_ufl.loads import BodyForce, deformation_gradient, evaluate, load_constant
 from contact_ufl.mpi import global_bounds
 from contact_ufl.plasticity import J2Plasticity, PlasticHistory
 from contact_ufl.scene import Scene
 
-DEFAULT_PETSC_OPTIONS = {
-    "snes_type": "newtonls",
-    "snes_linesearch_type": "basic",
-    "snes_rtol": 1e-9,
-    "snes_stol": 0.0,
-    "snes_max_it": 25,
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-}
-
-
-@dataclass
-class StepRecord:
-    """What happened in one accepted load step."""
-
-    step: int
-    t: float
-    newton_iterations: int
-    residual: float
-    active_points: int
-    contact_force: np.ndarray
-    wall_s: float
-
-
-@dataclass
-class History:
-    """Accepted steps and cut-backs of a run."""
-
-    steps: list[StepRecord] = field(default_factory=list)
-    cutbacks: list[tuple[float, str]] = field(default_factory=list)
-
-
-def _weakly(method: Callable) -> Callable:
-    """A callback calling the bound ``method`` through a weak reference to its object."""
-    ref = weakref.WeakMethod(method)
-
-    def call(*args):
-        return ref()(*args)
-
-    return call
+if TYPE_CHECKING:
+    from contact_ufl.newton import NewtonSolver
+    from contact_ufl.stepping import History, LoadStepper, StepRecord
 
 
 def softer_modulus(scene: Scene, pair: ContactPair) -> float:
@@ -94,6 +57,15 @@ def _nonempty(form: ufl.Form) -> ufl.Form | None:
 class ContactProblem:
     """Quasi-static large-deformation contact of the bodies of a scene.
 
+    The problem holds the displacement, the contact interfaces and plastic histories, the
+    residual and Jacobian forms over the assembled fields, the Dirichlet rows and the load
+    constants of the pseudo-time. It is solved by a
+    :class:`~contact_ufl.newton.NewtonSolver` (:attr:`solver`) stepped by a
+    :class:`~contact_ufl.stepping.LoadStepper` (:attr:`stepper`), both made on first use::
+
+        problem = ContactProblem(scene)
+        problem.solve(num_steps=4)
+
     Parameters
     ----------
     scene
@@ -104,11 +76,37 @@ class ContactProblem:
         Quadrature degree of the bulk integrals (default: exact for P1 simplices, ``2 p``
         otherwise).
     petsc_options
-        PETSc options (SNES, KSP, PC) overriding :data:`DEFAULT_PETSC_OPTIONS`.
+        PETSc options (Newton, KSP, PC) of :attr:`solver`, overriding
+        :data:`contact_ufl.newton.DEFAULT_PETSC_OPTIONS`.
     petsc_options_prefix
         Prefix of those options in the PETSc options database.
     verbose
         Print one line per load step (rank 0).
+
+    Attributes
+    ----------
+    u
+        The displacement.
+    t
+        The pseudo-time (load factor) of loads and prescribed displacements.
+    contacts
+        The contact interfaces, one per contact pair of the scene.
+    histories
+        The :class:`~contact_ufl.plasticity.PlasticHistory` of each elastoplastic body, by
+        cell tag.
+    fields, unknowns
+        The assembled fields ``[u, xhat_1, lambda_1, ...]`` and the unknowns
+        ``[u, lambda_1, ...]``.
+    layout, full_layout
+        Numbering of the unknowns and of the assembled fields.
+    residual_form, jacobian_form
+        The compiled blocked residual (rows: ``fields``) and Jacobian (``fields`` x
+        ``fields``).
+    dirichlet_rows
+        Local (owned) indices of the prescribed displacement dofs (unrolled).
+    dirichlet_scale
+        The stiffness ``k = E L^(d-2)`` of the prescribed-displacement equations
+        ``k (u - g) = 0`` (every row of the residual is then a force).
     """
 
     def __init__(
@@ -125,6 +123,8 @@ class ContactProblem:
         mesh = scene.mesh
         self.comm = mesh.comm
         self.verbose = verbose
+        self.petsc_options = dict(petsc_options or {})
+        self.petsc_options_prefix = petsc_options_prefix
         gdim = mesh.geometry.dim
         self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (gdim,)))
         self.u = dolfinx.fem.Function(self.V, name="displacement")
@@ -151,10 +151,8 @@ class ContactProblem:
         ]
         self._build_forms()
         self._build_dirichlet()
-        self._build_solver(petsc_options or {}, petsc_options_prefix)
-        self.history = History()
-        #: line search of the second try of a failed Newton solve (see :meth:`solve_step`)
-        self.fallback_linesearch: str | None = "bt"
+        self._solver: NewtonSolver | None = None
+        self._stepper: LoadStepper | None = None
 
     # -- forms ------------------------------------------------------------------------
     def first_piola(self, body) -> ufl.core.expr.Expr:
@@ -187,7 +185,6 @@ class ContactProblem:
             fields += c.fields
             unknowns += c.unknowns
         self.fields, self.unknowns = fields, unknowns
-        self._field_index = {id(f): k for k, f in enumerate(fields)}
         jacobian = [
             [_nonempty(ufl.derivative(Fi, f, ufl.TrialFunction(f.function_space))) for f in fields]
             for Fi in residuals
@@ -198,11 +195,8 @@ class ContactProblem:
         self._contact_residual_form = None
         self._load_resultant_forms = None
         self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
-        spaces = [f.function_space for f in fields]
-        self.full_layout = StackedLayout(spaces)
+        self.full_layout = StackedLayout([f.function_space for f in fields])
         self.layout = StackedLayout([f.function_space for f in unknowns])
-        self._r = fem_petsc.create_vector(spaces, kind="mpi")
-        self._K = fem_petsc.create_matrix(self.jacobian_form, kind="mpi")
 
     def _build_dirichlet(self) -> None:
         mesh, fdim = self.V.mesh, self.V.mesh.topology.dim - 1
@@ -219,15 +213,16 @@ class ContactProblem:
                 self._bc_values.append((bc, i))
         # prescribed-displacement equations k (u - g) = 0 are scaled by a stiffness k = E L^(d-2)
         # so that every row of the residual is a force (one absolute tolerance for all)
-        size, E = self._scales()
-        self._bc_scale = E * size ** (gdim - 2)
-        self._bc_rows = (
+        size, E = self.scales()
+        self.dirichlet_scale = E * size ** (gdim - 2)
+        self.dirichlet_rows = (
             np.concatenate(self._bc_dofs).astype(np.int64)
             if self._bc_dofs
             else np.zeros(0, np.int64)
         )
 
-    def _prescribed(self, t: float) -> np.ndarray:
+    def prescribed(self, t: float) -> np.ndarray:
+        """The prescribed displacements ``g(t)`` of the rows :attr:`dirichlet_rows`."""
         values = []
         for dofs, (bc, i) in zip(self._bc_dofs, self._bc_values, strict=True):
             value = evaluate(bc.value, t)
@@ -235,118 +230,91 @@ class ContactProblem:
             values.append(np.full(len(dofs), float(value)))
         return np.concatenate(values) if values else np.zeros(0)
 
-    # -- solver -----------------------------------------------------------------------
-    def _build_solver(self, options: dict, prefix: str) -> None:
-        self.x = fem_petsc.create_vector([f.function_space for f in self.unknowns], kind="mpi")
-        fem_petsc.assign(self.unknowns, self.x)
-        self._R = self.x.duplicate()
-        self._J = None
-        self._T = None
-        self._JT = None
-        self._pattern = None
-        self._state = None
-        self._update_contact(self.x)
-        for c in self.contacts:  # the initial state is the converged state of step 0
-            c.commit(self.x)
-            c.begin_step()
-        self._state = None
-        self._update_contact(self.x)
-        self._J = self._assemble_jacobian_matrix(first=True)
-        self.snes = PETSc.SNES().create(self.comm)
-        self.snes.setOptionsPrefix(prefix)
-        opts = PETSc.Options()
-        for key, value in {
-            **DEFAULT_PETSC_OPTIONS,
-            "snes_atol": self._default_atol(),
-            **options,
-        }.items():
-            opts[f"{prefix}{key}"] = value
-        # weak callbacks: the solver must not keep the problem (and its meshes, spaces and
-        # communicators) alive through a reference cycle that Python's collector cannot see
-        self.snes.setFunction(_weakly(self._residual), self._R)
-        self.snes.setJacobian(_weakly(self._jacobian), self._J)
-        self.snes.setFromOptions()
-        self.snes.getKSP().setFromOptions()
-
-    def _scales(self) -> tuple[float, float]:
-        """The scene's diameter L and largest Young's modulus E."""
+    def scales(self) -> tuple[float, float]:
+        """The scene's diameter L and largest Young's modulus E (collective)."""
         lo, hi = global_bounds(self.comm, self.V.mesh.geometry.x)
         return float(np.linalg.norm(hi - lo)), max(b.material.E for b in self.scene.bodies)
 
-    def _default_atol(self) -> float:
-        """A force scale: 1e-11 of ``E_max L^(d-1)`` with L the scene's diameter."""
-        size, E = self._scales()
-        return 1e-11 * E * size ** (self.V.mesh.geometry.dim - 1)
+    # -- pseudo-time and the step protocol ----------------------------------------------
+    def set_time(self, t: float) -> None:
+        """Set the pseudo-time (load factor) of loads and prescribed displacements."""
+        self.t = t
+        for load, c in self._load_constants:
+            c.value = evaluate(load.value, t)
 
-    def _set_state(self, x: PETSc.Vec) -> None:
-        if self._state is not None and x.equal(self._state):
-            return
-        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-        fem_petsc.assign(x, self.unknowns)
-        for f in self.unknowns:
-            f.x.scatter_forward()
-        self._update_contact(x)
-        self._state = x.copy()
+    def _parts_with_history(self) -> list:
+        return [*self.contacts, *self.histories.values()]
 
-    def _update_contact(self, x: PETSc.Vec) -> None:
-        """Search, refresh the contact data and (if the pairing changed) the operator T."""
-        gathers = [c.update(self.layout) for c in self.contacts]
-        pattern = [cols for g in gathers for _, cols in g]
-        pattern = np.concatenate(pattern) if pattern else np.zeros(0, np.int64)
-        changed = self._pattern is None or not np.array_equal(pattern, self._pattern)
-        changed = self.comm.allreduce(changed, MPI.LOR)
-        if changed:
-            self._pattern = pattern
-            self._T = self._chain_operator(gathers)
-            self._JT = None
-        for c in self.contacts:
-            c.update_history(self._T, x, self._block_slice)
+    def begin_step(self) -> None:
+        """Begin a load step from the last committed state, in every part with history
+        (contacts, plastic histories). Idempotent: a step cut back and tried again begins
+        from the same state."""
+        for part in self._parts_with_history():
+            part.begin_step()
 
-    def _chain_operator(self, gathers: list[list]) -> PETSc.Mat:
-        """``T``: identity from each unknown to its assembled field, gathers for the others."""
-        unknown_index = {id(f): k for k, f in enumerate(self.unknowns)}
-        identity, gather_blocks, gather_cols = [], [], []
-        for row, f in enumerate(self.fields):
-            if id(f) in unknown_index:
-                identity.append((row, unknown_index[id(f)]))
-        for g in gathers:
-            for f, cols in g:
-                gather_blocks.append(self._field_index[id(f)])
-                gather_cols.append(cols)
-        return chain_operator(self.full_layout, self.layout, identity, gather_blocks, gather_cols)
+    def commit(self, x: PETSc.Vec) -> None:
+        """Accept the current state, of unknowns ``x``, as the converged state of a load
+        step, in every part with history (contacts, then plastic histories)."""
+        for part in self._parts_with_history():
+            part.commit(x)
 
-    def _block_slice(self, f: dolfinx.fem.Function) -> slice:
-        """Local (owned) range of the assembled field ``f`` in the full layout."""
-        k = self._field_index[id(f)]
-        start = int(self.full_layout.local_sizes[:k].sum())
-        return slice(start, start + int(self.full_layout.local_sizes[k]))
+    # -- solver and load stepping (made on first use) -----------------------------------
+    @property
+    def solver(self) -> NewtonSolver:
+        """The :class:`~contact_ufl.newton.NewtonSolver` of this problem, made on first use
+        with :attr:`petsc_options` (the state it starts from is the converged state of step
+        0), or the one made directly for it. One solver per problem: it owns the search
+        state of the contacts and the chain operator T."""
+        if self._solver is None:
+            from contact_ufl.newton import NewtonSolver
 
-    def _residual(self, snes, x, F) -> None:
-        self._set_state(x)
-        self._assemble(self.residual_form, F)
-        if len(self._bc_rows):
-            u = self.u.x.array[self._bc_rows]
-            F.array[self._bc_rows] = self._bc_scale * (u - self._prescribed(self.t))
+            self._solver = NewtonSolver(self, self.petsc_options, self.petsc_options_prefix)
+        return self._solver
 
-    def _assemble(self, forms, out: PETSc.Vec) -> PETSc.Vec:
-        """Assemble ``forms`` over the assembled fields and map them to the unknowns."""
-        r = self._r
-        with r.localForm() as r_local:
-            r_local.set(0.0)
-        fem_petsc.assemble_vector(r, forms)
-        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self._T.multTranspose(r, out)
-        return out
+    @property
+    def stepper(self) -> LoadStepper:
+        """The :class:`~contact_ufl.stepping.LoadStepper` of :attr:`solver`, made on first
+        use."""
+        if self._stepper is None:
+            from contact_ufl.stepping import LoadStepper
 
+            self._stepper = LoadStepper(self, self.solver)
+        return self._stepper
+
+    @property
+    def history(self) -> History:
+        """Accepted steps and cut-backs of :meth:`solve` so far."""
+        return self.stepper.history
+
+    def solve(
+        self,
+        num_steps: int = 10,
+        t_end: float = 1.0,
+        max_cutbacks: int = 8,
+        callback: Callable[[ContactProblem, StepRecord], None] | None = None,
+    ) -> History:
+        """Load stepping from the current pseudo-time to ``t_end`` in ``num_steps`` steps.
+
+        A convenience: :meth:`LoadStepper.solve <contact_ufl.stepping.LoadStepper.solve>`
+        of :attr:`stepper` (cut-back of failed steps, :class:`ConvergenceError
+        <contact_ufl.errors.ConvergenceError>` when cut-backs run out).
+
+        Returns
+        -------
+        The :attr:`history` of all solves of this problem.
+        """
+        return self.stepper.solve(num_steps, t_end, max_cutbacks, callback)
+
+    # -- results --------------------------------------------------------------------
     def reaction(self, tag: int | str) -> np.ndarray:
         """Resultant of the support reaction on the facets ``tag`` (an integer or the name of
         a physical group) at the current state.
 
         It is the residual of the displacement equations (internal minus external forces,
         contact included) summed over the dofs of those facets, without the equations that
-        prescribe them.
+        prescribe them (assembled by :attr:`solver`, which owns the chain rule).
         """
-        R = self._assemble(self.residual_form, self._R.duplicate())
+        R = self.solver.assemble(self.residual_form)
         gdim = self.V.mesh.geometry.dim
         owned = self.V.dofmap.index_map.size_local
         facets = self.scene.facet_tags.find(self.scene.facet_tag(tag))
@@ -378,183 +346,13 @@ class ContactProblem:
 
     def contact_residual(self) -> PETSc.Vec:
         """The contact terms alone of the residual at the current state, as a vector of the
-        unknowns (master parts gathered through the chain-rule operator)."""
+        unknowns (master parts gathered through the chain rule of :attr:`solver`)."""
         if self._contact_residual_form is None:
             self._contact_residual_form = dolfinx.fem.form(
                 self._contact_residual_ufl, entity_maps=[c.slave.entity_map for c in self.contacts]
             )
-        return self._assemble(self._contact_residual_form, self._R.duplicate())
+        return self.solver.assemble(self._contact_residual_form)
 
-    def _assemble_jacobian_matrix(self, first: bool = False) -> PETSc.Mat:
-        K = self._K
-        K.zeroEntries()
-        fem_petsc.assemble_matrix(K, self.jacobian_form)
-        K.assemble()
-        if self._JT is None:
-            self._JT = K.PtAP(self._T)
-            new_pattern = True
-        else:
-            K.PtAP(self._T, result=self._JT)
-            new_pattern = False
-        if first:
-            J = self._JT.duplicate(copy=True)
-            J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
-            self._zero_bc_rows(J)
-            return J
-        J = self._J
-        J.zeroEntries()
-        structure = (
-            PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
-            if new_pattern
-            else PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
-        )
-        J.axpy(1.0, self._JT, structure=structure)
-        if new_pattern:
-            J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
-            self.snes.getKSP().getPC().reset()
-        self._zero_bc_rows(J)
-        return J
-
-    def _zero_bc_rows(self, J: PETSc.Mat) -> None:
-        rows = self.layout.owned(0, self._bc_rows).astype(PETSc.IntType)
-        J.zeroRows(rows, diag=self._bc_scale)
-
-    def _jacobian(self, snes, x, J, P) -> None:
-        self._set_state(x)
-        self._assemble_jacobian_matrix()
-
-    def forget_state(self) -> None:
-        """Make the next evaluation redo the search even at an unchanged state."""
-        self._state = None
-
-    def evaluate_residual(self, x: PETSc.Vec) -> PETSc.Vec:
-        """The residual at the unknowns ``x`` (a new vector); sets the state to ``x``."""
-        F = self._R.duplicate()
-        self._residual(self.snes, x, F)
-        return F
-
-    def evaluate_jacobian(self, x: PETSc.Vec) -> PETSc.Mat:
-        """The Jacobian at the unknowns ``x`` (the solver's matrix); sets the state to ``x``."""
-        self._jacobian(self.snes, x, self._J, self._J)
-        return self._J
-
-    # -- load stepping --------------------------------------------------------------
-    def set_time(self, t: float) -> None:
-        """Set the pseudo-time (load factor) of loads and prescribed displacements."""
-        self.t = t
-        for load, c in self._load_constants:
-            c.value = evaluate(load.value, t)
-
-    def solve_step(self, t: float) -> tuple[bool, int, str]:
-        """Solve for pseudo-time ``t`` from the current state.
-
-        Newton takes full steps first. Where that fails (a semismooth Newton can cycle
-        between contact or stick/slip states, or overshoot into inverted elements), the step
-        is solved once more from the same start with the backtracking line search
-        :attr:`fallback_linesearch` (``None``: no second try), before the caller cuts it back.
-
-        Returns
-        -------
-        converged, Newton iterations (of both tries), SNES converged reason (name)
-        """
-        self.set_time(t)
-        for c in self.contacts:
-            c.begin_step()
-        fem_petsc.assign(self.unknowns, self.x)
-        start = self.x.copy()
-        reason, its = self._newton()
-        linesearch = self.snes.getLineSearch()
-        primary = linesearch.getType()
-        if reason <= 0 and self.fallback_linesearch not in (None, primary):
-            start.copy(self.x)
-            linesearch.setType(self.fallback_linesearch)
-            try:
-                reason, more = self._newton()
-            finally:
-                linesearch.setType(primary)
-            its += more
-        self._state = None
-        self._set_state(self.x)
-        names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
-        return reason > 0, its, names.get(reason, str(reason))
-
-    def _newton(self) -> tuple[int, int]:
-        """One SNES solve from ``self.x``: converged reason and iterations."""
-        self._state = None
-        try:
-            self.snes.solve(None, self.x)
-            reason = self.snes.getConvergedReason()
-        except PETSc.Error as error:  # e.g. a failed factorisation: a failed step, not a crash
-            self._print(f"  PETSc error in the Newton solve: {error}")
-            reason = PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
-        if reason <= 0:
-            self.snes.getKSP().getPC().reset()  # no stale factorisation in the next try
-        return reason, self.snes.getIterationNumber()
-
-    def solve(
-        self,
-        num_steps: int = 10,
-        t_end: float = 1.0,
-        max_cutbacks: int = 8,
-        callback: Callable[[ContactProblem, StepRecord], None] | None = None,
-    ) -> History:
-        """Load stepping from the current pseudo-time to ``t_end`` in ``num_steps`` steps.
-
-        A step whose Newton solve fails is restored and halved; after two converged steps in
-        a row the step grows back (at most to its initial size). A step smaller than the
-        initial one halved ``max_cutbacks`` times raises :class:`ConvergenceError`, which
-        names the step. Accepted steps are in :attr:`history` (and were passed to
-        ``callback``, e.g. a :class:`~contact_ufl.output.ResultWriter`) whatever happens later.
-        """
-        dt0 = (t_end - self.t) / num_steps
-        dt, streak = dt0, 0
-        while self.t < t_end - 1e-12 * abs(t_end):
-            t_prev, t_new = self.t, min(self.t + dt, t_end)
-            saved = [f.x.array.copy() for f in self.unknowns]
-            start = time.perf_counter()
-            ok, its, reason = self.solve_step(t_new)
-            if not ok:
-                self._restore(saved, t_prev)
-                self.history.cutbacks.append((t_new, reason))
-                self._print(f"  step to t = {t_new:.5g} failed ({reason}): cutting back")
-                dt, streak = 0.5 * dt, 0
-                if dt < dt0 * 0.5**max_cutbacks * (1.0 - 1e-9):
-                    raise ConvergenceError(
-                        f"load step from t = {t_prev:.6g} to t = {t_new:.6g} did not converge "
-                        f"({reason}) after {max_cutbacks} cut-backs; the state of "
-                        f"t = {t_prev:.6g} is kept"
-                    )
-                continue
-            record = StepRecord(
-                len(self.history.steps) + 1,
-                t_new,
-                its,
-                self.snes.getFunctionNorm(),
-                self.active_points(),
-                self.contact_force(),
-                time.perf_counter() - start,
-            )
-            self.history.steps.append(record)
-            for c in self.contacts:
-                c.commit(self.x)
-            for h in self.histories.values():
-                h.commit()
-            self._state = None
-            self._print(self._format(record))
-            if callback is not None:
-                callback(self, record)
-            streak += 1
-            if streak >= 2 and dt < dt0:
-                dt, streak = min(2.0 * dt, dt0), 0
-        return self.history
-
-    def _restore(self, saved: list[np.ndarray], t: float) -> None:
-        for f, a in zip(self.unknowns, saved, strict=True):
-            f.x.array[:] = a
-        self.set_time(t)
-        self._state = None
-
-    # -- results --------------------------------------------------------------------
     def contact_force(self, k: int | None = None) -> np.ndarray:
         """Resultant contact force on the slave body, ``int (t_N nu - P(q)) dS_o`` (all pairs;
         the frictional part only with friction)."""
@@ -583,14 +381,3 @@ class ContactProblem:
     def search_time(self) -> float:
         """Seconds spent in the closest-point projection so far."""
         return sum(c.search_time for c in self.contacts)
-
-    def _format(self, r: StepRecord) -> str:
-        force = " ".join(f"{f: .4e}" for f in r.contact_force)
-        return (
-            f"step {r.step:3d}  t = {r.t:.4f}  newton {r.newton_iterations:2d}  "
-            f"|R| = {r.residual:.2e}  active {r.active_points:5d}  contact force [{force}]"
-        )
-
-    def _print(self, text: str) -> None:
-        if self.verbose and self.comm.rank == 0:
-            print(text, flush=True)

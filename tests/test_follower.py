@@ -91,10 +91,10 @@ def follower_beam():
     tips = {}
     problem.solve(num_steps=10, t_end=0.5)
     tips[1.0] = point_displacement(problem, (L, 0.0)) / L
-    problem.snes.setConvergenceHistory(length=100, reset=True)
+    problem.solver.snes.setConvergenceHistory(length=100, reset=True)
     problem.solve(num_steps=10, t_end=1.0)
     tips[2.0] = point_displacement(problem, (L, 0.0)) / L
-    residuals = problem.snes.getConvergenceHistory()[0]
+    residuals = problem.solver.snes.getConvergenceHistory()[0]
     return problem, P, tips, residuals
 
 
@@ -136,7 +136,7 @@ def test_follower_tangent_taylor(follower_beam):
     problem, _, _, _ = follower_beam
     du = dolfinx.fem.Function(problem.V)
     du.interpolate(lambda x: smooth_field(x, 0.01, 2))
-    direction = problem.x.duplicate()
+    direction = problem.solver.x.duplicate()
     dolfinx.fem.petsc.assign([du], direction)
     # steps small enough for a missing load stiffness to show (slope -> 1 from h ~ 1e-3)
     result = taylor_test(problem, direction, [1e-3 * 2.0**-j for j in range(4)])

@@ -46,12 +46,13 @@ def test_no_nan_where_q_vanishes():
     c = problem.contacts[0]
     c.friction.lambda_T.x.array[:] = 0.0
     c.friction.mask_n.x.array[:] = 0.0  # no slip history
-    problem.forget_state()
+    solver = problem.solver
+    solver.forget_state()
     import dolfinx.fem.petsc
 
-    dolfinx.fem.petsc.assign(problem.unknowns, problem.x)
-    R = problem.evaluate_residual(problem.x)
-    J = problem.evaluate_jacobian(problem.x)
+    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
+    R = solver.evaluate_residual(solver.x)
+    J = solver.evaluate_jacobian(solver.x)
     assert np.isfinite(R.norm()) and np.isfinite(J.norm())
 
 

@@ -119,8 +119,8 @@ def test_consistent_tangent_in_plastic_flow():
     x = problem.V.tabulate_dof_coordinates()
     values = problem.u.x.array.reshape(-1, 3)
     values[:, 0] += 0.01 * x[:, 0]  # further stretch: every point flows
-    fem_petsc.assign([problem.u], problem.x)
-    direction = problem.x.duplicate()
+    fem_petsc.assign([problem.u], problem.solver.x)
+    direction = problem.solver.x.duplicate()
     field = dolfinx.fem.Function(problem.V)
     field.x.array[:] = smooth_field(x.T, 1.0, 3).T.ravel()
     fem_petsc.assign([field], direction)

@@ -3,10 +3,13 @@
 import gc
 import weakref
 
+import numpy as np
 import pytest
 
 from contact_ufl.errors import ConvergenceError
+from contact_ufl.newton import NewtonSolver
 from contact_ufl.problem import ContactProblem
+from contact_ufl.stepping import LoadStepper
 from contact_ufl.verification import scenes
 
 
@@ -32,11 +35,30 @@ def test_cutbacks_run_out_with_a_clear_error():
     problem = hertz_problem()
     problem.solve(num_steps=2, t_end=0.5)
     accepted = list(problem.history.steps)
-    problem.snes.setTolerances(max_it=1)  # now no step can converge
+    problem.solver.snes.setTolerances(max_it=1)  # now no step can converge
     with pytest.raises(ConvergenceError, match=r"load step from t = .* did not converge"):
         problem.solve(num_steps=1, t_end=1.0, max_cutbacks=2)
     assert problem.history.steps[: len(accepted)] == accepted  # nothing accepted is lost
     assert problem.t == pytest.approx(accepted[-1].t)  # state restored to the last accepted
+
+
+def test_solver_and_stepping_made_by_hand():
+    """``problem.solve`` is the solver and the load stepping composed: made by hand they give
+    the same steps and forces to the last bit; a problem has one solver."""
+    problem = hertz_problem()
+    solver = NewtonSolver(problem)
+    assert problem.solver is solver
+    history = LoadStepper(problem, solver).solve(num_steps=4)
+    reference = hertz_problem()
+    reference.solve(num_steps=4)
+    assert [(r.t, r.newton_iterations, r.residual) for r in history.steps] == [
+        (r.t, r.newton_iterations, r.residual) for r in reference.history.steps
+    ]
+    tag = problem.scene.dirichlet[0].tag
+    assert np.array_equal(problem.contact_force(), reference.contact_force())
+    assert np.array_equal(problem.reaction(tag), reference.reaction(tag))
+    with pytest.raises(ValueError, match="has a solver already"):
+        NewtonSolver(problem)
 
 
 def test_a_dropped_problem_is_freed():

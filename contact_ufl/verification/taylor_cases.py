@@ -58,9 +58,10 @@ def contact_state(
             c.friction.lambda_T.interpolate(
                 lambda x: tangential * np.vstack([np.sin(3.0 * x[0] + k) for k in range(gdim)])
             )
-    dolfinx.fem.petsc.assign(problem.unknowns, problem.x)
-    problem.forget_state()
-    problem.evaluate_residual(problem.x)
+    solver = problem.solver
+    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
+    solver.forget_state()
+    solver.evaluate_residual(solver.x)
 
 
 def sliding_direction(
@@ -82,7 +83,7 @@ def sliding_direction(
         dl = dolfinx.fem.Function(c.normal.L)
         dl.interpolate(lambda x: multiplier * np.cos(4.0 * x[0] + 0.3))
         fields.append(dl)
-    dz = problem.x.duplicate()
+    dz = problem.solver.x.duplicate()
     dolfinx.fem.petsc.assign(fields, dz)
     return dz
 
@@ -107,12 +108,13 @@ def curved_case(dim: int, num_steps: int = 4, mu: float = 0.0, master_normal: st
     scene = curved_pair(dim)
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu, master_normal=master_normal)
     problem = ContactProblem(scene, verbose=False)
+    solver = problem.solver  # made at the reference state, the converged state of step 0
     state = CURVED_STATES[dim]
     tag = scene.bodies[0].tag
     shift = np.array(state["shift"])
     if mu > 0:
         contact_state(problem, tag, 0.5 * shift)
-        problem.contacts[0].commit(problem.x)
+        problem.contacts[0].commit(solver.x)
         problem.contacts[0].begin_step()
     contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
     direction = sliding_direction(problem, tag, np.array(state["slide"]))

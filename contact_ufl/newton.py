@@ -1,0 +1,319 @@
+"""Newton's method (PETSc SNES) over the unknowns of a contact problem.
+
+The residual and Jacobian forms of :class:`~contact_ufl.problem.ContactProblem` are
+assembled over the fields ``[u, xhat_1, lambda_1, ...]``; the chain operator ``T`` of
+:mod:`contact_ufl.layout` (identity on the unknowns, the gathers ``xhat = Xhat + P u``)
+maps them onto the unknowns ``[u, lambda_1, ...]``: residual ``T^T r``, tangent
+``T^T K T``. The search runs at every new state; ``T`` and the tangent's sparsity pattern
+change only when the pairing does.
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import dolfinx
+import dolfinx.fem.petsc as fem_petsc
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from contact_ufl.layout import chain_operator
+
+if TYPE_CHECKING:
+    from contact_ufl.problem import ContactProblem
+
+DEFAULT_PETSC_OPTIONS = {
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "basic",
+    "snes_rtol": 1e-9,
+    "snes_stol": 0.0,
+    "snes_max_it": 25,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+
+def _weakly(method: Callable) -> Callable:
+    """A callback calling the bound ``method`` through a weak reference to its object."""
+    ref = weakref.WeakMethod(method)
+
+    def call(*args):
+        return ref()(*args)
+
+    return call
+
+
+class NewtonSolver:
+    """PETSc SNES Newton over the unknowns of a :class:`~contact_ufl.problem.ContactProblem`.
+
+    Usually made on first use of :attr:`ContactProblem.solver
+    <contact_ufl.problem.ContactProblem.solver>`. Making it searches the contacts at the
+    current state and commits that state as the converged state of step 0
+    (:meth:`ContactProblem.commit <contact_ufl.problem.ContactProblem.commit>`); it then
+    becomes the problem's :attr:`~contact_ufl.problem.ContactProblem.solver` (one solver per
+    problem: a second one would commit the contacts and plastic histories again).
+
+    Parameters
+    ----------
+    problem
+        The problem: fields, unknowns, forms, Dirichlet rows, pseudo-time.
+    petsc_options
+        PETSc options (SNES, KSP, PC) overriding :data:`DEFAULT_PETSC_OPTIONS`; the
+        default ``snes_atol`` is ``1e-11 E_max L^(d-1)`` (a force, L the scene's diameter).
+    petsc_options_prefix
+        Prefix of those options in the PETSc options database.
+
+    Attributes
+    ----------
+    x
+        The unknowns ``[u, lambda_1, ...]`` (a PETSc vector; the problem's functions hold
+        the same values at the current state).
+    snes
+        The PETSc SNES.
+    fallback_linesearch
+        Line search of the second try of a failed Newton solve (see :meth:`solve_step`).
+    """
+
+    def __init__(
+        self,
+        problem: ContactProblem,
+        petsc_options: dict | None = None,
+        petsc_options_prefix: str = "contact_",
+    ):
+        if problem._solver is not None:
+            raise ValueError("this problem has a solver already (problem.solver)")
+        self.problem = problem
+        self.comm = problem.comm
+        spaces = [f.function_space for f in problem.fields]
+        self._field_index = {id(f): k for k, f in enumerate(problem.fields)}
+        self._r = fem_petsc.create_vector(spaces, kind="mpi")
+        self._K = fem_petsc.create_matrix(problem.jacobian_form, kind="mpi")
+        self.x = fem_petsc.create_vector([f.function_space for f in problem.unknowns], kind="mpi")
+        fem_petsc.assign(problem.unknowns, self.x)
+        self._R = self.x.duplicate()
+        self._J = None
+        self._T = None
+        self._JT = None
+        self._pattern = None
+        self._state = None
+        self._update_contact(self.x)
+        problem.commit(self.x)  # the initial state is the converged state of step 0
+        problem.begin_step()
+        self._state = None
+        self._update_contact(self.x)
+        self._J = self._assemble_jacobian_matrix(first=True)
+        self.snes = self._create_snes(petsc_options or {}, petsc_options_prefix)
+        self.fallback_linesearch: str | None = "bt"
+        problem._solver = self  # the solver of the problem's results that need T
+
+    def _create_snes(self, options: dict, prefix: str) -> PETSc.SNES:
+        snes = PETSc.SNES().create(self.comm)
+        snes.setOptionsPrefix(prefix)
+        opts = PETSc.Options()
+        for key, value in {
+            **DEFAULT_PETSC_OPTIONS,
+            "snes_atol": self._default_atol(),
+            **options,
+        }.items():
+            opts[f"{prefix}{key}"] = value
+        # weak callbacks: the SNES must not keep the solver (and its problem, meshes, spaces
+        # and communicators) alive through a reference cycle that Python's collector cannot see
+        snes.setFunction(_weakly(self._residual), self._R)
+        snes.setJacobian(_weakly(self._jacobian), self._J)
+        snes.setFromOptions()
+        snes.getKSP().setFromOptions()
+        return snes
+
+    def _default_atol(self) -> float:
+        """A force scale: 1e-11 of ``E_max L^(d-1)`` with L the scene's diameter."""
+        size, E = self.problem.scales()
+        return 1e-11 * E * size ** (self.problem.V.mesh.geometry.dim - 1)
+
+    # -- state, search and the chain operator -----------------------------------------
+    def _set_state(self, x: PETSc.Vec) -> None:
+        if self._state is not None and x.equal(self._state):
+            return
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        fem_petsc.assign(x, self.problem.unknowns)
+        for f in self.problem.unknowns:
+            f.x.scatter_forward()
+        self._update_contact(x)
+        self._state = x.copy()
+
+    def forget_state(self) -> None:
+        """Make the next evaluation redo the search even at an unchanged state."""
+        self._state = None
+
+    def _update_contact(self, x: PETSc.Vec) -> None:
+        """Search, refresh the contact data and (if the pairing changed) the operator T."""
+        contacts = self.problem.contacts
+        gathers = [c.update(self.problem.layout) for c in contacts]
+        pattern = [cols for g in gathers for _, cols in g]
+        pattern = np.concatenate(pattern) if pattern else np.zeros(0, np.int64)
+        changed = self._pattern is None or not np.array_equal(pattern, self._pattern)
+        changed = self.comm.allreduce(changed, MPI.LOR)
+        if changed:
+            self._pattern = pattern
+            self._T = self._chain_operator(gathers)
+            self._JT = None
+        for c in contacts:
+            c.update_history(self._T, x, self._block_slice)
+
+    def _chain_operator(self, gathers: list[list]) -> PETSc.Mat:
+        """``T``: identity from each unknown to its assembled field, gathers for the others."""
+        problem = self.problem
+        unknown_index = {id(f): k for k, f in enumerate(problem.unknowns)}
+        identity, gather_blocks, gather_cols = [], [], []
+        for row, f in enumerate(problem.fields):
+            if id(f) in unknown_index:
+                identity.append((row, unknown_index[id(f)]))
+        for g in gathers:
+            for f, cols in g:
+                gather_blocks.append(self._field_index[id(f)])
+                gather_cols.append(cols)
+        return chain_operator(
+            problem.full_layout, problem.layout, identity, gather_blocks, gather_cols
+        )
+
+    def _block_slice(self, f: dolfinx.fem.Function) -> slice:
+        """Local (owned) range of the assembled field ``f`` in the full layout."""
+        k = self._field_index[id(f)]
+        sizes = self.problem.full_layout.local_sizes
+        start = int(sizes[:k].sum())
+        return slice(start, start + int(sizes[k]))
+
+    # -- residual and tangent -----------------------------------------------------------
+    def assemble(self, forms, out: PETSc.Vec | None = None) -> PETSc.Vec:
+        """Assemble the linear ``forms`` (rows: the problem's fields) at the current state and
+        map them to the unknowns, ``T^T r``.
+
+        Parameters
+        ----------
+        forms
+            Compiled blocked linear forms over the problem's fields.
+        out
+            The result (default: a new vector of the unknowns).
+        """
+        out = self._R.duplicate() if out is None else out
+        r = self._r
+        with r.localForm() as r_local:
+            r_local.set(0.0)
+        fem_petsc.assemble_vector(r, forms)
+        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self._T.multTranspose(r, out)
+        return out
+
+    def _residual(self, snes, x, F) -> None:
+        self._set_state(x)
+        problem = self.problem
+        self.assemble(problem.residual_form, F)
+        rows = problem.dirichlet_rows
+        if len(rows):
+            u = problem.u.x.array[rows]
+            F.array[rows] = problem.dirichlet_scale * (u - problem.prescribed(problem.t))
+
+    def _assemble_jacobian_matrix(self, first: bool = False) -> PETSc.Mat:
+        K = self._K
+        K.zeroEntries()
+        fem_petsc.assemble_matrix(K, self.problem.jacobian_form)
+        K.assemble()
+        if self._JT is None:
+            self._JT = K.PtAP(self._T)
+            new_pattern = True
+        else:
+            K.PtAP(self._T, result=self._JT)
+            new_pattern = False
+        if first:
+            J = self._JT.duplicate(copy=True)
+            J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+            self._zero_dirichlet_rows(J)
+            return J
+        J = self._J
+        J.zeroEntries()
+        structure = (
+            PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+            if new_pattern
+            else PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
+        )
+        J.axpy(1.0, self._JT, structure=structure)
+        if new_pattern:  # MUMPS fails on a changed pattern unless the factorisation is reset
+            J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+            self.snes.getKSP().getPC().reset()
+        self._zero_dirichlet_rows(J)
+        return J
+
+    def _zero_dirichlet_rows(self, J: PETSc.Mat) -> None:
+        problem = self.problem
+        rows = problem.layout.owned(0, problem.dirichlet_rows).astype(PETSc.IntType)
+        J.zeroRows(rows, diag=problem.dirichlet_scale)
+
+    def _jacobian(self, snes, x, J, P) -> None:
+        self._set_state(x)
+        self._assemble_jacobian_matrix()
+
+    def evaluate_residual(self, x: PETSc.Vec) -> PETSc.Vec:
+        """The residual at the unknowns ``x`` (a new vector); sets the state to ``x``."""
+        F = self._R.duplicate()
+        self._residual(self.snes, x, F)
+        return F
+
+    def evaluate_jacobian(self, x: PETSc.Vec) -> PETSc.Mat:
+        """The Jacobian at the unknowns ``x`` (the solver's matrix); sets the state to ``x``."""
+        self._jacobian(self.snes, x, self._J, self._J)
+        return self._J
+
+    # -- Newton -------------------------------------------------------------------------
+    def solve_step(self, t: float) -> tuple[bool, int, str]:
+        """Solve for pseudo-time ``t`` from the current state (a step begun by
+        :meth:`ContactProblem.begin_step <contact_ufl.problem.ContactProblem.begin_step>`).
+
+        Newton takes full steps first. Where that fails (a semismooth Newton can cycle
+        between contact or stick/slip states, or overshoot into inverted elements), the step
+        is solved once more from the same start with the backtracking line search
+        :attr:`fallback_linesearch` (``None``: no second try), before the caller cuts it back.
+
+        Returns
+        -------
+        converged, Newton iterations (of both tries), SNES converged reason (name)
+        """
+        self.problem.set_time(t)
+        fem_petsc.assign(self.problem.unknowns, self.x)
+        start = self.x.copy()
+        reason, its = self._newton()
+        linesearch = self.snes.getLineSearch()
+        primary = linesearch.getType()
+        if reason <= 0 and self.fallback_linesearch not in (None, primary):
+            start.copy(self.x)
+            linesearch.setType(self.fallback_linesearch)
+            try:
+                reason, more = self._newton()
+            finally:
+                linesearch.setType(primary)
+            its += more
+        self._state = None
+        self._set_state(self.x)
+        names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
+        return reason > 0, its, names.get(reason, str(reason))
+
+    def _newton(self) -> tuple[int, int]:
+        """One SNES solve from :attr:`x`: converged reason and iterations."""
+        self._state = None
+        try:
+            self.snes.solve(None, self.x)
+            reason = self.snes.getConvergedReason()
+        except PETSc.Error as error:  # e.g. a failed factorisation: a failed step, not a crash
+            if self.problem.verbose and self.comm.rank == 0:
+                print(f"  PETSc error in the Newton solve: {error}", flush=True)
+            reason = PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
+        if reason <= 0:
+            self.snes.getKSP().getPC().reset()  # no stale factorisation in the next try
+        return reason, self.snes.getIterationNumber()
+
+    @property
+    def residual_norm(self) -> float:
+        """Norm of the residual at the end of the last Newton solve."""
+        return self.snes.getFunctionNorm()

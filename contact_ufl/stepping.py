@@ -1,0 +1,178 @@
+"""Load stepping with cut-back: the pseudo-time from the current state to its end.
+
+Every step follows the step protocol of the problem: :meth:`begin_step
+<contact_ufl.problem.ContactProblem.begin_step>`, a Newton solve (:meth:`NewtonSolver.solve_step
+<contact_ufl.newton.NewtonSolver.solve_step>`), then, once converged, :meth:`commit
+<contact_ufl.problem.ContactProblem.commit>`. A failed step is restored and halved.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from contact_ufl.errors import ConvergenceError
+
+if TYPE_CHECKING:
+    from contact_ufl.newton import NewtonSolver
+    from contact_ufl.problem import ContactProblem
+
+
+@dataclass
+class StepRecord:
+    """What happened in one accepted load step.
+
+    Attributes
+    ----------
+    step
+        Number of the accepted step (from 1, over all solves of the problem).
+    t
+        Pseudo-time reached.
+    newton_iterations
+        Newton iterations of the step (both tries where the fallback line search ran).
+    residual
+        Norm of the residual at convergence.
+    active_points
+        Slave quadrature points in contact (all pairs).
+    contact_force
+        Resultant contact force (all pairs).
+    wall_s
+        Wall time of the accepted try of the step (seconds).
+    """
+
+    step: int
+    t: float
+    newton_iterations: int
+    residual: float
+    active_points: int
+    contact_force: np.ndarray
+    wall_s: float
+
+
+@dataclass
+class History:
+    """Accepted steps and cut-backs of a run.
+
+    Attributes
+    ----------
+    steps
+        The accepted steps.
+    cutbacks
+        Pseudo-time and SNES converged reason of every failed step.
+    """
+
+    steps: list[StepRecord] = field(default_factory=list)
+    cutbacks: list[tuple[float, str]] = field(default_factory=list)
+
+
+class LoadStepper:
+    """Load stepping with cut-back of a problem and its Newton solver.
+
+    Usually made by :attr:`ContactProblem.stepper
+    <contact_ufl.problem.ContactProblem.stepper>`.
+
+    Parameters
+    ----------
+    problem
+        The problem (pseudo-time, step protocol, results of a step).
+    solver
+        Its Newton solver.
+    verbose
+        Print one line per load step on rank 0 (``None``: as the problem's ``verbose``
+        says at the time).
+
+    Attributes
+    ----------
+    history
+        Accepted steps and cut-backs of all solves so far.
+    """
+
+    def __init__(self, problem: ContactProblem, solver: NewtonSolver, verbose: bool | None = None):
+        self.problem = problem
+        self.solver = solver
+        self.verbose = verbose
+        self.history = History()
+
+    def solve(
+        self,
+        num_steps: int = 10,
+        t_end: float = 1.0,
+        max_cutbacks: int = 8,
+        callback: Callable[[ContactProblem, StepRecord], None] | None = None,
+    ) -> History:
+        """Load stepping from the current pseudo-time to ``t_end`` in ``num_steps`` steps.
+
+        A step whose Newton solve fails is restored and halved; after two converged steps in
+        a row the step grows back (at most to its initial size). A step smaller than the
+        initial one halved ``max_cutbacks`` times raises :class:`ConvergenceError
+        <contact_ufl.errors.ConvergenceError>`, which names the step. Accepted steps are in
+        :attr:`history` (and were passed to ``callback(problem, record)``, e.g. a
+        :class:`~contact_ufl.output.ResultWriter`) whatever happens later.
+
+        Returns
+        -------
+        :attr:`history`
+        """
+        problem, solver = self.problem, self.solver
+        dt0 = (t_end - problem.t) / num_steps
+        dt, streak = dt0, 0
+        while problem.t < t_end - 1e-12 * abs(t_end):
+            t_prev, t_new = problem.t, min(problem.t + dt, t_end)
+            saved = [f.x.array.copy() for f in problem.unknowns]
+            start = time.perf_counter()
+            problem.begin_step()
+            ok, its, reason = solver.solve_step(t_new)
+            if not ok:
+                self._restore(saved, t_prev)
+                self.history.cutbacks.append((t_new, reason))
+                self._print(f"  step to t = {t_new:.5g} failed ({reason}): cutting back")
+                dt, streak = 0.5 * dt, 0
+                if dt < dt0 * 0.5**max_cutbacks * (1.0 - 1e-9):
+                    raise ConvergenceError(
+                        f"load step from t = {t_prev:.6g} to t = {t_new:.6g} did not converge "
+                        f"({reason}) after {max_cutbacks} cut-backs; the state of "
+                        f"t = {t_prev:.6g} is kept"
+                    )
+                continue
+            record = StepRecord(
+                len(self.history.steps) + 1,
+                t_new,
+                its,
+                solver.residual_norm,
+                problem.active_points(),
+                problem.contact_force(),
+                time.perf_counter() - start,
+            )
+            self.history.steps.append(record)
+            problem.commit(solver.x)
+            solver.forget_state()
+            self._print(_format(record))
+            if callback is not None:
+                callback(problem, record)
+            streak += 1
+            if streak >= 2 and dt < dt0:
+                dt, streak = min(2.0 * dt, dt0), 0
+        return self.history
+
+    def _restore(self, saved: list[np.ndarray], t: float) -> None:
+        for f, a in zip(self.problem.unknowns, saved, strict=True):
+            f.x.array[:] = a
+        self.problem.set_time(t)
+        self.solver.forget_state()
+
+    def _print(self, text: str) -> None:
+        verbose = self.problem.verbose if self.verbose is None else self.verbose
+        if verbose and self.problem.comm.rank == 0:
+            print(text, flush=True)
+
+
+def _format(r: StepRecord) -> str:
+    force = " ".join(f"{f: .4e}" for f in r.contact_force)
+    return (
+        f"step {r.step:3d}  t = {r.t:.4f}  newton {r.newton_iterations:2d}  "
+        f"|R| = {r.residual:.2e}  active {r.active_points:5d}  contact force [{force}]"
+    )
