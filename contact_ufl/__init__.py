@@ -1,10 +1,85 @@
 """contact_ufl: large-deformation frictional contact for FEniCSx.
 
-Augmented-Lagrangian mixed weak form (displacements of both bodies plus contact multipliers
+Augmented-Lagrangian mixed weak form (displacements of all bodies plus contact multipliers
 on the slave surface), closest-point projection onto the master surface, Newton (PETSc SNES)
 with the tangent from UFL's Gateaux derivative chained through the master side.
+
+A scene is read from a gmsh mesh with named physical groups, and solved::
+
+    import contact_ufl as cu
+
+    scene = cu.Scene.from_gmsh(
+        "two_blocks.msh",
+        bodies=[cu.Body("upper", cu.NeoHookean(E=1.0, nu=0.3)),
+                cu.Body("lower", cu.NeoHookean(E=1.0, nu=0.3))],
+        dirichlet=[cu.Dirichlet("lower_bottom", (0.0, 0.0)),
+                   cu.Dirichlet("upper_top", lambda t: (0.0, -0.01 * t))],
+        contacts=[cu.ContactPair(slave="upper_contact", master="lower_contact")],
+    )
+    problem = cu.ContactProblem(scene)
+    problem.solve(num_steps=4)
+    print(problem.contact_force())
+
+The parts, as modules: :mod:`.scene` (bodies, supports, loads, pairs), :mod:`.gmshio`
+(meshes from gmsh), :mod:`.materials`, :mod:`.plasticity`, :mod:`.loads`, :mod:`.contact`
+(the contact pair as composed parts), :mod:`.problem` (fields and forms), :mod:`.newton`
+(the SNES solver), :mod:`.stepping` (load stepping), :mod:`.results`, :mod:`.output`,
+:mod:`.taylor`. Verification scenes and references live in :mod:`.verification`, which the
+library never imports.
 """
 
-from contact_ufl import _stack  # noqa: F401  (loads the MPI/PETSc libraries first)
+from contact_ufl import (
+    _stack,  # noqa: F401  (loads the MPI/PETSc libraries first)
+    output,
+    results,
+)
+from contact_ufl.contact import ContactPair
+from contact_ufl.errors import ContactInputError, ConvergenceError
+from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerForce, FollowerPressure
+from contact_ufl.materials import NeoHookean, SaintVenantKirchhoff
+from contact_ufl.newton import NewtonSolver
+from contact_ufl.output import ResultWriter
+from contact_ufl.plasticity import J2Plasticity
+from contact_ufl.problem import ContactProblem
+from contact_ufl.scene import Body, Scene
+from contact_ufl.stepping import History, LoadStepper, StepRecord
+from contact_ufl.taylor import taylor_test
 
 __version__ = "0.1.0"
+
+__all__ = [
+    "Body",
+    "BodyForce",
+    "ContactInputError",
+    "ContactPair",
+    "ContactProblem",
+    "ConvergenceError",
+    "DeadTraction",
+    "Dirichlet",
+    "FollowerForce",
+    "FollowerPressure",
+    "History",
+    "J2Plasticity",
+    "LoadStepper",
+    "MeshData",
+    "NeoHookean",
+    "NewtonSolver",
+    "ResultWriter",
+    "SaintVenantKirchhoff",
+    "Scene",
+    "StepRecord",
+    "output",
+    "read_gmsh",
+    "results",
+    "taylor_test",
+]
+
+_GMSH = {"read_gmsh", "MeshData"}  # gmsh is imported when they are first used
+
+
+def __getattr__(name: str):
+    if name in _GMSH:
+        from contact_ufl import gmshio
+
+        return getattr(gmshio, name)
+    raise AttributeError(f"module 'contact_ufl' has no attribute {name!r}")

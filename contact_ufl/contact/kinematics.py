@@ -213,7 +213,9 @@ class MeshKinematics:
         pairing = self.search.pair(self.u, layout)
         self.set_pairing(pairing)
         npts = len(pairing.points)
-        self.gather = self.slave.unrolled(self.Qx, pairing.columns.reshape(npts, -1), fill=-1)
+        self.gather = self.slave.unrolled(
+            self.Qx, pairing.columns.reshape(npts, self.nx * self.gdim), fill=-1
+        )
         return [(self.xhat, self.gather)]
 
     def set_pairing(self, pairing: Pairing) -> None:
@@ -221,7 +223,7 @@ class MeshKinematics:
         slave, proj, paired = self.slave, pairing.projection, pairing.paired
         self.projection = proj
         npts = len(pairing.points)
-        xhat = pairing.nodes.reshape(npts, -1)
+        xhat = pairing.nodes.reshape(npts, self.nx * self.gdim)
         slave.set_at_points(self.xhat, xhat)
         slave.set_at_points(self.xhat0, xhat)
         slave.set_at_points(self.x0, pairing.points)
