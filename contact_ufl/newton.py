@@ -76,6 +76,9 @@ class NewtonSolver:
         The PETSc SNES.
     fallback_linesearch
         Line search of the second try of a failed Newton solve (see :meth:`solve_step`).
+    close_gaps
+        Whether a failed step whose start has a contact pair with no point in contact is
+        tried once more after a closing iterate (see :meth:`solve_step`).
     """
 
     def __init__(
@@ -108,6 +111,8 @@ class NewtonSolver:
         self._J = self._assemble_jacobian_matrix(first=True)
         self.snes = self._create_snes(petsc_options or {}, petsc_options_prefix)
         self.fallback_linesearch: str | None = "bt"
+        #: try a closing iterate where a pair has no point in contact (:meth:`solve_step`)
+        self.close_gaps = True
         problem._solver = self  # the solver of the problem's results that need T
 
     def _create_snes(self, options: dict, prefix: str) -> PETSc.SNES:
@@ -271,14 +276,26 @@ class NewtonSolver:
         """Solve for pseudo-time ``t`` from the current state (a step begun by
         :meth:`ContactProblem.begin_step <contact_ufl.problem.ContactProblem.begin_step>`).
 
-        Newton takes full steps first. Where that fails (a semismooth Newton can cycle
-        between contact or stick/slip states, or overshoot into inverted elements), the step
-        is solved once more from the same start with the backtracking line search
-        :attr:`fallback_linesearch` (``None``: no second try), before the caller cuts it back.
+        Newton takes full steps first. Where that fails, the step is solved again from the
+        same start, before the caller cuts it back:
+
+        1. with the backtracking line search :attr:`fallback_linesearch` (``None``: not
+           tried): a semismooth Newton can cycle between contact or stick/slip states, or
+           overshoot into inverted elements;
+        2. where a contact pair has no point in contact at the start (:attr:`close_gaps`):
+           after one *closing* iterate, in which the open points of such a pair within
+           twice the nearest open gap, or within a tenth of the slave mesh size, count as in
+           contact (a patch of points around the nearest one, not a single point about
+           which the body could turn). A body held only by contact and
+           pushed by a force is free until it touches: its tangent is singular at the
+           start, and no Newton step can find the contact. The closing iterate ties the
+           nearest points to the master surface, so the load has a path; the iterates after
+           it use the contact law again (points in tension are released), so the solution
+           is that of the same equations.
 
         Returns
         -------
-        converged, Newton iterations (of both tries), SNES converged reason (name)
+        converged, Newton iterations (of all tries), SNES converged reason (name)
         """
         self.problem.set_time(t)
         fem_petsc.assign(self.problem.unknowns, self.x)
@@ -294,10 +311,44 @@ class NewtonSolver:
             finally:
                 linesearch.setType(primary)
             its += more
+        if reason <= 0 and self.close_gaps:
+            start.copy(self.x)
+            open_pairs = self._open_pairs()
+            if open_pairs:
+                self._closing_iterate(open_pairs)
+                reason, more = self._newton()
+                its += 1 + more
         self._state = None
         self._set_state(self.x)
         names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
         return reason > 0, its, names.get(reason, str(reason))
+
+    def _open_pairs(self) -> list:
+        """The contact pairs with no point in contact at :attr:`x` (collective)."""
+        self._state = None
+        self._set_state(self.x)
+        contacts = self.problem.contacts
+        counts = self.comm.allreduce(np.array([c.active().sum() for c in contacts]), MPI.SUM)
+        return [c for c, n in zip(contacts, counts, strict=True) if n == 0]
+
+    def _closing_iterate(self, pairs: list) -> None:
+        """One Newton iterate from :attr:`x` in which the open points of ``pairs`` near the
+        master surface count as in contact (see :meth:`solve_step`)."""
+        self._state = None
+        self._set_state(self.x)
+        for c in pairs:
+            nearest = self.comm.allreduce(c.normal.nearest_open_gap(c.projection), MPI.MIN)
+            if np.isfinite(nearest):
+                c.normal.closing.value = max(2.0 * nearest, 0.1 * c.slave.facet_size)
+        max_it = self.snes.getTolerances()[3]
+        self.snes.setTolerances(max_it=1)
+        try:
+            self._newton()
+        finally:
+            self.snes.setTolerances(max_it=max_it)
+            for c in pairs:
+                c.normal.closing.value = c.normal.touching
+            self._state = None
 
     def _newton(self) -> tuple[int, int]:
         """One SNES solve from :attr:`x`: converged reason and iterations."""

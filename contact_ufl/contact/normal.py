@@ -49,7 +49,8 @@ class NormalLaw:
     ----------
     closing
         The length within which an open point counts as in contact (a constant of the
-        forms): ``touching``, except in a closing iterate (:meth:`closing_iterate`).
+        forms): ``touching``, except in a closing iterate (see
+        :meth:`nearest_open_gap` and :meth:`contact_ufl.newton.NewtonSolver.solve_step`).
     """
 
     def __init__(self, slave: SlaveSurface, eps_N: float, touching: float):
@@ -88,3 +89,9 @@ class NormalLaw:
         """Mask of the owned points where the bracket counts as positive (:func:`macaulay`)."""
         closing = float(self.closing.value)
         return self._bracket_argument(proj) > -float(self.eps_N.value) * closing
+
+    def nearest_open_gap(self, proj: Projection) -> float:
+        """The smallest distance from the master surface of this rank's open points that have
+        a master facet (``inf`` if none): how far the nearest open point is from touching."""
+        gap = proj.gap[(proj.facet >= 0) & (proj.gap < 0.0)]
+        return float(-gap.max(initial=-np.inf))

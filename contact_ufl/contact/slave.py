@@ -195,6 +195,17 @@ class SlaveSurface:
         pts = x.reshape(-1, gdim)
         return np.vstack([pts.min(axis=0), pts.max(axis=0)])
 
+    @functools.cached_property
+    def facet_size(self) -> float:
+        """Mean diameter of the slave facets over all ranks (the slave mesh size)."""
+        gdim = self.V.mesh.geometry.dim
+        nodes = self.submesh.geometry.dofmaps[0][: self.num_cells]
+        x = self.submesh.geometry.x[nodes, :gdim]  # (nc, nv, gdim)
+        diameters = np.linalg.norm(x[:, :, None] - x[:, None, :], axis=-1).max(axis=(1, 2))
+        comm = self.V.mesh.comm
+        total, count = comm.allreduce(np.array([diameters.sum(), len(diameters)]), MPI.SUM)
+        return float(total / count)
+
     # -- data at the slave points: quadrature elements on the submesh -------------------
     def point_space(self, shape: tuple[int, ...]) -> dolfinx.fem.FunctionSpace:
         """A space of values of ``shape`` at the slave quadrature points (quadrature element)."""
