@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from petsc4py import PETSc
 
 from contact_ufl import scenes
 from contact_ufl.analytic import CattaneoMindlin2D, Hertz2D
@@ -107,9 +108,11 @@ def ironing_run(
 
     Returns ``{"mu", "history", "cutbacks", ...}`` with history records ``time``, ``Fx``,
     ``Fy`` (the force of the support on the indenter's top, which balances the contact
-    force), ``newton_iterations`` and ``converged`` (every accepted step converged; a step
-    that does not is cut back, and the run stops with :class:`ConvergenceError` when the
-    cut-backs run out), ``contact_normal`` and ``contact_friction`` (the parts of the
+    force), ``newton_iterations``, ``residual`` (SNES's final residual norm),
+    ``snes_reason`` (SNES's converged reason of the accepted solve, by name) and
+    ``converged`` (that reason is positive; a step whose Newton solve fails is cut back,
+    and the run stops with :class:`ConvergenceError` when the cut-backs run out),
+    ``contact_normal`` and ``contact_friction`` (the parts of the
     contact force on the indenter, :func:`contact_force_parts`), ``top_displacement``,
     ``stored_energy`` and ``dissipation`` (of the step), and the problem.
     """
@@ -118,8 +121,10 @@ def ironing_run(
     top = scene.tags["punch_top"]
     (driven,) = [d for d in scene.dirichlet if d.tag == top]
     history = []
+    reasons = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
 
     def record(problem, step):
+        reason = problem.snes.getConvergedReason()  # of the solve this step was accepted with
         F = problem.reaction(top)
         normal, frictional = contact_force_parts(problem)
         history.append(
@@ -128,7 +133,9 @@ def ironing_run(
                 "Fx": float(F[0]),
                 "Fy": float(F[1]),
                 "newton_iterations": step.newton_iterations,
-                "converged": True,
+                "residual": float(step.residual),
+                "snes_reason": reasons.get(reason, str(reason)),
+                "converged": bool(reason > 0),
                 "contact_normal": normal.tolist(),
                 "contact_friction": frictional.tolist(),
                 "top_displacement": evaluate(driven.value, step.t).tolist(),
