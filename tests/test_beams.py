@@ -14,8 +14,8 @@ SUPPORTS = ["upper_clamp", "lower_clamp"]
 NEAR = meshes.BeamPair(gap=0.1, lower_length=10.0)
 
 
-def solve_near_pair(load: float, comm=MPI.COMM_WORLD):
-    beams = scenes.beams(load=load, divisions=3, geometry=NEAR, comm=comm)
+def solve_near_pair(load: float, comm=MPI.COMM_WORLD, mu: float = 0.0):
+    beams = scenes.beams(load=load, divisions=3, geometry=NEAR, comm=comm, mu=mu)
     problem = ContactProblem(beams.scene, verbose=False)
     problem.solve(num_steps=3)
     return problem, beams
@@ -69,9 +69,15 @@ def test_two_cantilevers_in_series():
     assert np.degrees(np.arccos(abs(n_tip[0]))) < 3.0  # small rotations
 
 
-def test_same_result_on_any_number_of_ranks():
-    world, _ = solve_near_pair(load=0.12)
-    alone, _ = solve_near_pair(load=0.12, comm=MPI.COMM_SELF)
+@pytest.mark.parametrize("mu", [0.0, 0.3], ids=["mu=0", "mu=0.3"])
+def test_same_result_on_any_number_of_ranks(mu):
+    """The distributed solve equals the solve on one rank (each rank redoes it alone), with
+    and without friction: contact force, tip displacement, Newton iterations."""
+    world, _ = solve_near_pair(load=0.12, mu=mu)
+    alone, _ = solve_near_pair(load=0.12, comm=MPI.COMM_SELF, mu=mu)
+    if mu > 0:  # friction acts: the tangential force is a good part of the normal one
+        force = alone.contact_force()
+        assert abs(force[0]) > 0.1 * force[2]
     assert np.allclose(world.contact_force(), alone.contact_force(), rtol=1e-7, atol=1e-12)
     tip = world.scene.tags["upper_tip"]
     assert np.allclose(section_motion(world, tip)[0], section_motion(alone, tip)[0], atol=1e-9)
