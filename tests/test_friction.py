@@ -24,7 +24,7 @@ def test_frictional_taylor_second_order(dim, mu, state):
     assert stick == (active if state == "stick" else 0)
     result = taylor_test(problem, dz, steps)
     assert not result.facets_changed and not result.active_changed
-    assert np.all(np.abs(result.slopes - 2.0) < 0.1), result.slopes
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
 
 
 def test_friction_unknowns_only_with_mu():

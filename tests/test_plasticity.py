@@ -126,7 +126,7 @@ def test_consistent_tangent_in_plastic_flow():
     field.x.array[:] = smooth_field(x.T, 1.0, 3).T.ravel()
     fem_petsc.assign([field], direction)
     result = taylor_test(problem, direction, [1e-3 * 2.0**-k for k in range(4)])
-    assert np.all(np.abs(result.slopes - 2.0) < 0.1), result.slopes
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
 
 
 def test_bad_plastic_input():
