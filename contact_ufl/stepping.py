@@ -33,7 +33,8 @@ class StepRecord:
     t
         Pseudo-time reached.
     newton_iterations
-        Newton iterations of the step (both tries where the fallback line search ran).
+        Newton iterations of the step (of all tries, see
+        :meth:`~contact_ufl.newton.NewtonSolver.solve_step`).
     residual
         Norm of the residual at convergence.
     active_points
@@ -42,6 +43,9 @@ class StepRecord:
         Resultant contact force (all pairs).
     wall_s
         Wall time of the accepted try of the step (seconds).
+    reason
+        SNES's converged reason of the solve the step was accepted with (a
+        ``CONVERGED_*`` name).
     """
 
     step: int
@@ -51,6 +55,7 @@ class StepRecord:
     active_points: int
     contact_force: np.ndarray
     wall_s: float
+    reason: str = ""
 
 
 @dataclass
@@ -146,6 +151,7 @@ class LoadStepper:
                 problem.active_points(),
                 problem.contact_force(),
                 time.perf_counter() - start,
+                reason,
             )
             self.history.steps.append(record)
             problem.commit(solver.x)

@@ -25,7 +25,7 @@ def test_frictional_taylor_second_order(dim, mu, state):
     assert stick == (active if state == "stick" else 0)
     result = taylor_test(problem, dz, steps)
     assert not result.facets_changed and not result.active_changed
-    assert np.all(np.abs(result.slopes - 2.0) < 0.1), result.slopes
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
 
 
 def test_friction_unknowns_only_with_mu():
@@ -59,7 +59,8 @@ def test_no_nan_where_q_vanishes():
 def test_block_sticks_then_slides():
     """A block pressed on a flat and pushed: stuck while the tangential force is below
     mu N (no slip, in the weak sense of the multiplier equation), sliding above it (every
-    contact point slips, against the frictional traction on the slave body)."""
+    contact point slips, against the frictional traction on the slave body). The weak
+    slip of the stuck steps stays below 1e-6 of the step's push (2e-7 measured)."""
     mu, push, steps = 0.3, 0.03, 10
     problem = ContactProblem(scenes.pushed_block(mu=mu, push=push), verbose=False)
     c = problem.contacts[0]
@@ -102,7 +103,7 @@ def test_block_sticks_then_slides():
     assert stuck and sliding
     for r in stuck:
         assert r["stick"] == r["active"] > 0
-        assert r["weak_slip"] < 1e-5 * increment
+        assert r["weak_slip"] < 1e-6 * increment
     for r in log:
         assert r["ratio"] <= mu * (1.0 + 1e-8)
     for r in sliding:

@@ -20,17 +20,21 @@ def hertz_errors(problem, hertz):
 
 
 def test_hertz_half_width_and_peak_pressure(hertz_moderate):
+    """At a/h = 10 the half-width and the peak pressure are within 1% (0.2% and 0.7%
+    measured; finer meshes level off at about 0.5%, benchmarks/results/hertz.json)."""
     problem, hertz = hertz_moderate
     a_err, p0_err, profile_err, exact = hertz_errors(problem, hertz)
     assert exact.a / hertz.h_contact > 8  # the contact zone is resolved
-    assert abs(a_err) < 0.02
-    assert abs(p0_err) < 0.02
+    assert abs(a_err) < 0.01
+    assert abs(p0_err) < 0.01
     assert profile_err < 0.03
 
 
 def test_hertz_errors_fall_under_refinement(hertz_sequence):
+    """From a/h = 2.5 to 5 to 10 the errors of a and p0 fall (from 6-8% to below 1%)."""
     errors = np.array([np.abs(hertz_errors(p, h)[:2]) for p, h in hertz_sequence])
     assert np.all(np.diff(errors, axis=0) < 0), errors
+    assert np.all(errors[0] > 0.05) and np.all(errors[-1] < 0.01), errors
 
 
 def test_hertz_contact_law(hertz_moderate):

@@ -32,7 +32,10 @@ def test_patch_pressure_uniform(composite):
 
 
 def test_patch_total_force_exact(composite):
-    """The contact force balances the applied load (width 1) to round-off.
+    """The contact force balances the applied load (width 1) to round-off. This holds by
+    construction (the equilibrium of any converged solve: the P1 test functions sum to
+    one), so it checks the post-processing, not the pressure; test_patch_pressure_uniform
+    is the verification.
 
     Its tangential part is not zero to round-off: the master surface tilts by the small
     residual waviness of the non-matching interface (held by the supports of the sides).
@@ -43,7 +46,9 @@ def test_patch_total_force_exact(composite):
 
 
 def test_patch_action_reaction(composite):
-    """(e): the contact forces on the two bodies are opposite to round-off."""
+    """(e): the contact forces on the two bodies are opposite to round-off. This holds by
+    construction (the master virtual displacement is interpolated with shape functions
+    that sum to one), whatever the solution: not a verification of it."""
     resultants = body_resultants(composite, composite.contact_residual())
     slave, master = (resultants[b.tag] for b in composite.scene.bodies)
     assert np.linalg.norm(slave) > 0.5 * PRESSURE
@@ -65,6 +70,8 @@ def test_patch_one_gauss_rule_is_not_enough():
     ],
 )
 def test_patch_3d(cell, degree, subdivisions, tolerance):
+    """The pressure within ``tolerance`` in 3D; the total force and action equals reaction
+    hold by construction (see the 2D tests)."""
     problem = solve_patch(degree, subdivisions, dim=3, cell=cell)
     lam = problem.contacts[0].lambda_N.x.array
     assert np.abs(lam / PRESSURE - 1.0).max() < tolerance

@@ -61,7 +61,8 @@ def uniaxial_kirchhoff(problem, stretch) -> list[tuple[float, float]]:
 def test_perfect_plasticity_holds_the_yield_stress():
     """Without hardening, tau_11 = sigma_y at every step of the loading beyond yield (to
     stretch 1.5) and tau_11 = -sigma_y once reversed loading yields in compression: the
-    analytic uniaxial solution at any strain."""
+    analytic uniaxial solution at any strain. Newton takes at most 5 iterations per step
+    (4 measured)."""
     problem = bar(J2Plasticity(E, NU, SIGMA_Y), there_and_back)
     records = uniaxial_kirchhoff(problem, there_and_back)
     loading, reversed_ = records[:10], records[11:]
@@ -75,7 +76,8 @@ def test_perfect_plasticity_holds_the_yield_stress():
 def test_linear_hardening_follows_the_yield_surface():
     """With hardening H the converged stress sits on the hardened yield surface,
     tau_11 = sigma_y + H alpha with the committed equivalent plastic strain, which grows
-    with the stretch; the small-strain limit is the bilinear law."""
+    with the stretch; the small-strain limit is the bilinear law (to 0.1%: at 2% strain
+    the finite-strain response differs from it by 0.04%)."""
     H = 0.1
     problem = bar(J2Plasticity(E, NU, SIGMA_Y, hardening=H), lambda t: 0.5 * t)
     alpha = problem.histories[1].alpha
@@ -98,7 +100,7 @@ def test_linear_hardening_follows_the_yield_surface():
     small.solve(num_steps=4, t_end=10.0)  # strain 2%, twice the yield strain
     eps = 0.02
     bilinear = SIGMA_Y + E * H / (E + H) * (eps - SIGMA_Y / E)
-    assert small.reaction(4)[0] * (1.0 + eps) == pytest.approx(bilinear, rel=0.02)
+    assert small.reaction(4)[0] * (1.0 + eps) == pytest.approx(bilinear, rel=1e-3)
 
 
 def test_elastic_below_yield():
@@ -125,7 +127,7 @@ def test_consistent_tangent_in_plastic_flow():
     field.x.array[:] = smooth_field(x.T, 1.0, 3).T.ravel()
     fem_petsc.assign([field], direction)
     result = taylor_test(problem, direction, [1e-3 * 2.0**-k for k in range(4)])
-    assert np.all(np.abs(result.slopes - 2.0) < 0.1), result.slopes
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
 
 
 def test_bad_plastic_input():
@@ -140,8 +142,11 @@ def test_bad_plastic_input():
         stored_energy(problem)
 
 
-def _indent_and_lift(yield_stress):
-    problem = ContactProblem(scenes.plastic_indentation(yield_stress=yield_stress), verbose=False)
+def _indent_and_lift(yield_stress, comm=MPI.COMM_WORLD):
+    """Press the cylinder in 8 steps, lift it off in 8: the problem, the peak contact
+    pressure at the deepest point and the depth of the imprint."""
+    scene = scenes.plastic_indentation(yield_stress=yield_stress, comm=comm)
+    problem = ContactProblem(scene, verbose=False)
     problem.solve(num_steps=8, t_end=1.0)
     peak = contact_samples(problem).pressure.max()
     problem.solve(num_steps=8, t_end=2.0)
@@ -150,19 +155,21 @@ def _indent_and_lift(yield_stress):
 
 def test_indentation_leaves_an_imprint():
     """A stiff cylinder pressed 0.02 into a perfectly plastic block (sigma_y = 0.01 E) and
-    lifted off: the peak contact pressure is capped near the plane-strain indentation
-    hardness (Prandtl's (2 + pi) k = 2.97 sigma_y, k = sigma_y / sqrt(3); within 15%, the
-    bound is the flat punch's) where the elastic block reaches 6 sigma_y; the plastic block
-    keeps an imprint of a good part of the depth, the elastic one springs back to round-off;
-    both lift off completely."""
+    lifted off: the peak contact pressure is capped below the plane-strain indentation
+    hardness (Prandtl's (2 + pi) k = 2.97 sigma_y, k = sigma_y / sqrt(3), the flat
+    punch's bound), at 2.846 sigma_y, where the elastic block reaches 6.024 sigma_y; the
+    plastic block keeps an imprint of 40.6% of the depth, the elastic one springs back to
+    1e-11; both lift off completely. The values are this mesh's (to 0.002 sigma_y and 0.2%
+    of the depth), not a converged limit."""
     sigma_y, depth = 0.01, 0.02
     plastic, peak, imprint = _indent_and_lift(sigma_y)
     elastic, elastic_peak, spring_back = _indent_and_lift(None)
-    assert elastic_peak > 5.0 * sigma_y
+    assert elastic_peak / sigma_y == pytest.approx(6.024, abs=0.002)
     hardness = (2.0 + np.pi) / np.sqrt(3.0) * sigma_y
-    assert 0.85 * hardness < peak < 1.1 * hardness
-    assert imprint > 0.25 * depth
-    assert abs(spring_back) < 1e-10
+    assert peak < hardness
+    assert peak / sigma_y == pytest.approx(2.846, abs=0.002)
+    assert imprint / depth == pytest.approx(0.406, abs=0.002)
+    assert abs(spring_back) < 1e-11
     # the history moves in the block only: the elastic disc has no plastic strain
     (history,) = plastic.histories.values()
     disc = plastic.scene.cell_tags.find(plastic.scene.tags["cylinder"])
@@ -173,6 +180,26 @@ def test_indentation_leaves_an_imprint():
         assert problem.t == pytest.approx(2.0)
         assert problem.active_points() == 0
         assert np.linalg.norm(problem.contact_force()) == 0.0
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size == 1, reason="compares a distributed solve")
+def test_indentation_on_any_number_of_ranks():
+    """The plastic indentation and lift-off distributed equals the solve on one rank (each
+    rank redoes it alone), to solver tolerance: peak pressure, imprint, plastic strain and
+    the contact force of every step. (The Newton iterations may differ by one in a step:
+    round-off moves an intermediate iterate across the yield surface.)"""
+    world, peak, imprint = _indent_and_lift(0.01)
+    alone, peak_alone, imprint_alone = _indent_and_lift(0.01, comm=MPI.COMM_SELF)
+    assert peak == pytest.approx(peak_alone, rel=1e-7)
+    assert imprint == pytest.approx(imprint_alone, rel=1e-7)
+    (history,) = world.histories.values()
+    alpha = world.comm.allreduce(history.alpha.x.array.max(initial=0.0), op=MPI.MAX)
+    (history_alone,) = alone.histories.values()
+    assert alpha == pytest.approx(history_alone.alpha.x.array.max(), rel=1e-7)
+    forces = [[s.contact_force for s in p.history.steps] for p in (world, alone)]
+    scale = max(np.linalg.norm(f) for f in forces[1])
+    assert len(forces[0]) == len(forces[1]) == 16
+    assert np.allclose(*forces, rtol=0, atol=1e-7 * scale)
 
 
 def test_plastic_strain_is_written(tmp_path_factory):

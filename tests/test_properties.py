@@ -15,7 +15,9 @@ def test_multipliers_are_the_tractions(hertz_sequence):
 
 
 def test_action_equals_reaction(hertz_moderate):
-    """(e): the contact forces on the two bodies are opposite to round-off."""
+    """(e): the contact forces on the two bodies are opposite to round-off. This holds by
+    construction (the master virtual displacement is interpolated with shape functions
+    that sum to one), whatever the solution: not a verification of it."""
     problem, _ = hertz_moderate
     resultants = body_resultants(problem, problem.contact_residual())
     slave, master = (resultants[b.tag] for b in problem.scene.bodies)

@@ -21,7 +21,7 @@ def test_taylor_second_order(dim):
     assert not result.facets_changed and not result.active_changed
     zeroth_slopes = np.diff(np.log(result.zeroth)) / np.diff(np.log(result.h))
     assert np.all(np.abs(zeroth_slopes - 1.0) < 0.05)
-    assert np.all(np.abs(result.slopes - 2.0) < 0.1), result.slopes
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
 
 
 def test_taylor_detects_a_frozen_projection():
@@ -29,7 +29,7 @@ def test_taylor_detects_a_frozen_projection():
     problem, dz, steps = curved_case(2)
     problem.contacts[0].kinematics.frozen_projection = True
     result = taylor_test(problem, dz, steps)
-    assert np.all(np.abs(result.slopes - 1.0) < 0.1), result.slopes
+    assert np.all(np.abs(result.slopes - 1.0) < 0.01), result.slopes
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.05])
@@ -44,4 +44,4 @@ def test_taylor_smoothed_master_normal(mu):
     assert problem.comm.allreduce(change, op=MPI.MAX) > 1e-6  # another normal indeed
     result = taylor_test(problem, dz, steps)
     assert not result.facets_changed and not result.active_changed
-    assert np.all(np.abs(result.slopes - 2.0) < 0.1), result.slopes
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes

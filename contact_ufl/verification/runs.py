@@ -88,9 +88,11 @@ def ironing_run(
 
     Returns ``{"mu", "history", "cutbacks", ...}`` with history records ``time``, ``Fx``,
     ``Fy`` (the force of the support on the indenter's top, which balances the contact
-    force), ``newton_iterations`` and ``converged`` (every accepted step converged; a step
-    that does not is cut back, and the run stops with :class:`ConvergenceError` when the
-    cut-backs run out), ``contact_normal`` and ``contact_friction`` (the parts of the
+    force), ``newton_iterations``, ``residual`` (SNES's final residual norm),
+    ``snes_reason`` (SNES's converged reason of the accepted solve, by name) and
+    ``converged`` (that reason is positive; a step whose Newton solve fails is cut back,
+    and the run stops with :class:`ConvergenceError` when the cut-backs run out),
+    ``contact_normal`` and ``contact_friction`` (the parts of the
     contact force on the indenter, :func:`contact_force_parts`), ``top_displacement``,
     ``stored_energy`` and ``dissipation`` (of the step), and the problem.
     """
@@ -109,7 +111,9 @@ def ironing_run(
                 "Fx": float(F[0]),
                 "Fy": float(F[1]),
                 "newton_iterations": step.newton_iterations,
-                "converged": True,
+                "residual": float(step.residual),
+                "snes_reason": step.reason,
+                "converged": step.reason.startswith("CONVERGED"),
                 "contact_normal": normal.tolist(),
                 "contact_friction": frictional.tolist(),
                 "top_displacement": evaluate(driven.value, step.t).tolist(),
