@@ -158,8 +158,9 @@ class ContactInterface:
         pairing = self.search.pair(self.u, layout)
         self.kinematics.set_pairing(pairing)
         npts = len(pairing.points)
+        width = int(np.prod(pairing.columns.shape[1:]))  # also for npts = 0
         self._gather = self.slave.unrolled(
-            self.kinematics.Qx, pairing.columns.reshape(npts, -1), fill=-1
+            self.kinematics.Qx, pairing.columns.reshape(npts, width), fill=-1
         )
         gathers = [(self.kinematics.xhat, self._gather)]
         return gathers + (self.friction.gathers(self._gather) if self.friction else [])

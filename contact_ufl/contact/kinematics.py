@@ -180,7 +180,8 @@ class MeshKinematics:
         slave, proj, paired = self.slave, pairing.projection, pairing.paired
         self.projection = proj
         npts = len(pairing.points)
-        xhat = pairing.nodes.reshape(npts, -1)
+        # (npts, nx * gdim), spelled out for a rank without slave points (npts = 0)
+        xhat = pairing.nodes.reshape(npts, int(np.prod(pairing.nodes.shape[1:])))
         slave.set_at_points(self.xhat, xhat)
         slave.set_at_points(self.xhat0, xhat)
         slave.set_at_points(self.x0, pairing.points)
