@@ -355,13 +355,14 @@ class BeamsScene:
         """Beam-theory estimate ``(N, w)`` of the contact force and the upper tip deflection.
 
         The upper beam is a cantilever of length ``L`` with tip stiffness ``k1 = 3 EI / L^3``;
-        the lower one, loaded at ``a = tip`` from its clamp, has ``k2 = 3 EI_2 / a^3``. Contact
+        the lower one, loaded at ``a = lower_arm`` from its clamp, has ``k2 = 3 EI_2 / a^3``.
+        Contact
         starts at ``P_c = k1 gap``; then ``N = (P - P_c) k2 / (k1 + k2)`` and the tip deflects
         by ``gap + N / k2`` (before, by ``P / k1`` and ``N = 0``).
         """
         g = self.geometry
         k1 = 3.0 * self.bending_stiffness / g.length**3
-        k2 = 3.0 * self.lower_bending_stiffness / g.tip**3
+        k2 = 3.0 * self.lower_bending_stiffness / g.lower_arm**3
         P_c = k1 * g.gap
         if P <= P_c:
             return 0.0, P / k1
