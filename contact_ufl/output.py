@@ -122,18 +122,29 @@ def gathered_grid(
     return grid.warp_by_vector("displacement") if deformed else grid
 
 
+_DIRECTIONS = {"iso": (0.7, -1.0, 0.6), "xz": (0.0, -1.0, 0.0), "xy": (0.0, 0.0, 1.0)}
+
+
+def _direction(view: str | tuple[float, float, float]) -> tuple[float, ...]:
+    """The direction to look from of the camera ``view`` (see :func:`_view`); a clear
+    error for an unknown name or a direction that is not 3 numbers, not all 0."""
+    if isinstance(view, str):
+        if view not in _DIRECTIONS:
+            names = sorted(_DIRECTIONS)
+            raise ValueError(f"view must be one of {names} or a direction, got {view!r}")
+        return _DIRECTIONS[view]
+    direction = tuple(float(v) for v in view)
+    if len(direction) != 3 or not any(direction):
+        raise ValueError(f"a view direction needs 3 components, not all 0, got {view!r}")
+    return direction
+
+
 def _view(plotter, view: str | tuple[float, float, float]) -> None:
     """Camera: ``"iso"`` (3D view from the front, above and to the right), ``"xz"`` (the
     x-z plane seen from -y: the plane of bending of the beams), ``"xy"`` (seen from +z),
     or a direction ``(x, y, z)`` to look from (with +z up)."""
-    directions = {"iso": (0.7, -1.0, 0.6), "xz": (0.0, -1.0, 0.0), "xy": (0.0, 0.0, 1.0)}
-    if isinstance(view, str) and view not in directions:
-        raise ValueError(f"view must be one of {sorted(directions)} or a direction, got {view!r}")
-    direction = directions[view] if isinstance(view, str) else tuple(view)
-    if len(direction) != 3 or not np.any(direction):
-        raise ValueError(f"a view direction needs 3 components, not all 0, got {view!r}")
     up = (0.0, 1.0, 0.0) if view == "xy" else (0.0, 0.0, 1.0)
-    plotter.view_vector(direction, viewup=up)
+    plotter.view_vector(_direction(view), viewup=up)
     plotter.reset_camera()
 
 
@@ -178,6 +189,7 @@ def _screenshot(plotter, path: str | Path, title: str) -> None:
 def plot_reference(problem, path: str | Path, view: str = "iso", title: str = "") -> None:
     """The reference configuration: the mesh of every body, coloured by body (collective;
     rank 0 writes the picture)."""
+    _direction(view)  # bad input fails on every rank
     grid = gathered_grid(problem, deformed=False)
     if grid is None:
         return
@@ -237,17 +249,16 @@ def gathered_contact_surface(problem, pair: int = 0) -> pyvista.PolyData | None:
     return surface
 
 
-def _arrows(points: pyvista.PolyData, vectors: str, length: float, saturate: float):
+def _arrows(
+    points: pyvista.PolyData, vectors: str, length: float, saturate: float
+) -> pyvista.PolyData:
     """Arrow glyphs at ``points`` along the point vectors ``vectors``: their lengths are
     proportional to the vectors' up to the ``saturate`` percentile of the nonzero ones,
     which is ``length`` long, and capped at that length above it."""
     norms = np.linalg.norm(points[vectors], axis=1)
     top = float(np.percentile(norms[norms > 0.0], saturate))
     points["length"] = norms
-    glyphs = points.glyph(
-        orient=vectors, scale="length", factor=length, clamping=True, rng=(0.0, top)
-    )
-    return glyphs
+    return points.glyph(orient=vectors, scale="length", factor=length, clamping=True, rng=(0, top))
 
 
 def plot_contact_state(
@@ -285,12 +296,13 @@ def plot_contact_state(
     zoom
         Camera zoom towards the part of the slave surface in contact.
     """
+    _direction(view)  # bad input fails on every rank, before the collective gathers
+    if not 0.0 < saturate <= 100.0:
+        raise ValueError(f"saturate is a percentile in (0, 100], got {saturate}")
     grid = gathered_grid(problem)
     surface = gathered_contact_surface(problem)
     if grid is None:
         return
-    if not 0.0 < saturate <= 100.0:
-        raise ValueError(f"saturate is a percentile in (0, 100], got {saturate}")
     pv = _pyvista()
     plotter = pv.Plotter(off_screen=True, window_size=(1200, 700))
     plotter.add_mesh(grid, color="lightgrey", show_edges=True, opacity=0.2)

@@ -382,13 +382,16 @@ def beams(
 ) -> BeamsScene:
     """Two Neo-Hookean cantilevers, the upper one pushed at its free tip by a follower force.
 
-    The beams of :func:`contact_ufl.meshes.beams_3d` are clamped at opposite ends. The free
-    end section of the upper beam carries the follower force :class:`FollowerForce` of
+    The beams of :func:`contact_ufl.meshes.beams_3d` (by default clamped on the same side,
+    the lower one nearer the upper tip: :class:`contact_ufl.meshes.BeamPair`). The free end
+    section of the upper beam carries the follower force :class:`FollowerForce` of
     magnitude ``load * t * EI / L^2`` (``t`` the pseudo-time), directed along the carried
     reference direction ``-e_z``: it stays perpendicular to the deformed beam axis. The upper
-    beam bends down, its tip meets the lower beam and, as it rotates, slides along it.
-    Slave: the bottom of the upper beam above the lower one; master: the top of the lower
-    beam near its free end; ``eps_N = eps_factor E / h`` with ``h`` the upper element size.
+    beam bends down and its tip meets the lower beam; the lower beam, pressed by a shorter
+    lever, turns faster, and the upper beam's underside bends onto it and slides along it
+    (with ``clamps = "opposite"`` only the tip corner touches). Slave: the bottom of the
+    upper beam above the lower one; master: the top of the lower beam from
+    ``master_start``; ``eps_N = eps_factor E / h`` with ``h`` the upper element size.
 
     Parameters
     ----------

@@ -150,7 +150,8 @@ for mu, problem in problems.items():
 for mu, problem in problems.items():
     pair = problem.contacts[0]  # the reference x of the slave points in contact
     x = np.concatenate(comm.allgather(pair.slave.X.reshape(-1, 3)[pair.active(), 0]))
-    say(f"mu = {mu}: {len(x)} slave points in contact, {x.min():.2f} <= X <= {x.max():.2f}")
+    zone = f", {x.min():.2f} <= X <= {x.max():.2f}" if len(x) else ""
+    say(f"mu = {mu}: {len(x)} slave points in contact{zone}")
     for view, camera in (("iso", (-0.6, -1.0, 0.8)), ("xz", "xz")):
         name = out / f"beams_mu{mu:g}_{view}.png"
         title = f"mu = {mu:g}, last step"

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contact_ufl import meshes, scenes
+from contact_ufl import meshes, output, scenes
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import (
     contact_force_parts,
@@ -179,3 +179,28 @@ def test_showcase_on_any_number_of_ranks(showcase):
     assert [s.newton_iterations for s in world.history.steps] == [
         s.newton_iterations for s in alone.history.steps
     ]
+
+
+def test_contact_state_picture(showcase, tmp_path):
+    """The picture's surface holds every slave point, with t_N > 0 exactly at the points in
+    contact and its peak at the tip corner; bad camera or colour input fails on every rank."""
+    problem = showcase[0][0.3]
+    surface = output.gathered_contact_surface(problem)
+    _, t_N = contact_zone(problem)
+    slave = problem.contacts[0].slave
+    points = problem.comm.allreduce(slave.X.shape[0] * slave.X.shape[1])
+    active = problem.active_points()
+    if MPI.COMM_WORLD.rank == 0:
+        assert surface.n_points == points
+        assert np.count_nonzero(surface["t_N"] > 0.0) == active
+        assert surface["t_N"].max() == pytest.approx(t_N.max())
+        assert np.any(surface["t_T"])  # the frictional traction is there to draw
+    else:
+        assert surface is None
+    folder = MPI.COMM_WORLD.bcast(tmp_path, root=0)
+    for bad in ({"view": (0.0, 0.0, 0.0)}, {"view": "side"}, {"saturate": 0.0}):
+        with pytest.raises(ValueError):
+            output.plot_contact_state(problem, folder / "bad.png", **bad)
+    output.plot_contact_state(problem, folder / "state.png", "xz", saturate=80.0)
+    if MPI.COMM_WORLD.rank == 0:
+        assert (folder / "state.png").stat().st_size > 10_000
