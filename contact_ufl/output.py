@@ -142,9 +142,12 @@ def _direction(view: str | tuple[float, float, float]) -> tuple[float, ...]:
 def _view(plotter, view: str | tuple[float, float, float]) -> None:
     """Camera: ``"iso"`` (3D view from the front, above and to the right), ``"xz"`` (the
     x-z plane seen from -y: the plane of bending of the beams), ``"xy"`` (seen from +z),
-    or a direction ``(x, y, z)`` to look from (with +z up)."""
+    or a direction ``(x, y, z)`` to look from (with +z up). The plane views are parallel
+    projections: the angles in that plane are true."""
     up = (0.0, 1.0, 0.0) if view == "xy" else (0.0, 0.0, 1.0)
     plotter.view_vector(_direction(view), viewup=up)
+    if view in ("xz", "xy"):
+        plotter.enable_parallel_projection()
     plotter.reset_camera()
 
 
