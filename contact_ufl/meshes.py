@@ -12,7 +12,8 @@ Generators
 * :func:`patch_2d`: two stacked rectangles (contact patch test), triangles or quadrilaterals.
 * :func:`patch_3d`: two stacked boxes, tetrahedra or hexahedra.
 * :func:`cylinders_3d`: half cylinder on a block with a cylindrical top of crossed axis.
-* :func:`beams_3d`: two cantilever beams clamped at opposite ends, overlapping in plan.
+* :func:`beams_3d`: two cantilever beams, clamped on the same side or at opposite ends,
+  overlapping in plan.
 
 Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
 11, 12, ... in the order they are listed in each generator's documentation; always look them
@@ -1053,7 +1054,7 @@ def beams_3d(
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
 ) -> SceneMesh:
-    """Two hexahedral cantilever beams clamped at opposite ends, overlapping in plan.
+    """Two hexahedral cantilever beams, overlapping in plan (clamps: :class:`BeamPair`).
 
     Structured hexahedra: ``divisions`` elements through the width and the height of the
     upper beam, and elements of that height through the lower one; along the axis the upper

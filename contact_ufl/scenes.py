@@ -356,9 +356,10 @@ class BeamsScene:
 
         The upper beam is a cantilever of length ``L`` with tip stiffness ``k1 = 3 EI / L^3``;
         the lower one, loaded at ``a = lower_arm`` from its clamp, has ``k2 = 3 EI_2 / a^3``.
-        Contact
-        starts at ``P_c = k1 gap``; then ``N = (P - P_c) k2 / (k1 + k2)`` and the tip deflects
-        by ``gap + N / k2`` (before, by ``P / k1`` and ``N = 0``).
+        Contact starts at ``P_c = k1 gap``; then ``N = (P - P_c) k2 / (k1 + k2)`` and the tip
+        deflects by ``gap + N / k2`` (before, by ``P / k1`` and ``N = 0``). A point contact:
+        it holds while only the tip corner touches (with ``clamps = "opposite"``, or at
+        small load).
         """
         g = self.geometry
         k1 = 3.0 * self.bending_stiffness / g.length**3
