@@ -204,3 +204,8 @@ def test_contact_state_picture(showcase, tmp_path):
     output.plot_contact_state(problem, folder / "state.png", "xz", saturate=80.0)
     if MPI.COMM_WORLD.rank == 0:
         assert (folder / "state.png").stat().st_size > 10_000
+
+
+def test_unknown_clamps_are_refused():
+    with pytest.raises(ValueError, match="clamps must be 'opposite' or 'same'"):
+        meshes.beams_3d(meshes.BeamPair(clamps="middle"), divisions=1)
