@@ -122,32 +122,32 @@ def gathered_grid(
     return grid.warp_by_vector("displacement") if deformed else grid
 
 
-def gathered_tractions(problem, pair: int = 0) -> tuple[np.ndarray, ...] | None:
-    """Current positions ``(n, 3)``, contact tractions ``(n, 3)`` and normal tractions
-    ``t_N`` ``(n,)`` (nominal, on the slave body) of the slave points in contact, gathered on
-    rank 0 (``None`` on the other ranks)."""
-    c = problem.contacts[pair]
-    gdim = c.gdim
-    active = c.active()
-    x = np.zeros((int(active.sum()), 3))
-    t = np.zeros_like(x)
-    x[:, :gdim] = c.slave.positions(problem.u).reshape(-1, gdim)[active]
-    t[:, :gdim] = c.traction_at_points()[active]
-    t_N = c.normal_traction_at_points()[active]
-    parts = problem.comm.gather((x, t, t_N), root=0)
-    if problem.comm.rank != 0:
-        return None
-    return tuple(np.concatenate([p[k] for p in parts]) for k in range(3))
+_DIRECTIONS = {"iso": (0.7, -1.0, 0.6), "xz": (0.0, -1.0, 0.0), "xy": (0.0, 0.0, 1.0)}
 
 
-def _view(plotter, view: str) -> None:
+def _direction(view: str | tuple[float, float, float]) -> tuple[float, ...]:
+    """The direction to look from of the camera ``view`` (see :func:`_view`); a clear
+    error for an unknown name or a direction that is not 3 numbers, not all 0."""
+    if isinstance(view, str):
+        if view not in _DIRECTIONS:
+            names = sorted(_DIRECTIONS)
+            raise ValueError(f"view must be one of {names} or a direction, got {view!r}")
+        return _DIRECTIONS[view]
+    direction = tuple(float(v) for v in view)
+    if len(direction) != 3 or not any(direction):
+        raise ValueError(f"a view direction needs 3 components, not all 0, got {view!r}")
+    return direction
+
+
+def _view(plotter, view: str | tuple[float, float, float]) -> None:
     """Camera: ``"iso"`` (3D view from the front, above and to the right), ``"xz"`` (the
-    x-z plane seen from -y: the plane of bending of the beams) or ``"xy"`` (seen from +z)."""
-    directions = {"iso": (0.7, -1.0, 0.6), "xz": (0.0, -1.0, 0.0), "xy": (0.0, 0.0, 1.0)}
-    if view not in directions:
-        raise ValueError(f"view must be one of {sorted(directions)}, got {view!r}")
+    x-z plane seen from -y: the plane of bending of the beams), ``"xy"`` (seen from +z),
+    or a direction ``(x, y, z)`` to look from (with +z up). The plane views are parallel
+    projections: the angles in that plane are true."""
     up = (0.0, 1.0, 0.0) if view == "xy" else (0.0, 0.0, 1.0)
-    plotter.view_vector(directions[view], viewup=up)
+    plotter.view_vector(_direction(view), viewup=up)
+    if view in ("xz", "xy"):
+        plotter.enable_parallel_projection()
     plotter.reset_camera()
 
 
@@ -192,6 +192,7 @@ def _screenshot(plotter, path: str | Path, title: str) -> None:
 def plot_reference(problem, path: str | Path, view: str = "iso", title: str = "") -> None:
     """The reference configuration: the mesh of every body, coloured by body (collective;
     rank 0 writes the picture)."""
+    _direction(view)  # bad input fails on every rank
     grid = gathered_grid(problem, deformed=False)
     if grid is None:
         return
@@ -202,35 +203,141 @@ def plot_reference(problem, path: str | Path, view: str = "iso", title: str = ""
     _screenshot(plotter, path, title)
 
 
-def plot_contact_state(
-    problem, path: str | Path, view: str = "iso", title: str = "", scale: float | None = None
-) -> None:
-    """The deformed bodies with the contact tractions of the first pair drawn as arrows at
-    the slave points in contact, coloured by the normal traction ``t_N`` (at a converged
-    state the multiplier lambda_N there; collective, rank 0 writes the picture).
+def _facet_cells(points_ref: np.ndarray) -> np.ndarray:
+    """Cells joining the quadrature points of one slave facet, in its reference coordinates
+    ``points_ref`` ``(nq, fdim)``: segments (``fdim = 1``) or triangles (``fdim = 2``), as
+    local point indices ``(k, fdim + 1)``."""
+    if points_ref.shape[1] == 1:
+        order = np.argsort(points_ref[:, 0])
+        return np.column_stack([order[:-1], order[1:]])
+    from scipy.spatial import Delaunay
 
-    ``scale`` is the arrow length per unit traction (default: the longest arrow is a
-    tenth of the scene's size).
+    return Delaunay(points_ref).simplices
+
+
+def gathered_contact_surface(problem, pair: int = 0) -> pyvista.PolyData | None:
+    """The deformed slave surface of contact pair ``pair`` as one pyvista surface on rank 0
+    (``None`` on the other ranks).
+
+    Its points are the slave quadrature points at their current positions; the
+    quadrature points of each facet are joined into triangles (segments in 2D). Point
+    data: ``"t_N"`` (the normal traction ``<lambda_N + eps_N g>``, 0 where open),
+    ``"traction"`` (the contact traction on the slave body, nominal) and ``"t_T"`` (its
+    tangential part, the frictional traction; 0 without friction). Collective.
     """
+    c = problem.contacts[pair]
+    gdim = c.gdim
+    n = c.slave.X.shape[0] * c.slave.X.shape[1]
+    x, t = np.zeros((n, 3)), np.zeros((n, 3))
+    x[:, :gdim] = c.slave.positions(problem.u).reshape(-1, gdim)
+    t_N = c.normal_traction_at_points()
+    t[:, :gdim] = c.traction_at_points()
+    t_T = t.copy()
+    t_T[:, :gdim] -= t_N[:, None] * c.projection.normal.reshape(-1, gdim)
+    t_T[t_N <= 0.0] = 0.0
+    parts = problem.comm.gather((x, t_N, t, t_T), root=0)
+    if problem.comm.rank != 0:
+        return None
+    pv = _pyvista()
+    local = _facet_cells(c.slave.points_ref)
+    nq = c.slave.num_points
+    x, t_N, t, t_T = (np.concatenate([q[k] for q in parts]) for k in range(4))
+    cells = local[None] + nq * np.arange(len(x) // nq)[:, None, None]
+    cells = cells.reshape(-1, local.shape[1])
+    prefixed = np.column_stack([np.full(len(cells), cells.shape[1]), cells]).ravel()
+    surface = pv.PolyData(x, lines=prefixed) if local.shape[1] == 2 else pv.PolyData(x, prefixed)
+    surface.point_data["t_N"] = t_N
+    surface.point_data["traction"] = t
+    surface.point_data["t_T"] = t_T
+    return surface
+
+
+def _arrows(
+    points: pyvista.PolyData, vectors: str, length: float, saturate: float
+) -> pyvista.PolyData:
+    """Arrow glyphs at ``points`` along the point vectors ``vectors``: their lengths are
+    proportional to the vectors' up to the ``saturate`` percentile of the nonzero ones,
+    which is ``length`` long, and capped at that length above it."""
+    norms = np.linalg.norm(points[vectors], axis=1)
+    top = float(np.percentile(norms[norms > 0.0], saturate))
+    points["length"] = norms
+    return points.glyph(orient=vectors, scale="length", factor=length, clamping=True, rng=(0, top))
+
+
+def plot_contact_state(
+    problem,
+    path: str | Path,
+    view: str | tuple[float, float, float] = "iso",
+    title: str = "",
+    scale: float = 0.08,
+    saturate: float = 100.0,
+    zoom: float = 1.0,
+) -> None:
+    """The deformed bodies and the contact state of the first pair (collective; rank 0
+    writes the picture).
+
+    The bodies are drawn translucent; the slave surface is grey where open and coloured by
+    the normal traction ``t_N`` (at a converged state the multiplier lambda_N) where in
+    contact. In the ``"xz"`` view (the surface seen edge-on) the slave points in contact
+    carry the contact tractions on the slave body as arrows coloured by ``t_N``. With
+    friction, the frictional tractions ``t_T`` are black arrows, in every view.
+
+    Parameters
+    ----------
+    problem
+        The contact problem, at a converged state.
+    path, view, title
+        The PNG file, the camera (see :func:`_view`) and a title.
+    scale
+        Length of the longest arrows (those at or above the saturation value), relative to
+        the scene's size; the frictional arrows are half as long.
+    saturate
+        Percentile of the positive ``t_N`` taken as the top of the colour range (from 0):
+        below 100, larger values (a peak at a corner) get the top colour, and the colour
+        bar's title gives the largest value. The arrow lengths saturate the same way (at
+        that percentile of the traction's, or the frictional traction's, magnitudes).
+    zoom
+        Camera zoom towards the part of the slave surface in contact.
+    """
+    _direction(view)  # bad input fails on every rank, before the collective gathers
+    if not 0.0 < saturate <= 100.0:
+        raise ValueError(f"saturate is a percentile in (0, 100], got {saturate}")
     grid = gathered_grid(problem)
-    tractions = gathered_tractions(problem)
+    surface = gathered_contact_surface(problem)
     if grid is None:
         return
     pv = _pyvista()
     plotter = pv.Plotter(off_screen=True, window_size=(1200, 700))
-    plotter.add_mesh(grid, color="lightgrey", show_edges=True, opacity=0.5)
-    x, t, t_N = tractions
-    magnitude = np.linalg.norm(t, axis=1)
-    if len(x) and magnitude.max() > 0.0:
-        size = float(np.linalg.norm(np.ptp(grid.points, axis=0)))
-        factor = scale or 0.1 * size / magnitude.max()
-        arrows = pv.PolyData(x)
-        arrows["traction"] = t
-        arrows["length"] = magnitude
-        arrows["t_N"] = t_N
-        glyphs = arrows.glyph(orient="traction", scale="length", factor=factor)
-        plotter.add_mesh(glyphs, scalars="t_N", cmap="plasma")
+    plotter.add_mesh(grid, color="lightgrey", show_edges=True, opacity=0.2)
+    in_contact = surface["t_N"] > 0.0
+    patch = surface.extract_points(in_contact, adjacent_cells=True)
+    plotter.add_mesh(surface, color="darkgrey")
+    contact = surface.extract_points(in_contact, adjacent_cells=False, include_cells=False)
+    if contact.n_points == 0:
+        _view(plotter, view)
+        _screenshot(plotter, path, title)
+        return
+    t_N = contact["t_N"]
+    top = float(np.percentile(t_N, saturate))
+    label = "t_N = lambda_N" + (f" (max {t_N.max():.3g})" if top < t_N.max() else "")
+    colours = {
+        "scalars": "t_N",
+        "cmap": "plasma",
+        "clim": (0.0, top),
+        "scalar_bar_args": {"title": label},
+    }
+    if patch.n_cells:
+        plotter.add_mesh(patch, **colours)
+    length = scale * float(np.linalg.norm(np.ptp(grid.points, axis=0)))
+    if view == "xz":
+        arrows = _arrows(contact, "traction", length, saturate)
+        plotter.add_mesh(arrows, **(colours | {"show_scalar_bar": not patch.n_cells}))
+        plotter.add_points(contact, render_points_as_spheres=True, point_size=8, **colours)
+    if np.any(contact["t_T"]):
+        plotter.add_mesh(_arrows(contact, "t_T", 0.5 * length, saturate), color="black")
     _view(plotter, view)
+    plotter.set_focus(contact.center)
+    plotter.camera.zoom(zoom)
     _screenshot(plotter, path, title)
 
 

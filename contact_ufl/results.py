@@ -293,7 +293,7 @@ class CoulombCheck:
     active: int
 
 
-def coulomb_law(problem, pair: int = 0) -> CoulombCheck:
+def coulomb_law(problem, pair: int = 0, floor: float = 0.0) -> CoulombCheck:
     """Check the Coulomb law on the multipliers of a frictional pair at its last converged
     step (after :meth:`~contact_ufl.problem.ContactProblem.solve`, or from its callback):
     the slip and the stick/slip state are those the step was solved with.
@@ -304,14 +304,23 @@ def coulomb_law(problem, pair: int = 0) -> CoulombCheck:
     smooth (the beams, measured 4e-6) that is small; next to a traction singularity, such as
     the corners of a flat punch, the excess does not vanish under refinement (about 10% of
     ``max mu lambda_N`` at the pushed block's edges, at 4, 8 and 16 elements across).
+    At the edge of a contact zone that ends inside the slave surface, a point in contact
+    (``lambda_N + eps_N g > 0``) can carry a multiplier ``lambda_N`` that is zero to the
+    projection error, even slightly negative: there ``|lambda_T| <= mu lambda_N`` fails by
+    that error and the direction of ``lambda_T`` is meaningless. ``floor`` leaves out the
+    points with ``lambda_N <= floor * max(lambda_N)`` (default 0: every point in contact).
     """
     c = problem.contacts[pair]
     comm = problem.comm
     if c.friction is None:
         raise ValueError(f"contact pair {pair} is frictionless")
     friction = c.friction
-    active = c.active()
+    if not 0.0 <= floor < 1.0:
+        raise ValueError(f"floor is a fraction of max(lambda_N) in [0, 1), got {floor}")
     lam_N = c.multiplier_at_points()
+    active = c.active()
+    if floor > 0.0:
+        active &= lam_N > floor * comm.allreduce(lam_N[active].max(initial=0.0), MPI.MAX)
     lam_T = friction.tangential_multiplier_at_points()
     radius = float(friction.mu.value) * lam_N
     excess = np.linalg.norm(lam_T, axis=1) - radius

@@ -12,9 +12,8 @@ Generators
 * :func:`patch_2d`: two stacked rectangles (contact patch test), triangles or quadrilaterals.
 * :func:`patch_3d`: two stacked boxes, tetrahedra or hexahedra.
 * :func:`cylinders_3d`: half cylinder on a block with a cylindrical top of crossed axis.
-* :func:`ironing_2d`: a punch with a rounded bottom over a long block (shallow ironing).
-* :func:`beams_3d`: two cantilever beams clamped at opposite ends, overlapping in plan.
-* :func:`tag_single_body`: tags of a one-body mesh made without gmsh.
+* :func:`beams_3d`: two cantilever beams, clamped on the same side or at opposite ends,
+  overlapping in plan.
 
 Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
 11, 12, ... in the order they are listed in each generator's documentation; always look them
@@ -878,27 +877,38 @@ class BeamPair:
     """Geometry of :func:`beams_3d` (lengths in the units of the mesh).
 
     The lower beam occupies ``[0, lower_length] x [-e, width + e] x [-lower_height, 0]`` with
-    ``e = (lower_width - width) / 2`` and is clamped at ``x = 0``; the upper beam ``[tip, tip
-    + length] x [0, width] x [gap, gap + height]`` is clamped at ``x = tip + length`` and free
-    at ``x = tip``, above the middle of the lower beam. The lower beam is the wider one, so the
-    side edges of the two beams do not lie on top of each other (an edge-on-edge contact is
-    degenerate: a slave point on the edge of the master surface is in or out by round-off).
+    ``e = (lower_width - width) / 2``; the upper beam ``[tip, tip + length] x [0, width] x
+    [gap, gap + height]`` is clamped at ``x = tip + length`` and free at ``x = tip``, above
+    the lower beam. With ``clamps = "opposite"`` the lower beam is clamped at ``x = 0``: its
+    top, pressed down by the upper tip, falls away from the upper beam, which touches it
+    with its tip corner only. With ``clamps = "same"`` it is clamped at ``x = lower_length``,
+    on the side of the upper clamp but nearer the tip (``lower_arm < length``): pressed at
+    the tip, the lower beam turns faster than the upper one, and the upper beam's underside
+    bends onto it over a length. The lower beam is the wider one, so the side edges of the
+    two beams do not lie on top of each other (an edge-on-edge contact is degenerate: a
+    slave point on the edge of the master surface is in or out by round-off).
     """
 
     length: float = 10.0
-    lower_length: float = 14.0
+    lower_length: float = 10.0
     width: float = 1.0
     height: float = 1.0
-    lower_height: float = 1.5
+    lower_height: float = 1.0
     lower_width: float = 1.5
-    gap: float = 3.0
-    tip: float = 6.0
-    master_start: float = 4.0
+    gap: float = 0.5
+    tip: float = 2.0
+    master_start: float = 1.0
+    clamps: str = "same"
 
     @property
     def overlap(self) -> float:
         """Length of the upper beam's part above the lower beam."""
         return self.lower_length - self.tip
+
+    @property
+    def lower_arm(self) -> float:
+        """Distance from the lower beam's clamp to the point under the upper tip."""
+        return self.tip if self.clamps == "opposite" else self.lower_length - self.tip
 
 
 def beams_3d(
@@ -909,7 +919,7 @@ def beams_3d(
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
 ) -> MeshData:
-    """Two hexahedral cantilever beams clamped at opposite ends, overlapping in plan.
+    """Two hexahedral cantilever beams, overlapping in plan (clamps: :class:`BeamPair`).
 
     Structured hexahedra: ``divisions`` elements through the width and the height of the
     upper beam, and elements of that height through the lower one; along the axis the upper
@@ -937,7 +947,8 @@ def beams_3d(
     MeshData
         Cell groups ``"upper"`` (1), ``"lower"`` (2); facet groups ``"upper_contact"`` (11),
         ``"lower_contact"`` (12), ``"upper_clamp"`` (end x = tip + length, 13),
-        ``"lower_clamp"`` (end x = 0, 14), ``"upper_tip"`` (end x = tip, 15).
+        ``"lower_clamp"`` (end x = 0, or x = lower_length with ``clamps = "same"``, 14),
+        ``"upper_tip"`` (end x = tip, 15).
     """
     g = geometry
     _check_positive(
@@ -949,6 +960,8 @@ def beams_3d(
         master_ratio=master_ratio,
         divisions=float(divisions),
     )
+    if g.clamps not in ("opposite", "same"):
+        raise ValueError(f"clamps must be 'opposite' or 'same', got {g.clamps!r}")
     if not g.lower_width > g.width:
         raise ValueError(f"need lower_width > width, got {g.lower_width} and {g.width}")
     if not 0.0 < g.master_start < g.tip < g.lower_length < g.tip + g.length:
@@ -983,8 +996,12 @@ def beams_3d(
         ]
         _, pieces = occ.fragment([(3, b) for b in boxes[:2]], [(3, b) for b in boxes[2:]])
         occ.synchronize()
-        clamped_lower, master_part, slave_part, clamped_upper = (p[0][1] for p in pieces)
-        lower, upper = [clamped_lower, master_part], [slave_part, clamped_upper]
+        lower_start, master_part, slave_part, clamped_upper = (p[0][1] for p in pieces)
+        lower, upper = [lower_start, master_part], [slave_part, clamped_upper]
+        if g.clamps == "opposite":
+            lower_clamp = face(lower_start, 0, 0.0)
+        else:
+            lower_clamp = face(master_part, 0, g.lower_length)
         h_width = g.width / divisions
         for volumes, sizes, odd_across in (
             (lower, (h_lower, master_ratio * h_width, g.height / divisions), True),
@@ -1012,7 +1029,7 @@ def beams_3d(
                 ("upper_contact", 2, [face(slave_part, 2, g.gap)]),
                 ("lower_contact", 2, [face(master_part, 2, 0.0)]),
                 ("upper_clamp", 2, [face(clamped_upper, 0, g.tip + g.length)]),
-                ("lower_clamp", 2, [face(clamped_lower, 0, 0.0)]),
+                ("lower_clamp", 2, [lower_clamp]),
                 ("upper_tip", 2, [face(slave_part, 0, g.tip)]),
             ],
             tdim=3,

@@ -356,13 +356,15 @@ class BeamsScene:
         """Beam-theory estimate ``(N, w)`` of the contact force and the upper tip deflection.
 
         The upper beam is a cantilever of length ``L`` with tip stiffness ``k1 = 3 EI / L^3``;
-        the lower one, loaded at ``a = tip`` from its clamp, has ``k2 = 3 EI_2 / a^3``. Contact
-        starts at ``P_c = k1 gap``; then ``N = (P - P_c) k2 / (k1 + k2)`` and the tip deflects
-        by ``gap + N / k2`` (before, by ``P / k1`` and ``N = 0``).
+        the lower one, loaded at ``a = lower_arm`` from its clamp, has ``k2 = 3 EI_2 / a^3``.
+        Contact starts at ``P_c = k1 gap``; then ``N = (P - P_c) k2 / (k1 + k2)`` and the tip
+        deflects by ``gap + N / k2`` (before, by ``P / k1`` and ``N = 0``). A point contact:
+        it holds while only the tip corner touches (with ``clamps = "opposite"``, or at
+        small load).
         """
         g = self.geometry
         k1 = 3.0 * self.bending_stiffness / g.length**3
-        k2 = 3.0 * self.lower_bending_stiffness / g.tip**3
+        k2 = 3.0 * self.lower_bending_stiffness / g.lower_arm**3
         P_c = k1 * g.gap
         if P <= P_c:
             return 0.0, P / k1
@@ -382,13 +384,17 @@ def beams(
 ) -> BeamsScene:
     """Two Neo-Hookean cantilevers, the upper one pushed at its free tip by a follower force.
 
-    The beams of :func:`~contact_ufl.verification.geometries.beams_3d` are clamped at opposite ends.
-    The free end section of the upper beam carries the follower force :class:`FollowerForce` of
-    magnitude ``load * t * EI / L^2`` (``t`` the pseudo-time), directed along the carried reference
-    direction ``-e_z``: it stays perpendicular to the deformed beam axis. The upper beam bends down,
-    its tip meets the lower beam and, as it rotates, slides along it. Slave: the bottom of the upper
-    beam above the lower one; master: the top of the lower beam near its free end; ``eps_N =
-    eps_factor E / h`` with ``h`` the upper element size.
+    The beams of :func:`~contact_ufl.verification.geometries.beams_3d` (by default clamped on
+    the same side, the lower one nearer the upper tip:
+    :class:`~contact_ufl.verification.geometries.BeamPair`). The free end section of the upper
+    beam carries the follower force :class:`FollowerForce` of magnitude ``load * t * EI / L^2``
+    (``t`` the pseudo-time), directed along the carried reference direction ``-e_z``: it stays
+    perpendicular to the deformed beam axis. The upper beam bends down and its tip meets the
+    lower beam; the lower beam, pressed by a shorter lever, turns faster, and the upper beam's
+    underside bends onto it and slides along it (with ``clamps = "opposite"`` only the tip
+    corner touches). Slave: the bottom of the upper beam above the lower one; master: the top of
+    the lower beam from ``master_start``; ``eps_N = eps_factor E / h`` with ``h`` the upper
+    element size.
 
     Parameters
     ----------
