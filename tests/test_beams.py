@@ -105,7 +105,7 @@ def test_large_rotations_and_equilibrium(showcase):
     """20 steps without a cut-back, a large rotation, and equilibrium. The two balances
     hold by construction (equilibrium of any converged solve, to the solver tolerance):
     they check the reactions and the contact force, not the solution."""
-    runs, _, _ = showcase
+    runs, _ = showcase
     for problem in runs.values():
         assert problem.t == pytest.approx(1.0)
         assert len(problem.history.steps) == STEPS and not problem.history.cutbacks
@@ -162,7 +162,7 @@ def test_coulomb_law_at_every_step(showcase):
 
 
 def test_friction_changes_the_final_state(showcase):
-    runs, _, _ = showcase
+    runs, _ = showcase
     tip = runs[0.0].scene.tags["upper_tip"]
     u0, u3 = (section_motion(runs[mu], tip)[0] for mu in (0.0, 0.3))
     assert abs(u0[0] - u3[0]) > 0.05 * abs(u0[0])
