@@ -10,9 +10,9 @@ where a master facet tag would go::
 Rigid motion
 ------------
 ``motion`` is a callable of the pseudo-time ``t`` returning either a translation ``c(t)``
-(``gdim`` numbers) or a pair ``(c(t), Q(t))`` of a translation and a rotation matrix
-(``gdim x gdim``, orthogonal with determinant 1). A point ``P`` of the obstacle in its
-reference position moves to
+(``gdim`` numbers, e.g. ``lambda t: (0.0, -0.1 * t)``) or a pair ``(c(t), Q(t))`` of a
+translation and a rotation matrix (``gdim x gdim``, orthogonal with determinant 1). A point
+``P`` of the obstacle in its reference position moves to
 
     p(t) + Q(t) (P - p0),     p(t) = p0 + c(t),
 
@@ -67,6 +67,14 @@ def _vector(value) -> tuple[float, ...]:
     return tuple(float(v) for v in np.ravel(np.asarray(value, dtype=float)))
 
 
+def _is_vector(value, gdim: int) -> bool:
+    """Whether ``value`` is a translation (``gdim`` numbers), not a pair (c, Q)."""
+    try:
+        return np.asarray(value, dtype=float).shape == (gdim,)
+    except (ValueError, TypeError):
+        return False
+
+
 def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
@@ -97,10 +105,10 @@ class RigidObstacle:
         c, Q = np.zeros(gdim), np.eye(gdim)
         if self.motion is not None:
             value = self.motion(t)
-            if isinstance(value, tuple) and len(value) == 2:
-                c, Q = (np.asarray(v, dtype=float) for v in value)
-            else:
+            if _is_vector(value, gdim):
                 c = np.asarray(value, dtype=float)
+            else:
+                c, Q = (np.asarray(v, dtype=float) for v in value)
         return np.asarray(self.reference_point) + c, Q
 
     def validate(self, comm: MPI.Comm, gdim: int) -> None:

@@ -1,0 +1,153 @@
+"""Rigid obstacles as the master of a contact pair: consistent tangent, Hertz on a rigid
+flat, the obstacle's reaction, friction, the same result on any number of ranks, bad input."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+from test_hertz import hertz_errors
+
+import contact_ufl as cu
+from contact_ufl.errors import ContactInputError
+from contact_ufl.problem import ContactProblem
+from contact_ufl.results import coulomb_law
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification import scenes
+from contact_ufl.verification.taylor_cases import obstacle_case
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("mu", [0.0, 0.05])
+def test_taylor_on_a_moving_obstacle(dim, mu):
+    """A deformed slave pressed onto a translated and rotated circle (2D) or cylinder (3D)
+    and slid over it: second-order remainders, frictionless and in slip (the slip reference
+    moved with the obstacle since the last committed step)."""
+    problem, dz, steps = obstacle_case(dim, mu=mu)
+    c = problem.contacts[0]
+    assert isinstance(c.pair.master, cu.RigidSphere if dim == 2 else cu.RigidCylinder)
+    assert c.fields == [c.lambda_N, *([c.friction.lambda_T] if mu else [])]  # no master field
+    active = problem.active_points()
+    assert active > 10
+    if mu:
+        assert problem.comm.allreduce(int(c.stick().sum())) == 0  # all in slip
+        slip = np.abs(c.friction.slip_at_points()).max(initial=0.0)
+        slip = problem.comm.allreduce(slip, op=MPI.MAX)
+        assert slip > 1e-3
+    result = taylor_test(problem, dz, steps)
+    assert not result.facets_changed and not result.active_changed
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
+
+
+def test_hertz_on_a_rigid_flat():
+    """The half disc of the Hertz scene pressed onto a RigidPlane: a and p0 within 1% of
+    Hertz with E* = E / (1 - nu^2) at a/h = 10, as the elastic flat of test_hertz. (Measured
+    -0.4% and +0.9%. The depth is half that of test_hertz: with a rigid flat the disc takes
+    all the strain, and at the same depth the finite-strain departure from the linear theory
+    alone is 1.2%.)"""
+    hertz = scenes.hertz_on_rigid_flat(h_contact=0.0035, depth=0.0025)
+    problem = ContactProblem(hertz.scene, verbose=False)
+    problem.solve(num_steps=4)
+    a_err, p0_err, profile_err, exact = hertz_errors(problem, hertz)
+    assert exact.a / hertz.h_contact > 8
+    assert abs(a_err) < 0.01
+    assert abs(p0_err) < 0.01
+    assert profile_err < 0.03
+
+
+def test_obstacle_reaction_balances_the_support():
+    """A block clamped at its bottom and pressed by a rigid circle moved down: the reaction
+    of the obstacle (its force on the block) is minus the support's reaction.
+
+    This holds by construction: the contact traction is a term of the displacement
+    residual, and the sum of the residual over the dofs of a body is the resultant of the
+    forces on it (the internal forces sum to zero), so reaction(support) = -(contact force)
+    up to the residual of the free dofs (the solver tolerance)."""
+    scene, circle = scenes.block_under_circle(n=8, depth=0.05)
+    problem = ContactProblem(scene, verbose=False)
+    problem.solve(num_steps=3)
+    R_obstacle = problem.obstacle_reaction(circle)
+    R_support = problem.reaction(1)
+    assert R_obstacle[1] < -0.01  # the circle pushes the block down
+    assert np.allclose(R_obstacle, problem.contact_force(), rtol=0, atol=1e-14)
+    assert np.linalg.norm(R_obstacle + R_support) < 1e-9 * np.linalg.norm(R_support)
+    assert problem.active_points() > 5
+    with pytest.raises(ValueError, match="no contact pair"):
+        problem.obstacle_reaction(cu.RigidPlane((0.0, 0.0), (0.0, 1.0)))
+
+
+def test_block_dragged_on_a_rigid_plane_sticks_then_slips():
+    """A block pressed onto a RigidPlane and dragged: it sticks while the tangential force
+    is below mu times the normal force, and where it slips |lambda_T| = mu lambda_N (the
+    global ratio is then mu: the plane's normal is constant)."""
+    mu, push, steps = 0.3, 0.03, 20
+    problem = ContactProblem(scenes.pushed_block_on_plane(mu=mu, push=push, nu=0.0), verbose=False)
+    log = []
+
+    def record(problem, step):
+        force = problem.contact_force()
+        c = problem.contacts[0]
+        log.append((step.t, abs(force[0]) / force[1], coulomb_law(problem), c.friction))
+
+    problem.solve(num_steps=2, t_end=1.0, callback=record)
+    problem.solve(num_steps=steps, t_end=2.0, callback=record)
+    stuck = [(r, check, f) for t, r, check, f in log if r < 0.5 * mu]
+    sliding = [(r, check) for t, r, check, f in log if t > 1.5]
+    assert len(stuck) > 2 and sliding
+    for _, check, friction in stuck:
+        assert check.slipping == 0 and check.active > 40
+        assert friction.last_weak_slip < 1e-6 * push / steps
+    for ratio, check in sliding:
+        assert check.slipping == check.active > 40
+        assert check.slip_excess < 1e-10 and check.excess < 1e-10 and check.alignment > 0.999
+        assert abs(ratio - mu) < 1e-10
+
+
+def _slid_block(comm):
+    scene, circle = scenes.block_under_circle(n=8, depth=0.04, slide=0.02, mu=0.3, comm=comm)
+    problem = ContactProblem(scene, verbose=False)
+    problem.solve(num_steps=3)
+    return problem, circle
+
+
+def test_same_result_on_any_number_of_ranks():
+    """The frictional circle pressed and slid over the block: the same obstacle reaction and
+    Newton iterations on this communicator as on one rank."""
+    alone, circle_alone = _slid_block(MPI.COMM_SELF)
+    shared, circle = _slid_block(MPI.COMM_WORLD)
+    f1, f2 = alone.obstacle_reaction(circle_alone), shared.obstacle_reaction(circle)
+    assert abs(f1[0]) > 0.05 * abs(f1[1])  # a real tangential force
+    assert np.allclose(f1, f2, rtol=0, atol=1e-9 * np.linalg.norm(f1))
+    assert [s.newton_iterations for s in alone.history.steps] == [
+        s.newton_iterations for s in shared.history.steps
+    ]
+
+
+@pytest.mark.parametrize(
+    "master, message",
+    [
+        (cu.RigidSphere((0.0, 1.0), 0.0), "radius must be positive"),
+        (cu.RigidSphere((0.0, 1.0), -0.5), "radius must be positive"),
+        (cu.RigidPlane((0.0, 1.0), (0.0, 0.0)), "normal must be a nonzero vector"),
+        (cu.RigidPlane((0.0, 0.0, 1.0), (0.0, 0.0, -1.0)), "must have 2 components in 2D"),
+        (cu.RigidCylinder((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), 0.5), "needs a 3D scene"),
+        (cu.RigidPlane((0.0, 1.0), (0.0, 1.0)), "never faces its obstacle"),
+        (
+            cu.RigidPlane((0.0, 1.0), (0.0, -1.0), motion=lambda t: (t, 2 * t, 0.0)),
+            "motion",
+        ),
+    ],
+)
+def test_bad_obstacles(master, message):
+    """A degenerate or misplaced obstacle: a clear error on every rank."""
+    scene, _ = scenes.block_under_circle(n=2)
+    pair = dataclasses.replace(scene.contacts[0], master=master)
+    with pytest.raises(ContactInputError, match=message):
+        ContactProblem(dataclasses.replace(scene, contacts=[pair]), verbose=False)
+
+
+def test_an_obstacle_cannot_be_the_slave():
+    scene, circle = scenes.block_under_circle(n=2)
+    pair = cu.ContactPair(slave=circle, master=2)
+    with pytest.raises(ContactInputError, match="cannot be the slave"):
+        ContactProblem(dataclasses.replace(scene, contacts=[pair]), verbose=False)
