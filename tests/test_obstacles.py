@@ -3,8 +3,10 @@ flat, the obstacle's reaction, friction, the same result on any number of ranks,
 
 import dataclasses
 
+import dolfinx
 import numpy as np
 import pytest
+import ufl
 from mpi4py import MPI
 from test_hertz import hertz_errors
 
@@ -14,7 +16,10 @@ from contact_ufl.problem import ContactProblem
 from contact_ufl.results import coulomb_law
 from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import scenes
-from contact_ufl.verification.taylor_cases import obstacle_case
+from contact_ufl.verification.taylor_cases import obstacle_case, rotation
+
+#: a rotation about (1, 1, 1) by 0.4 (test_closest_points_on_a_moved_obstacle)
+ROT = rotation(0.4 * np.ones(3) / np.sqrt(3.0))
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -34,9 +39,67 @@ def test_taylor_on_a_moving_obstacle(dim, mu):
         slip = np.abs(c.friction.slip_at_points()).max(initial=0.0)
         slip = problem.comm.allreduce(slip, op=MPI.MAX)
         assert slip > 1e-3
+    assert ufl_numpy_mismatch(problem) < 1e-12
     result = taylor_test(problem, dz, steps)
     assert not result.facets_changed and not result.active_changed
     assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
+
+
+def ufl_numpy_mismatch(problem) -> float:
+    """``|(g, nu)_UFL - (g, nu)_NumPy|`` in L2 over the paired slave points, relative: the
+    forms and the results see the same closest points on the moved obstacle."""
+    c = problem.contacts[0]
+    k, slave = c.kinematics, c.slave
+    proj = k.projection
+    paired = proj.facet >= 0
+    data = dolfinx.fem.Function(slave.point_space((1 + c.gdim,)))
+    slave.set_at_points(
+        data, np.where(paired[:, None], np.hstack([proj.gap[:, None], proj.normal]), 0)
+    )
+    exact = ufl.as_vector([k.gap, *[k.nu[i] for i in range(c.gdim)]])
+    diff = k.mask * (exact - data)
+    values = [
+        dolfinx.fem.assemble_scalar(dolfinx.fem.form(f * c.ds, entity_maps=[slave.entity_map]))
+        for f in (ufl.dot(diff, diff), k.mask * ufl.dot(data, data))
+    ]
+    total = problem.comm.allreduce(np.array(values), MPI.SUM)
+    return float(np.sqrt(total[0] / total[1]))
+
+
+@pytest.mark.parametrize(
+    "obstacle",
+    [
+        cu.RigidPlane((0.0, 0.5, 0.0), (1.0, 2.0, 2.0), motion=lambda t: (np.ones(3) * t, ROT)),
+        cu.RigidSphere((0.1, 0.2, 0.3), 0.7, motion=lambda t: (np.ones(3) * t, ROT)),
+        cu.RigidCylinder((0.1, 0.2, 0.3), (0.0, 1.0, 1.0), 0.7, motion=lambda t: ((t, 0, 0), ROT)),
+        cu.RigidSphere((0.1, 0.2), 0.7, motion=lambda t: (t, 2.0 * t)),
+    ],
+)
+def test_closest_points_on_a_moved_obstacle(obstacle):
+    """The moved obstacle (rotation about its point, then translation): the closest point y
+    of x is on the moved surface, x - y is along the unit outward normal nu, and
+    g = -nu . (x - y)."""
+    gdim = len(obstacle.reference_point)
+    rng = np.random.default_rng(0)
+    x = rng.uniform(-2.0, 2.0, (50, gdim))
+    p, Q = obstacle.pose(0.5, gdim)
+    nu, g, valid = obstacle.closest(x, p, Q)
+    assert valid.all()
+    y = x + g[:, None] * nu
+    assert np.allclose(np.linalg.norm(nu, axis=1), 1.0)
+    assert np.allclose(-np.einsum("pd,pd->p", nu, x - y), g)
+    # the moved surface: the reference surface mapped by P -> p + Q (P - p0)
+    Y = (y - p) @ Q + obstacle.reference_point  # back to the reference position
+    if isinstance(obstacle, cu.RigidPlane):
+        n0 = np.asarray(obstacle.normal)
+        assert np.allclose((Y - obstacle.point) @ n0, 0.0)
+        assert np.allclose(nu, Q @ n0 / np.linalg.norm(n0))
+    elif isinstance(obstacle, cu.RigidSphere):
+        assert np.allclose(np.linalg.norm(Y - obstacle.centre, axis=1), obstacle.radius)
+    else:
+        a0 = np.asarray(obstacle.axis) / np.linalg.norm(obstacle.axis)
+        w = Y - obstacle.point
+        assert np.allclose(np.linalg.norm(w - np.outer(w @ a0, a0), axis=1), obstacle.radius)
 
 
 def test_hertz_on_a_rigid_flat():
@@ -150,4 +213,11 @@ def test_an_obstacle_cannot_be_the_slave():
     scene, circle = scenes.block_under_circle(n=2)
     pair = cu.ContactPair(slave=circle, master=2)
     with pytest.raises(ContactInputError, match="cannot be the slave"):
+        ContactProblem(dataclasses.replace(scene, contacts=[pair]), verbose=False)
+
+
+def test_no_smoothed_normal_on_an_obstacle():
+    scene, circle = scenes.block_under_circle(n=2)
+    pair = cu.ContactPair(slave=2, master=circle, master_normal="smoothed")
+    with pytest.raises(ContactInputError, match="own exact normal"):
         ContactProblem(dataclasses.replace(scene, contacts=[pair]), verbose=False)

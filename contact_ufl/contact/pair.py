@@ -112,6 +112,12 @@ class ContactPair:
         )
         collective_check(
             comm,
+            not (self.on_obstacle and self.master_normal != "facet"),
+            f"master_normal={self.master_normal!r} applies to a meshed master surface; a rigid "
+            "obstacle has its own exact normal",
+        )
+        collective_check(
+            comm,
             self.slave != self.master,
             f"slave and master tags must differ (both {self.slave})",
         )
