@@ -13,7 +13,7 @@ from test_hertz import hertz_errors
 import contact_ufl as cu
 from contact_ufl.errors import ContactInputError
 from contact_ufl.problem import ContactProblem
-from contact_ufl.results import coulomb_law
+from contact_ufl.results import coulomb_law, equilibrium_error
 from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import scenes
 from contact_ufl.verification.taylor_cases import obstacle_case, rotation
@@ -154,6 +154,9 @@ def test_block_dragged_on_a_rigid_plane_sticks_then_slips():
 
     problem.solve(num_steps=2, t_end=1.0, callback=record)
     problem.solve(num_steps=steps, t_end=2.0, callback=record)
+    plane = problem.scene.contacts[0].master
+    assert equilibrium_error(problem, ["lower_bottom", "upper_top"], [plane]) < 1e-8
+    assert equilibrium_error(problem, ["lower_bottom", "upper_top"]) > 0.1  # the plane's part
     stuck = [(r, check, f) for t, r, check, f in log if r < 0.5 * mu]
     sliding = [(r, check) for t, r, check, f in log if t > 1.5]
     assert len(stuck) > 2 and sliding

@@ -67,7 +67,7 @@ class CoulombLaw:
     ----------
     kinematics
         The pair's master side (normal, projected point, and the slip reference
-        ``y_n`` with its history: :meth:`slip_reference`).
+        ``y_n`` with its history, made by its ``slip_reference()``).
     t_N
         The normal contact traction (UFL, from the normal law).
     mu

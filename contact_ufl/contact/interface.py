@@ -57,6 +57,18 @@ class ContactInterface:
     modulus
         Young's modulus of the softer of the two bodies: the scale of the default ``eps_N``
         (needed only when ``pair.eps_N`` is ``None``).
+
+    Attributes
+    ----------
+    slave
+        The slave side.
+    master
+        The master side: a :class:`.MeshMaster`, or the rigid obstacle of the pair.
+    kinematics
+        The master side as the laws see it: :class:`.MeshKinematics` or
+        :class:`.ObstacleKinematics`.
+    normal, friction
+        The normal law and the Coulomb law (``None`` without friction).
     """
 
     def __init__(
