@@ -4,6 +4,7 @@ flat, the obstacle's reaction, friction, the same result on any number of ranks,
 import dataclasses
 
 import dolfinx
+import dolfinx.fem.petsc
 import numpy as np
 import pytest
 import ufl
@@ -22,15 +23,16 @@ from contact_ufl.verification.taylor_cases import obstacle_case, rotation
 ROT = rotation(0.4 * np.ones(3) / np.sqrt(3.0))
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim, shape", [(2, "circle"), (3, "cylinder"), (3, "sphere")])
 @pytest.mark.parametrize("mu", [0.0, 0.05])
-def test_taylor_on_a_moving_obstacle(dim, mu):
-    """A deformed slave pressed onto a translated and rotated circle (2D) or cylinder (3D)
-    and slid over it: second-order remainders, frictionless and in slip (the slip reference
-    moved with the obstacle since the last committed step)."""
-    problem, dz, steps = obstacle_case(dim, mu=mu)
+def test_taylor_on_a_moving_obstacle(dim, shape, mu):
+    """A deformed slave pressed onto a translated and rotated circle (2D), cylinder or
+    sphere (3D) and slid over it: second-order remainders, frictionless and in slip (the
+    slip reference moved with the obstacle since the last committed step)."""
+    problem, dz, steps = obstacle_case(dim, mu=mu, shape=shape)
     c = problem.contacts[0]
-    assert isinstance(c.pair.master, cu.RigidSphere if dim == 2 else cu.RigidCylinder)
+    expected = cu.RigidCylinder if shape == "cylinder" else cu.RigidSphere
+    assert isinstance(c.pair.master, expected)
     assert c.fields == [c.lambda_N, *([c.friction.lambda_T] if mu else [])]  # no master field
     active = problem.active_points()
     assert active > 10
@@ -224,3 +226,30 @@ def test_no_smoothed_normal_on_an_obstacle():
     pair = cu.ContactPair(slave=2, master=circle, master_normal="smoothed")
     with pytest.raises(ContactInputError, match="own exact normal"):
         ContactProblem(dataclasses.replace(scene, contacts=[pair]), verbose=False)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_slip_follows_the_obstacle(dim):
+    """A slave body carried along with the obstacle's rigid motion (translation and rotation)
+    since the last converged step does not slip on it: zero slip, unchanged gaps."""
+    problem, _, _ = obstacle_case(dim, mu=0.05)
+    c, solver = problem.contacts[0], problem.solver
+    problem.commit(solver.x)
+    problem.begin_step()
+    gap = c.projection.gap.copy()
+    p1, Q1 = c.kinematics.pose
+    problem.set_time(1.5)
+    p2, Q2 = c.kinematics.pose
+    assert np.linalg.norm(Q2 - Q1) > 0.05 and np.linalg.norm(p2 - p1) > 0.005
+    # x -> p2 + Q2 Q1^T (x - p1) at the nodes: exact for P1, the map being affine
+    X = problem.V.tabulate_dof_coordinates()[:, :dim]
+    x = X + problem.u.x.array.reshape(-1, dim)
+    problem.u.x.array[:] = (p2 + (x - p1) @ (Q2 @ Q1.T).T - X).ravel()
+    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
+    solver.forget_state()
+    solver.evaluate_residual(solver.x)
+    slip = np.abs(c.friction.slip_at_points()).max(initial=0.0)
+    assert problem.comm.allreduce(slip, op=MPI.MAX) < 1e-13
+    paired = c.projection.facet >= 0
+    assert np.allclose(c.projection.gap[paired], gap[paired], rtol=0, atol=1e-13)
+    assert problem.comm.allreduce(int(paired.sum())) > 10

@@ -143,12 +143,13 @@ def rotation(angles: np.ndarray) -> np.ndarray:
     return np.eye(3) + np.sin(theta) * K + (1.0 - np.cos(theta)) * K @ K
 
 
-def moving_obstacle(dim: int) -> RigidObstacle:
+def moving_obstacle(dim: int, shape: str = "cylinder") -> RigidObstacle:
     """The rigid obstacle of :func:`obstacle_case`: the lower body's top of
     :func:`~contact_ufl.verification.scenes.curved_pair` made rigid (2D: the circle of
     radius 3 touching the disc at the origin; 3D: the cylinder of radius 3 with axis along
-    x), translated by ``(0.02, -0.01) t`` (3D ``(0.02, 0.01, -0.008) t``) and rotated about
-    its centre (axis) by ``0.3 t`` (3D the rotation vector ``(0.1, 0, 0.2) t``)."""
+    x, or with ``shape="sphere"`` the ball of radius 3 touching the half cylinder at the
+    origin), translated by ``(0.02, -0.01) t`` (3D ``(0.02, 0.01, -0.008) t``) and rotated
+    about its centre (axis) by ``0.3 t`` (3D the rotation vector ``(0.1, 0, 0.2) t``)."""
     if dim == 2:
 
         def motion(t: float):
@@ -159,21 +160,28 @@ def moving_obstacle(dim: int) -> RigidObstacle:
     def motion3(t: float):
         return np.array([0.02, 0.01, -0.008]) * t, rotation(np.array([0.1, 0.0, 0.2]) * t)
 
+    if shape == "sphere":
+        return RigidSphere((0.0, 0.0, -3.0), 3.0, motion=motion3)
     return RigidCylinder((0.0, 0.0, -3.0), (1.0, 0.0, 0.0), 3.0, motion=motion3)
 
 
-def obstacle_case(dim: int, num_steps: int = 4, mu: float = 0.0):
+def obstacle_case(dim: int, num_steps: int = 4, mu: float = 0.0, shape: str = "cylinder"):
     """The Taylor test case of a slave on a moved and rotated rigid obstacle
     (:func:`moving_obstacle`): the upper body of
     :func:`~contact_ufl.verification.scenes.curved_pair` pressed onto it and slid over it.
 
     The state is at pseudo-time 1; with ``mu > 0`` the slip history was committed at
     pseudo-time 0.5 half-way along the translation, so the slip reference has moved with
-    the obstacle since (a small ``mu`` puts the contact points in slip). Returns the
-    problem at its state, the direction and the steps, as :func:`curved_case`.
+    the obstacle since (a small ``mu`` puts the contact points in slip). ``shape``: that of
+    the 3D obstacle (:func:`moving_obstacle`). Returns the problem at its state, the
+    direction and the steps, as :func:`curved_case`.
     """
     scene = curved_pair(dim)
-    scene.contacts[0] = dataclasses.replace(scene.contacts[0], master=moving_obstacle(dim), mu=mu)
+    obstacle = moving_obstacle(dim, shape)
+    # every slave point within the search radius: no point changes pairing over the steps
+    scene.contacts[0] = dataclasses.replace(
+        scene.contacts[0], master=obstacle, mu=mu, search_radius=2.0
+    )
     problem = ContactProblem(scene, verbose=False)
     solver = problem.solver
     state = CURVED_STATES[dim]
