@@ -47,6 +47,16 @@ def test_taylor_on_a_moving_obstacle(dim, shape, mu):
     assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
 
 
+def test_taylor_detects_a_frozen_obstacle_projection():
+    """Freezing the obstacle's normal and projected point leaves a first-order remainder;
+    unfreezing it restores the second order."""
+    problem, dz, steps = obstacle_case(3, shape="sphere")
+    problem.contacts[0].kinematics.frozen_projection = True
+    assert np.all(np.abs(taylor_test(problem, dz, steps).slopes - 1.0) < 0.01)
+    problem.contacts[0].kinematics.frozen_projection = False
+    assert np.all(np.abs(taylor_test(problem, dz, steps).slopes - 2.0) < 0.01)
+
+
 def ufl_numpy_mismatch(problem) -> float:
     """``|(g, nu)_UFL - (g, nu)_NumPy|`` in L2 over the paired slave points, relative: the
     forms and the results see the same closest points on the moved obstacle."""

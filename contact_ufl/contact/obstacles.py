@@ -315,10 +315,28 @@ class ObstacleKinematics:
         self.projection: Projection | None = None
         #: seconds spent computing closest points so far
         self.search_time = 0.0
-        self.x = ufl.SpatialCoordinate(mesh) + u
-        self.nu, self.gap = obstacle.closest_ufl(self.x, self.p, self.Q, self.mask)
-        self.y = self.x + self.gap * self.nu
+        # the normal and projected point of the last update, as data (frozen_projection)
+        self._nu0 = dolfinx.fem.Function(slave.point_space((gdim,)))
+        self._y0 = dolfinx.fem.Function(slave.point_space((gdim,)))
+        self._frozen = dolfinx.fem.Constant(mesh, 0.0)
+        self.x = x = ufl.SpatialCoordinate(mesh) + u
+        nu, gap = obstacle.closest_ufl(x, self.p, self.Q, self.mask)
+        f = self._frozen
+        self.nu = (1.0 - f) * nu + f * self._nu0
+        self.gap = (1.0 - f) * gap - f * ufl.dot(self._nu0, x - self._y0)
+        self.y = x + self.gap * self.nu
         self.set_time(0.0)
+
+    @property
+    def frozen_projection(self) -> bool:
+        """Freeze the normal and the projected point inside a Newton iteration (data of the
+        last update: the normal's rotation drops out of the tangent, and Newton converges
+        only linearly), as :attr:`.MeshKinematics.frozen_projection`. For comparisons."""
+        return bool(self._frozen.value)
+
+    @frozen_projection.setter
+    def frozen_projection(self, frozen: bool) -> None:
+        self._frozen.value = float(frozen)
 
     def set_time(self, t: float) -> None:
         """Move the obstacle to its pose at pseudo-time ``t``."""
@@ -360,8 +378,10 @@ class ObstacleKinematics:
         """Closest points of the current slave points; nothing is gathered."""
         start = time.perf_counter()
         x = self.slave.positions(self.u).reshape(-1, self.gdim)
-        self.projection = self.closest_points(x)
-        self.slave.set_at_points(self.mask, (self.projection.facet >= 0).astype(float))
+        self.projection = proj = self.closest_points(x)
+        self.slave.set_at_points(self.mask, (proj.facet >= 0).astype(float))
+        self.slave.set_at_points(self._nu0, proj.normal)
+        self.slave.set_at_points(self._y0, proj.y)
         self.search_time += time.perf_counter() - start
         return []
 
