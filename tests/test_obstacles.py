@@ -17,6 +17,7 @@ from contact_ufl.problem import ContactProblem
 from contact_ufl.results import coulomb_law, equilibrium_error
 from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import scenes
+from contact_ufl.verification.geometries import tag_single_body
 from contact_ufl.verification.taylor_cases import obstacle_case, rotation
 
 #: a rotation about (1, 1, 1) by 0.4 (test_closest_points_on_a_moved_obstacle)
@@ -263,3 +264,49 @@ def test_slip_follows_the_obstacle(dim):
     paired = c.projection.facet >= 0
     assert np.allclose(c.projection.gap[paired], gap[paired], rtol=0, atol=1e-13)
     assert problem.comm.allreduce(int(paired.sum())) > 10
+
+
+def _cube_scene(master) -> cu.Scene:
+    """The unit cube as one body, clamped at z = 0 (tag 1), its top z = 1 (tag 2) the slave
+    of a pair with ``master``."""
+    mesh = dolfinx.mesh.create_unit_cube(
+        MPI.COMM_WORLD, 2, 2, 2, ghost_mode=dolfinx.mesh.GhostMode.shared_facet
+    )
+    cells, facets = tag_single_body(
+        mesh, [lambda x: np.isclose(x[2], 0.0), lambda x: np.isclose(x[2], 1.0)]
+    )
+    return cu.Scene(
+        mesh,
+        cells,
+        facets,
+        [cu.Body(1, cu.NeoHookean(1.0, 0.3))],
+        contacts=[cu.ContactPair(2, master)],
+        dirichlet=[cu.Dirichlet(1, (0.0, 0.0, 0.0))],
+    )
+
+
+@pytest.mark.parametrize(
+    "master, message",
+    [
+        (cu.RigidCylinder((0.5, 0.5, 2.0), (0.0, 0.0, 0.0), 0.5), "axis must be a nonzero"),
+        (cu.RigidCylinder((0.5, 0.5, 2.0), (1.0, 0.0, 0.0), 0.0), "radius must be positive"),
+        (cu.RigidCylinder((0.5, 2.0), (1.0, 0.0), 0.5), "must have 3 components in 3D"),
+        (cu.RigidSphere((0.5, 0.5, 2.0), -1.0), "radius must be positive"),
+        (cu.RigidPlane((0.5, 0.5, 1.5), (0.0, 0.0, 0.0)), "normal must be a nonzero"),
+    ],
+)
+def test_bad_obstacles_in_3d(master, message):
+    with pytest.raises(ContactInputError, match=message):
+        ContactProblem(_cube_scene(master), verbose=False)
+
+
+def test_a_cylinder_above_a_cube():
+    """The 3D scene of the bad-input cases with a valid cylinder moved down onto the cube:
+    it solves, and the obstacle's reaction balances the support's."""
+    down = lambda t: (0.0, 0.0, -0.05 * t)  # noqa: E731
+    cylinder = cu.RigidCylinder((0.5, 0.5, 1.5), (1.0, 0.0, 0.0), 0.5, motion=down)
+    problem = ContactProblem(_cube_scene(cylinder), verbose=False)
+    problem.solve(num_steps=2)
+    R = problem.obstacle_reaction(cylinder)
+    assert R[2] < -1e-3
+    assert np.linalg.norm(R + problem.reaction(1)) < 1e-9 * np.linalg.norm(R)
