@@ -310,3 +310,22 @@ def test_a_cylinder_above_a_cube():
     R = problem.obstacle_reaction(cylinder)
     assert R[2] < -1e-3
     assert np.linalg.norm(R + problem.reaction(1)) < 1e-9 * np.linalg.norm(R)
+
+
+def test_names_resolve_around_an_obstacle():
+    """A slave given by physical-group name is resolved; the obstacle master is left as it
+    is, and the pair works."""
+    scene, circle = scenes.block_under_circle(n=4)
+    named = cu.Scene(
+        scene.mesh,
+        scene.cell_tags,
+        scene.facet_tags,
+        scene.bodies,
+        contacts=[cu.ContactPair("top", circle)],
+        dirichlet=[cu.Dirichlet("bottom", (0.0, 0.0))],
+        tags={"bottom": 1, "top": 2},
+    )
+    assert named.contacts[0].slave == 2 and named.contacts[0].master is circle
+    problem = ContactProblem(named, verbose=False)
+    problem.solve(num_steps=1)
+    assert problem.active_points() > 0
