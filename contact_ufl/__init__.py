@@ -33,7 +33,7 @@ from contact_ufl import (
     output,
     results,
 )
-from contact_ufl.contact import ContactPair
+from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSphere
 from contact_ufl.errors import ContactInputError, ConvergenceError
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerForce, FollowerPressure
 from contact_ufl.materials import NeoHookean, SaintVenantKirchhoff
@@ -65,6 +65,9 @@ __all__ = [
     "NeoHookean",
     "NewtonSolver",
     "ResultWriter",
+    "RigidCylinder",
+    "RigidPlane",
+    "RigidSphere",
     "SaintVenantKirchhoff",
     "Scene",
     "StepRecord",

@@ -22,6 +22,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from contact_ufl.contact import ContactInterface, ContactPair
+from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.layout import StackedLayout
 from contact_ufl.loads import BodyForce, deformation_gradient, evaluate, load_constant
 from contact_ufl.mpi import global_bounds
@@ -34,12 +35,14 @@ if TYPE_CHECKING:
 
 
 def softer_modulus(scene: Scene, pair: ContactPair) -> float:
-    """The smallest Young's modulus of the bodies whose cells hold the facets of ``pair``."""
+    """The smallest Young's modulus of the bodies whose cells hold the facets of ``pair``
+    (the slave body alone when the master is a rigid obstacle)."""
     mesh = scene.mesh
     tdim = mesh.topology.dim
     mesh.topology.create_connectivity(tdim - 1, tdim)
     f2c = mesh.topology.connectivity(tdim - 1, tdim)
-    facets = np.concatenate([scene.facet_tags.find(pair.slave), scene.facet_tags.find(pair.master)])
+    sides = [pair.slave] if pair.on_obstacle else [pair.slave, pair.master]
+    facets = np.concatenate([scene.facet_tags.find(tag) for tag in sides])
     cells = f2c.array[f2c.offsets[facets]]
     num_cells = mesh.topology.index_map(tdim).size_local + mesh.topology.index_map(tdim).num_ghosts
     cell_tag = np.full(num_cells, -1, dtype=np.int64)
@@ -237,10 +240,13 @@ class ContactProblem:
 
     # -- pseudo-time and the step protocol ----------------------------------------------
     def set_time(self, t: float) -> None:
-        """Set the pseudo-time (load factor) of loads and prescribed displacements."""
+        """Set the pseudo-time (load factor) of loads, prescribed displacements and the
+        motion of rigid obstacles."""
         self.t = t
         for load, c in self._load_constants:
             c.value = evaluate(load.value, t)
+        for c in self.contacts:
+            c.set_time(t)
 
     def _parts_with_history(self) -> list:
         return [*self.contacts, *self.histories.values()]
@@ -322,6 +328,23 @@ class ContactProblem:
         blocks = blocks[blocks < owned]
         local = R.array[: owned * gdim].reshape(-1, gdim)[blocks].sum(axis=0)
         return self.comm.allreduce(local, MPI.SUM)
+
+    def obstacle_reaction(self, obstacle: RigidObstacle) -> np.ndarray:
+        """Resultant force of a rigid obstacle on the bodies at the current state: its
+        reaction, reported like a support's (:meth:`reaction` is the force of a support on
+        the body). The force of the bodies on the obstacle is its negative.
+
+        It is the contact resultant ``int (t_N nu - P(q)) dS_o`` on the slave surfaces of
+        all pairs whose master is ``obstacle`` (compared with ``==``), summed over all
+        ranks. With the obstacle a scene's forces balance as with supports only:
+        ``sum of support reactions + obstacle reactions + loads = 0``, to solver tolerance
+        (the contact traction is a term of the displacement residual, whose sum over a
+        body's dofs is exactly the resultant of its external and contact forces).
+        """
+        pairs = [c for c in self.contacts if c.pair.on_obstacle and c.pair.master == obstacle]
+        if not pairs:
+            raise ValueError(f"no contact pair of this problem has the master {obstacle}")
+        return sum((c.integrate("traction") for c in pairs), np.zeros(self.V.mesh.geometry.dim))
 
     def load_resultant(self) -> np.ndarray:
         """Resultant of all applied loads (dead and follower) at the current state."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import dolfinx
@@ -252,17 +253,21 @@ def section_motion(problem, tag: int | str) -> tuple[np.ndarray, np.ndarray]:
     return _facet_integral(problem, u, tag) / area, n / np.linalg.norm(n)
 
 
-def equilibrium_error(problem, supports: list[str | int]) -> float:
-    """Global equilibrium: ``|sum of support reactions + resultant of the loads|``, relative
-    to the loads' resultant. The contact forces are internal to the scene and cancel.
+def equilibrium_error(problem, supports: list[str | int], obstacles: Sequence = ()) -> float:
+    """Global equilibrium: ``|sum of support and obstacle reactions + resultant of the
+    loads|``, relative to the loads' resultant. The contact forces between bodies are
+    internal to the scene and cancel.
 
     ``supports`` are facet tags (or the names of their physical groups) that carry all
-    prescribed displacements.
+    prescribed displacements; ``obstacles`` the rigid obstacles of the scene's pairs (their
+    reactions, :meth:`~contact_ufl.problem.ContactProblem.obstacle_reaction`, count like the
+    supports').
     """
     tags = [problem.scene.facet_tag(s) for s in supports]
     # reaction() is the residual without the prescribed-displacement equations on the
     # support dofs, internal minus external forces: the force of the support on the body
     reactions = sum(problem.reaction(tag) for tag in tags)
+    reactions = reactions + sum(problem.obstacle_reaction(o) for o in obstacles)
     load = problem.load_resultant()
     return float(np.linalg.norm(load + reactions) / np.linalg.norm(load))
 

@@ -69,7 +69,8 @@ class Scene:
     Notes
     -----
     Every tag (``Body.tag``, ``Dirichlet.tag``, the loads' ``tag``, ``ContactPair.slave``
-    and ``.master``) may be a physical group name: it is replaced by its integer when the
+    and ``.master``) may be a physical group name (a rigid obstacle as ``.master`` is left as
+    it is): it is replaced by its integer when the
     scene is made. An unknown name, or a group of the wrong dimension (a cell group as a
     contact surface, a facet group as a body), raises
     :class:`~contact_ufl.errors.ContactInputError` on every rank.
@@ -126,6 +127,7 @@ class Scene:
 
         parts = [*bodies, *dirichlet, *loads]
         keys = [p.tag for p in parts] + [k for c in contacts for k in (c.slave, c.master)]
+        # (rigid obstacles among the keys are not strings: they need no physical group)
         data = read_gmsh(
             source,
             comm,
@@ -269,6 +271,8 @@ class Scene:
             f"facet_tags have dimension {self.facet_tags.dim}, expected {tdim - 1}",
         )
         collective_check(comm, len(self.bodies) > 0, "a scene needs at least one body")
+        for pair in self.contacts:
+            pair.validate(comm)
         for body in self.bodies:
             count = comm.allreduce(len(self.cell_tags.find(body.tag)), MPI.SUM)
             collective_check(

@@ -21,6 +21,10 @@ current position ``ybar_n`` (the current positions ``xhat_n`` of the nodes of th
 master facet, gathered from the displacement like ``xhat``). It is objective, it follows
 the master body when it moves, and it needs no assumption that the point stays on one
 master facet (large sliding). A point with no master facet at the last step has s_T = 0.
+The master side provides ``ybar_n`` with its history (``slip_reference()``): on a meshed
+master as above (:class:`~contact_ufl.contact.kinematics.MeshSlipReference`), on a rigid
+obstacle the last step's projected point moved by the obstacle's rigid motion since
+(:class:`~contact_ufl.contact.obstacles.ObstacleSlipReference`).
 
 Discrete multiplier: ``lambda_T`` is a continuous P1 vector field on the slave submesh; only
 its part tangent to the master surface enters q, and its multiplier equation drives its
@@ -37,8 +41,11 @@ import ufl
 from mpi4py import MPI
 
 from contact_ufl.contact.kinematics import MeshKinematics
-from contact_ufl.contact.projection import shape_functions
+from contact_ufl.contact.obstacles import ObstacleKinematics
 from contact_ufl.contact.slave import SlaveSurface
+
+#: A master side as the laws see it.
+MasterKinematics = MeshKinematics | ObstacleKinematics
 
 
 def disc_projection(q, radius):
@@ -59,7 +66,8 @@ class CoulombLaw:
     Parameters
     ----------
     kinematics
-        The pair's contact kinematics (normal, projected point, gathered master nodes).
+        The pair's master side (normal, projected point, and the slip reference
+        ``y_n`` with its history, made by its ``slip_reference()``).
     t_N
         The normal contact traction (UFL, from the normal law).
     mu
@@ -68,7 +76,7 @@ class CoulombLaw:
         Tangential augmentation parameter (> 0).
     """
 
-    def __init__(self, kinematics: MeshKinematics, t_N, mu: float, eps_T: float):
+    def __init__(self, kinematics: MasterKinematics, t_N, mu: float, eps_T: float):
         self.kinematics = k = kinematics
         self.slave: SlaveSurface = k.slave
         self.gdim = k.gdim
@@ -77,37 +85,34 @@ class CoulombLaw:
         self.lambda_T = dolfinx.fem.Function(self.L_T, name="lambda_T")
         self.mu = dolfinx.fem.Constant(mesh, float(mu))
         self.eps_T = dolfinx.fem.Constant(mesh, float(eps_T))
-        self.xhat_n = dolfinx.fem.Function(k.Qx, name="master_nodes_last_step")
-        self.xi_n = dolfinx.fem.Function(k.xi0.function_space)
-        self.mask_n = dolfinx.fem.Function(k.mask.function_space)
-        self._zero = dolfinx.fem.Function(k.mask.function_space)
-        self._gather_n = None
-        self._x_commit = None
-        self._xhat_n_commit = None
-        self._work = None  # vectors of update_history, allocated once
-        self._committed = None  # the converged state, until the next step begins
+        #: the slip reference of the master side (``y_n``, its history and step protocol)
+        self.reference = k.slip_reference()
         #: Slip increments s_T of the last converged step at the owned slave points, and
         #: which of them stuck.
         self.last_slip = np.zeros((0, self.gdim))
         self.last_stick = np.zeros(0, dtype=bool)
         self.last_weak_slip = 0.0
         self._t_N = t_N
-        y_n = k.master_point(self.xi_n, k.nodes(self.xhat_n))
         nu = k.nu
 
         def tangential(w):
             return w - ufl.dot(w, nu) * nu
 
-        self.y_n = y_n
-        self.slip = self.mask_n * tangential(k.x - y_n)
+        self.y_n = self.reference.y_n
+        self.slip = self.mask_n * tangential(k.x - self.y_n)
         self.q = tangential(self.lambda_T) + self.eps_T * self.slip
         self.t_T = disc_projection(self.q, self.mu * t_N)
 
     @property
+    def mask_n(self) -> dolfinx.fem.Function:
+        """1 at the slave points that had a master at the last converged step."""
+        return self.reference.mask_n
+
+    @property
     def fields(self) -> list[dolfinx.fem.Function]:
-        """Fields of the assembled system the law adds: ``lambda_T`` and the last step's
-        master nodes (gathered from the displacement)."""
-        return [self.lambda_T, self.xhat_n]
+        """Fields of the assembled system the law adds: ``lambda_T`` and those of the slip
+        reference (on a meshed master, the last step's master nodes)."""
+        return [self.lambda_T, *self.reference.fields]
 
     @property
     def unknowns(self) -> list[dolfinx.fem.Function]:
@@ -119,14 +124,11 @@ class CoulombLaw:
         return -self.t_T
 
     def residuals(self) -> list[ufl.Form]:
-        """The ``lambda_T`` equation (times eps_T, like the normal one) and the zero residual
-        of ``xhat_n``."""
+        """The ``lambda_T`` equation (times eps_T, like the normal one) and the residuals of
+        the slip reference's fields."""
         ds = self.slave.ds
         F_t = -ufl.dot(self.lambda_T - self.t_T, ufl.TestFunction(self.L_T)) * ds
-        # xhat_n has no equation of its own: a zero residual, present so that derivatives
-        # with respect to it are assembled and chained onto the displacement by T
-        F_n = self._zero * ufl.dot(self.xhat_n, ufl.TestFunction(self.kinematics.Qx)) * ds
-        return [F_t, F_n]
+        return [F_t, *self.reference.residuals(ds)]
 
     def surface_integrands(self) -> dict[str, ufl.core.expr.Expr]:
         """``"friction"``, the frictional traction on the slave body ``-P(q)``, and
@@ -134,30 +136,15 @@ class CoulombLaw:
         return {"friction": -self.t_T, "dissipation": ufl.dot(self.t_T, self.slip)}
 
     def gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
-        """The gathered fields of the law (after the kinematics' update): the last step's
-        master nodes gather what the converged projection gathered."""
-        if self._gather_n is None:
-            self._gather_n = np.full_like(self.kinematics.gather, -1)
-        return [(self.xhat_n, self._gather_n)]
+        """The gathered fields of the law (after the kinematics' update): those of the slip
+        reference."""
+        return self.reference.gathers()
 
     # -- the step protocol ------------------------------------------------------------
     def update_history(self, T, x, block_slice) -> None:
-        """Current positions of the last step's master facet nodes: ``xhat_n,commit +
-        P_n (u - u_commit)``, evaluated through T (the nodes may live on any rank)."""
-        xhat = self.kinematics.xhat
-        owned = len(self._gather_n)
-        if self._x_commit is None:
-            self.xhat_n.x.array[:owned] = xhat.x.array[:owned]
-        else:
-            if self._work is None:
-                self._work = (x.duplicate(), T.createVecLeft())
-            dx, full = self._work
-            x.copy(dx)
-            dx.axpy(-1.0, self._x_commit)
-            T.mult(dx, full)
-            moved = full.array[block_slice(self.xhat_n)]
-            self.xhat_n.x.array[:owned] = self._xhat_n_commit + moved
-        self.xhat_n.x.scatter_forward()
+        """Refresh the slip reference at the current state (through T where it is
+        gathered from the displacement)."""
+        self.reference.update_history(T, x, block_slice)
 
     def commit(self, x, normal_traction: np.ndarray) -> None:
         """Remember the converged projection: the reference of the next step's slip.
@@ -166,42 +153,22 @@ class CoulombLaw:
         step starts everything inspected (slip, stick, tractions, contact force) is that of
         the converged step. ``normal_traction``: ``t_N`` at the owned points.
         """
-        k = self.kinematics
-        owned = len(k.gather)
         self.last_slip = self.slip_at_points()
         self.last_stick = self.stick(normal_traction)
         self.last_weak_slip = self.weak_slip(self.last_stick)
-        self._committed = (
-            k.gather.copy(),
-            k.xhat.x.array[:owned].copy(),
-            x.copy(),
-            k.xi0.x.array.copy(),
-            k.mask.x.array.copy(),
-            k.xhat.x.array.copy(),
-        )
+        self.reference.commit(x)
 
     def begin_step(self) -> None:
         """The last committed projection becomes the reference of the slip (idempotent:
         a step cut back and tried again starts from the same reference)."""
-        if self._committed is None:
-            return
-        gather, xhat_owned, x, xi, mask, xhat = self._committed
-        self._gather_n = gather
-        self._xhat_n_commit = xhat_owned
-        self._x_commit = x
-        self.xi_n.x.array[:] = xi
-        self.mask_n.x.array[:] = mask
-        self.xhat_n.x.array[:] = xhat
-        self._committed = None
+        self.reference.begin_step()
 
     # -- inspection -------------------------------------------------------------------
     def slip_at_points(self) -> np.ndarray:
         """Slip increment s_T since the last converged step at the owned slave points."""
         k, slave, gdim = self.kinematics, self.slave, self.gdim
         x = slave.positions(k.u).reshape(-1, gdim)
-        nodes = slave.at_points(self.xhat_n).reshape(len(x), k.nx, gdim)[:, : k.nn]
-        N_n = shape_functions(k.nn, gdim, slave.at_points(self.xi_n))[0]
-        s = (x - np.einsum("pa,pad->pd", N_n, nodes)) * slave.at_points(self.mask_n)
+        s = (x - self.reference.y_n_at_points()) * slave.at_points(self.mask_n)
         return self._tangential(s)
 
     @functools.cached_property

@@ -4,10 +4,12 @@ A :class:`ContactInterface` is what the problem assembles for one :class:`.Conta
 
 * the slave side (:class:`.SlaveSurface`): the slave facets, their quadrature points and the
   data carried at them;
-* the master side (:class:`.MeshMaster`): a meshed master surface;
-* the search (:class:`.ClosestPointSearch`): the Python closest-point mapping;
+* the master side (:class:`.MeshMaster`): a meshed master surface, with
+* the search (:class:`.ClosestPointSearch`): the Python closest-point mapping, and
 * the kinematics (:class:`.MeshKinematics`): the projected point, the normal, the gap and
   the master virtual displacement in UFL;
+* or, for a rigid obstacle as the master (:mod:`.obstacles`), its kinematics
+  (:class:`.ObstacleKinematics`), with no fields and no unknowns;
 * the normal law (:class:`.NormalLaw`) and, where ``mu > 0``, the Coulomb law
   (:class:`.CoulombLaw`).
 
@@ -31,6 +33,7 @@ from contact_ufl.contact.coulomb import CoulombLaw
 from contact_ufl.contact.kinematics import MeshKinematics
 from contact_ufl.contact.master import MeshMaster
 from contact_ufl.contact.normal import NormalLaw
+from contact_ufl.contact.obstacles import ObstacleKinematics
 from contact_ufl.contact.pair import ContactPair
 from contact_ufl.contact.projection import Projection
 from contact_ufl.contact.search import ClosestPointSearch
@@ -54,6 +57,18 @@ class ContactInterface:
     modulus
         Young's modulus of the softer of the two bodies: the scale of the default ``eps_N``
         (needed only when ``pair.eps_N`` is ``None``).
+
+    Attributes
+    ----------
+    slave
+        The slave side.
+    master
+        The master side: a :class:`.MeshMaster`, or the rigid obstacle of the pair.
+    kinematics
+        The master side as the laws see it: :class:`.MeshKinematics` or
+        :class:`.ObstacleKinematics`.
+    normal, friction
+        The normal law and the Coulomb law (``None`` without friction).
     """
 
     def __init__(
@@ -68,7 +83,7 @@ class ContactInterface:
         comm = mesh.comm
         pair.validate(comm)
         self.u, self.V, self.pair = u, V, pair
-        self.gdim = gdim = mesh.geometry.dim
+        self.gdim = mesh.geometry.dim
         degree = V.ufl_element().embedded_superdegree
         # the master surface is interpolated from its vertices: exact for P1/Q1 only
         geometry_degree = mesh.geometry.cmaps[0].degree
@@ -78,30 +93,14 @@ class ContactInterface:
             f"contact needs degree-1 displacement and geometry (got {degree} and "
             f"{geometry_degree}): higher-order master surfaces are not implemented",
         )
-        smoothed = pair.master_normal == "smoothed"
-        collective_check(
-            comm,
-            not smoothed or gdim == 2,
-            "master_normal='smoothed' is implemented for 2D (segment) master surfaces only",
-        )
         qdeg = pair.quadrature_degree or 2 * degree + 1
         self.slave = SlaveSurface(
             V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions, pair.quadrature_rule
         )
-        self.master = MeshMaster(V, facet_tags, pair.master, smoothed)
-        size = global_diameter(
-            comm,
-            np.vstack([self.slave.X.reshape(-1, gdim), self.master.X_nodes.reshape(-1, gdim)]),
-        )
-        #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see ``macaulay``)
-        self.touching = 1e-12 * size
-        radius = pair.search_radius or 0.25 * size
-        search = ClosestPointSearch(self.slave, self.master, radius, self.touching)
-        search.check_facing(
-            f"slave surface (tag {pair.slave}) of the pair with master surface (tag {pair.master})"
-        )
         #: the master side as the laws see it (gap, normal, projected point, master fields)
-        self.kinematics = MeshKinematics(u, self.slave, self.master, search)
+        self.kinematics = (
+            self._obstacle_side(pair) if pair.on_obstacle else self._mesh_side(facet_tags, pair)
+        )
         eps_N = pair.eps_N if pair.eps_N is not None else default_eps(self.slave, modulus)
         self.normal = NormalLaw(self.slave, eps_N, self.touching)
         self.t_N = self.normal.traction(self.kinematics.gap, self.kinematics.mask)
@@ -112,6 +111,44 @@ class ContactInterface:
             else None
         )
         self._surface_forms: dict[str, list[dolfinx.fem.Form]] = {}
+
+    def _mesh_side(self, facet_tags: dolfinx.mesh.MeshTags, pair: ContactPair) -> MeshKinematics:
+        """The kinematics of a meshed master surface (with its search)."""
+        comm, gdim = self.V.mesh.comm, self.gdim
+        smoothed = pair.master_normal == "smoothed"
+        collective_check(
+            comm,
+            not smoothed or gdim == 2,
+            "master_normal='smoothed' is implemented for 2D (segment) master surfaces only",
+        )
+        self.master = MeshMaster(self.V, facet_tags, pair.master, smoothed)
+        size = global_diameter(
+            comm,
+            np.vstack([self.slave.X.reshape(-1, gdim), self.master.X_nodes.reshape(-1, gdim)]),
+        )
+        #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see ``macaulay``)
+        self.touching = 1e-12 * size
+        radius = pair.search_radius or 0.25 * size
+        search = ClosestPointSearch(self.slave, self.master, radius, self.touching)
+        kinematics = MeshKinematics(self.u, self.slave, self.master, search)
+        kinematics.check_facing(
+            f"slave surface (tag {pair.slave}) of the pair with master surface (tag {pair.master})"
+        )
+        return kinematics
+
+    def _obstacle_side(self, pair: ContactPair) -> ObstacleKinematics:
+        """The kinematics of a rigid obstacle: the sizes are those of the slave surface."""
+        comm, gdim = self.V.mesh.comm, self.gdim
+        self.master = obstacle = pair.master
+        obstacle.validate(comm, gdim)
+        size = global_diameter(comm, self.slave.X.reshape(-1, gdim))
+        self.touching = 1e-12 * size
+        radius = pair.search_radius or 0.25 * size
+        kinematics = ObstacleKinematics(self.u, self.slave, obstacle, radius)
+        kinematics.check_facing(
+            f"slave surface (tag {pair.slave}) of the pair with a {type(obstacle).__name__}"
+        )
+        return kinematics
 
     # -- what the problem assembles ----------------------------------------------------
     @property
@@ -155,7 +192,11 @@ class ContactInterface:
         gathers = self.kinematics.update(layout)
         return gathers + (self.friction.gathers() if self.friction else [])
 
-    # -- the step protocol --------------------------------------------------------------
+    # -- pseudo-time and the step protocol ------------------------------------------------
+    def set_time(self, t: float) -> None:
+        """Set the pseudo-time of the master side (the pose of a rigid obstacle)."""
+        self.kinematics.set_time(t)
+
     def update_history(self, T, x, block_slice) -> None:
         """Refresh the data that needs the chain operator (the slip reference)."""
         if self.friction:
@@ -180,7 +221,7 @@ class ContactInterface:
     @property
     def search_time(self) -> float:
         """Seconds spent in the closest-point search so far."""
-        return self.kinematics.search.time
+        return self.kinematics.search_time
 
     @property
     def lambda_N(self) -> dolfinx.fem.Function:

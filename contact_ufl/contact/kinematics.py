@@ -28,6 +28,7 @@ import numpy as np
 import ufl
 
 from contact_ufl.contact.master import MeshMaster
+from contact_ufl.contact.projection import shape_functions
 from contact_ufl.contact.search import ClosestPointSearch, Pairing
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.layout import StackedLayout
@@ -233,3 +234,119 @@ class MeshKinematics:
         slave.set_at_points(self.mask, paired.astype(float))
         if self.neighbour_flags is not None:
             slave.set_at_points(self.neighbour_flags, pairing.flags)
+
+    @property
+    def search_time(self) -> float:
+        """Seconds spent in the closest-point search so far."""
+        return self.search.time
+
+    def set_time(self, t: float) -> None:
+        """Nothing: a meshed master moves with the displacement."""
+
+    def check_facing(self, description: str) -> None:
+        """Raise (on every rank) if no slave point faces the master surface (see
+        :meth:`.ClosestPointSearch.check_facing`)."""
+        self.search.check_facing(description)
+
+    def slip_reference(self) -> MeshSlipReference:
+        """The slip reference of the Coulomb law on this master side."""
+        return MeshSlipReference(self)
+
+
+class MeshSlipReference:
+    """The slip reference ``y_n`` of friction on a meshed master side.
+
+    ``y_n = sum_a N_a(xi_n) xhat_n,a``: the master *material* point a slave point was
+    projected onto at the end of the last converged step, at its current position (the
+    current positions ``xhat_n`` of the nodes of that step's master facet, gathered from the
+    displacement like ``xhat``). ``xhat_n`` is a field of the assembled system (with a zero
+    residual, so that its derivatives are assembled and chained onto the displacement).
+
+    Parameters
+    ----------
+    kinematics
+        The master side.
+    """
+
+    def __init__(self, kinematics: MeshKinematics):
+        self.kinematics = k = kinematics
+        self.xhat_n = dolfinx.fem.Function(k.Qx, name="master_nodes_last_step")
+        self.xi_n = dolfinx.fem.Function(k.xi0.function_space)
+        self.mask_n = dolfinx.fem.Function(k.mask.function_space)
+        self._zero = dolfinx.fem.Function(k.mask.function_space)
+        self._gather_n = None
+        self._x_commit = None
+        self._xhat_n_commit = None
+        self._work = None  # vectors of update_history, allocated once
+        self._committed = None  # the converged state, until the next step begins
+        self.y_n = k.master_point(self.xi_n, k.nodes(self.xhat_n))
+
+    @property
+    def fields(self) -> list[dolfinx.fem.Function]:
+        """The last step's master nodes (gathered from the displacement)."""
+        return [self.xhat_n]
+
+    def residuals(self, ds: ufl.Measure) -> list[ufl.Form]:
+        """The zero residual of ``xhat_n``: it has no equation of its own, but derivatives
+        with respect to it are assembled and chained onto the displacement by T."""
+        return [self._zero * ufl.dot(self.xhat_n, ufl.TestFunction(self.kinematics.Qx)) * ds]
+
+    def gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """The last step's master nodes gather what the converged projection gathered."""
+        if self._gather_n is None:
+            self._gather_n = np.full_like(self.kinematics.gather, -1)
+        return [(self.xhat_n, self._gather_n)]
+
+    def update_history(self, T, x, block_slice) -> None:
+        """Current positions of the last step's master facet nodes: ``xhat_n,commit +
+        P_n (u - u_commit)``, evaluated through T (the nodes may live on any rank)."""
+        xhat = self.kinematics.xhat
+        owned = len(self._gather_n)
+        if self._x_commit is None:
+            self.xhat_n.x.array[:owned] = xhat.x.array[:owned]
+        else:
+            if self._work is None:
+                self._work = (x.duplicate(), T.createVecLeft())
+            dx, full = self._work
+            x.copy(dx)
+            dx.axpy(-1.0, self._x_commit)
+            T.mult(dx, full)
+            moved = full.array[block_slice(self.xhat_n)]
+            self.xhat_n.x.array[:owned] = self._xhat_n_commit + moved
+        self.xhat_n.x.scatter_forward()
+
+    def commit(self, x) -> None:
+        """Remember the converged projection (it becomes the reference in
+        :meth:`begin_step`)."""
+        k = self.kinematics
+        owned = len(k.gather)
+        self._committed = (
+            k.gather.copy(),
+            k.xhat.x.array[:owned].copy(),
+            x.copy(),
+            k.xi0.x.array.copy(),
+            k.mask.x.array.copy(),
+            k.xhat.x.array.copy(),
+        )
+
+    def begin_step(self) -> None:
+        """The last committed projection becomes the reference of the slip (idempotent:
+        a step cut back and tried again starts from the same reference)."""
+        if self._committed is None:
+            return
+        gather, xhat_owned, x, xi, mask, xhat = self._committed
+        self._gather_n = gather
+        self._xhat_n_commit = xhat_owned
+        self._x_commit = x
+        self.xi_n.x.array[:] = xi
+        self.mask_n.x.array[:] = mask
+        self.xhat_n.x.array[:] = xhat
+        self._committed = None
+
+    def y_n_at_points(self) -> np.ndarray:
+        """``y_n`` at the owned slave points, ``(n, gdim)``."""
+        k, slave, gdim = self.kinematics, self.kinematics.slave, self.kinematics.gdim
+        npts = slave.num_cells * slave.num_points
+        nodes = slave.at_points(self.xhat_n).reshape(npts, k.nx, gdim)[:, : k.nn]
+        N_n = shape_functions(k.nn, gdim, slave.at_points(self.xi_n))[0]
+        return np.einsum("pa,pad->pd", N_n, nodes)

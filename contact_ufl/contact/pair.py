@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from mpi4py import MPI
 
+from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.contact.quadrature import QUADRATURE_RULES
 from contact_ufl.errors import check_positive, collective_check
 
@@ -20,7 +21,10 @@ class ContactPair:
         Facet tag (or physical-group name) of the slave (contactor) surface; it carries the
         multipliers. Make it the finer of the two surfaces.
     master
-        Facet tag (or physical-group name) of the master (target) surface.
+        Facet tag (or physical-group name) of the master (target) surface, or a rigid
+        obstacle (:class:`~contact_ufl.contact.obstacles.RigidPlane`, ``RigidSphere``,
+        ``RigidCylinder``): an analytic surface with a prescribed motion, no mesh and no
+        unknowns.
     eps_N
         Normal augmentation parameter (> 0). It does not change the exact solution. Default
         (``None``): ``E / L``, with ``E`` the smaller Young's modulus of the two bodies and
@@ -55,7 +59,7 @@ class ContactPair:
     """
 
     slave: int | str
-    master: int | str
+    master: int | str | RigidObstacle
     eps_N: float | None = None
     mu: float = 0.0
     eps_T: float | None = None
@@ -70,8 +74,19 @@ class ContactPair:
         """Whether the pair has Coulomb friction (``mu > 0``)."""
         return self.mu > 0.0
 
+    @property
+    def on_obstacle(self) -> bool:
+        """Whether the master side is a rigid obstacle."""
+        return isinstance(self.master, RigidObstacle)
+
     def validate(self, comm: MPI.Comm) -> None:
         """Raise a clear error (on every rank) for invalid parameters."""
+        collective_check(
+            comm,
+            not isinstance(self.slave, RigidObstacle),
+            f"a rigid obstacle cannot be the slave of a contact pair (it has no mesh to carry "
+            f"the multipliers): make it the master, got slave = {type(self.slave).__name__}",
+        )
         if self.eps_N is not None:
             check_positive(comm, eps_N=self.eps_N)
         collective_check(comm, self.mu >= 0.0, f"mu must be >= 0, got mu = {self.mu}")
@@ -94,6 +109,12 @@ class ContactPair:
             comm,
             self.master_normal in ("facet", "smoothed"),
             f"master_normal must be 'facet' or 'smoothed', got {self.master_normal!r}",
+        )
+        collective_check(
+            comm,
+            not (self.on_obstacle and self.master_normal != "facet"),
+            f"master_normal={self.master_normal!r} applies to a meshed master surface; a rigid "
+            "obstacle has its own exact normal",
         )
         collective_check(
             comm,

@@ -10,10 +10,11 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+import dolfinx
 import numpy as np
 from mpi4py import MPI
 
-from contact_ufl.contact import ContactPair
+from contact_ufl.contact import ContactPair, RigidPlane, RigidSphere
 from contact_ufl.loads import DeadTraction, Dirichlet, FollowerForce
 from contact_ufl.materials import NeoHookean
 from contact_ufl.plasticity import J2Plasticity
@@ -445,3 +446,80 @@ def beams(
         tags=tags,
     )
     return BeamsScene(scene, geometry, E, nu, load)
+
+
+# -- rigid obstacles ---------------------------------------------------------------------------
+
+
+def hertz_on_rigid_flat(
+    h_contact: float = 0.005,
+    depth: float = 0.005,
+    E: float = 1.0,
+    nu: float = 0.3,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> HertzScene:
+    """Plane-strain Hertz on a rigid flat: the half disc of :func:`hertz_2d` (R = 1) pressed
+    by ``depth`` onto the :class:`~contact_ufl.contact.obstacles.RigidPlane` ``y = 0`` (the
+    block's top made rigid). The block stays in the scene, clamped and unloaded (no pair
+    involves it); ``E* = E / (1 - nu^2)`` (Johnson 1985, 4.2, with a rigid flat).
+    """
+    hertz = hertz_2d(h_contact=h_contact, depth=depth, E=E, nu=nu, comm=comm)
+    scene = hertz.scene
+    pair = dataclasses.replace(scene.contacts[0], master=RigidPlane((0.0, 0.0), (0.0, 1.0)))
+    scene = dataclasses.replace(scene, contacts=[pair])
+    return HertzScene(scene, 1.0, E / (1.0 - nu**2), h_contact)
+
+
+def block_under_circle(
+    n: int = 8,
+    depth: float = 0.05,
+    radius: float = 0.5,
+    E: float = 1.0,
+    nu: float = 0.3,
+    mu: float = 0.0,
+    slide: float = 0.0,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> tuple[Scene, RigidSphere]:
+    """A Neo-Hookean block ``[-0.5, 0.5] x [0, 0.5]`` (``2n x n`` squares cut into
+    triangles) clamped at its bottom (facet tag 1), its top (tag 2, the slave) pressed by a
+    rigid circle of ``radius`` that touches it at ``(0, 0.5)`` and moves by ``(slide t,
+    -depth t)`` (a :class:`~contact_ufl.contact.obstacles.RigidSphere` with a motion);
+    friction coefficient ``mu``, default ``eps_N``. Returns the scene and the obstacle."""
+    mesh = dolfinx.mesh.create_rectangle(
+        comm,
+        [np.array([-0.5, 0.0]), np.array([0.5, 0.5])],
+        [2 * n, n],
+        dolfinx.mesh.CellType.triangle,
+        ghost_mode=dolfinx.mesh.GhostMode.shared_facet,
+    )
+    cells, facets = geometries.tag_single_body(
+        mesh, [lambda x: np.isclose(x[1], 0.0), lambda x: np.isclose(x[1], 0.5)]
+    )
+    circle = RigidSphere((0.0, 0.5 + radius), radius, motion=lambda t: (slide * t, -depth * t))
+    scene = Scene(
+        mesh,
+        cells,
+        facets,
+        bodies=[Body(1, NeoHookean(E, nu), "block")],
+        contacts=[ContactPair(2, circle, mu=mu)],
+        dirichlet=[Dirichlet(1, (0.0, 0.0))],
+    )
+    return scene, circle
+
+
+def pushed_block_on_plane(
+    mu: float = 0.3,
+    pressure: float = 0.01,
+    push: float = 0.05,
+    nu: float = 0.3,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """:func:`pushed_block` with the lower block's top made rigid: the upper block pressed by
+    ``pressure`` onto the :class:`~contact_ufl.contact.obstacles.RigidPlane` ``y = 0`` from
+    t = 0 to 1, then its top moved horizontally by ``push (t - 1)`` (stick, then slip). The
+    lower block stays, clamped and unloaded (no pair involves it). With ``nu > 0`` the
+    pressed block widens on the rigid flat, so its edges slip already while it is pressed;
+    with ``nu = 0`` it sticks everywhere until the push nears ``mu`` times the load."""
+    scene = pushed_block(mu=mu, pressure=pressure, push=push, nu=nu, comm=comm)
+    pair = dataclasses.replace(scene.contacts[0], master=RigidPlane((0.0, 0.0), (0.0, 1.0)))
+    return dataclasses.replace(scene, contacts=[pair])

@@ -15,10 +15,18 @@ import dolfinx.fem.petsc
 import numpy as np
 from petsc4py import PETSc
 
+from contact_ufl.contact.obstacles import RigidCylinder, RigidObstacle, RigidSphere
 from contact_ufl.problem import ContactProblem
 from contact_ufl.verification.scenes import curved_pair
 
-__all__ = ["CURVED_STATES", "contact_state", "curved_case", "sliding_direction", "smooth_field"]
+__all__ = [
+    "CURVED_STATES",
+    "contact_state",
+    "curved_case",
+    "obstacle_case",
+    "sliding_direction",
+    "smooth_field",
+]
 
 
 def smooth_field(x: np.ndarray, amplitude: float, gdim: int, phase: float = 0.0) -> np.ndarray:
@@ -116,6 +124,75 @@ def curved_case(dim: int, num_steps: int = 4, mu: float = 0.0, master_normal: st
         contact_state(problem, tag, 0.5 * shift)
         problem.contacts[0].commit(solver.x)
         problem.contacts[0].begin_step()
+    contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
+    direction = sliding_direction(problem, tag, np.array(state["slide"]))
+    return problem, direction, [state["h0"] * 2.0**-k for k in range(num_steps)]
+
+
+def rotation(angles: np.ndarray) -> np.ndarray:
+    """The rotation matrix ``exp(W)`` of the rotation vector ``angles`` (3D; in 2D the
+    angle ``angles[0]`` about the normal of the plane)."""
+    if len(angles) == 1:
+        c, s = np.cos(angles[0]), np.sin(angles[0])
+        return np.array([[c, -s], [s, c]])
+    theta = np.linalg.norm(angles)
+    if theta == 0.0:
+        return np.eye(3)
+    k = np.asarray(angles) / theta
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + np.sin(theta) * K + (1.0 - np.cos(theta)) * K @ K
+
+
+def moving_obstacle(dim: int, shape: str = "cylinder") -> RigidObstacle:
+    """The rigid obstacle of :func:`obstacle_case`: the lower body's top of
+    :func:`~contact_ufl.verification.scenes.curved_pair` made rigid (2D: the circle of
+    radius 3 touching the disc at the origin; 3D: the cylinder of radius 3 with axis along
+    x, or with ``shape="sphere"`` the ball of radius 3 touching the half cylinder at the
+    origin), translated by ``(0.02, -0.01) t`` (3D ``(0.02, 0.01, -0.008) t``) and rotated
+    about its centre (axis) by ``0.3 t`` (3D the rotation vector ``(0.1, 0, 0.2) t``)."""
+    if dim == 2:
+
+        def motion(t: float):
+            return np.array([0.02, -0.01]) * t, rotation(np.array([0.3 * t]))
+
+        return RigidSphere((0.0, -3.0), 3.0, motion=motion)
+
+    def motion3(t: float):
+        return np.array([0.02, 0.01, -0.008]) * t, rotation(np.array([0.1, 0.0, 0.2]) * t)
+
+    if shape == "sphere":
+        return RigidSphere((0.0, 0.0, -3.0), 3.0, motion=motion3)
+    return RigidCylinder((0.0, 0.0, -3.0), (1.0, 0.0, 0.0), 3.0, motion=motion3)
+
+
+def obstacle_case(dim: int, num_steps: int = 4, mu: float = 0.0, shape: str = "cylinder"):
+    """The Taylor test case of a slave on a moved and rotated rigid obstacle
+    (:func:`moving_obstacle`): the upper body of
+    :func:`~contact_ufl.verification.scenes.curved_pair` pressed onto it and slid over it.
+
+    The state is at pseudo-time 1; with ``mu > 0`` the slip history was committed at
+    pseudo-time 0.5 half-way along the translation, so the slip reference has moved with
+    the obstacle since (a small ``mu`` puts the contact points in slip). ``shape``: that of
+    the 3D obstacle (:func:`moving_obstacle`). Returns the problem at its state, the
+    direction and the steps, as :func:`curved_case`.
+    """
+    scene = curved_pair(dim)
+    obstacle = moving_obstacle(dim, shape)
+    # every slave point within the search radius: no point changes pairing over the steps
+    scene.contacts[0] = dataclasses.replace(
+        scene.contacts[0], master=obstacle, mu=mu, search_radius=2.0
+    )
+    problem = ContactProblem(scene, verbose=False)
+    solver = problem.solver
+    state = CURVED_STATES[dim]
+    tag = scene.bodies[0].tag
+    shift = np.array(state["shift"])
+    if mu > 0:
+        problem.set_time(0.5)
+        contact_state(problem, tag, 0.5 * shift)
+        problem.contacts[0].commit(solver.x)
+        problem.contacts[0].begin_step()
+    problem.set_time(1.0)
     contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
     direction = sliding_direction(problem, tag, np.array(state["slide"]))
     return problem, direction, [state["h0"] * 2.0**-k for k in range(num_steps)]
