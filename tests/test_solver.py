@@ -44,19 +44,26 @@ def test_cutbacks_run_out_with_a_clear_error():
 
 def test_solver_and_stepping_made_by_hand():
     """``problem.solve`` is the solver and the load stepping composed: made by hand they give
-    the same steps and forces to the last bit; a problem has one solver."""
+    the same steps, Newton iterations and forces (to the last bit on one rank; on two, MUMPS's
+    parallel factorisation is reproducible only to round-off); a problem has one solver."""
     problem = hertz_problem()
     solver = NewtonSolver(problem)
     assert problem.solver is solver
     history = LoadStepper(problem, solver).solve(num_steps=4)
     reference = hertz_problem()
     reference.solve(num_steps=4)
-    assert [(r.t, r.newton_iterations, r.residual) for r in history.steps] == [
-        (r.t, r.newton_iterations, r.residual) for r in reference.history.steps
+    assert [(r.t, r.newton_iterations) for r in history.steps] == [
+        (r.t, r.newton_iterations) for r in reference.history.steps
     ]
     tag = problem.scene.dirichlet[0].tag
-    assert np.array_equal(problem.contact_force(), reference.contact_force())
-    assert np.array_equal(problem.reaction(tag), reference.reaction(tag))
+    tol = 0.0 if problem.comm.size == 1 else 1e-10  # relative, of the force
+    scale = np.linalg.norm(reference.contact_force())
+    for ours, theirs in (
+        ([r.residual for r in history.steps], [r.residual for r in reference.history.steps]),
+        (problem.contact_force(), reference.contact_force()),
+        (problem.reaction(tag), reference.reaction(tag)),
+    ):
+        assert np.abs(np.subtract(ours, theirs)).max() <= tol * scale
     with pytest.raises(ValueError, match="has a solver already"):
         NewtonSolver(problem)
 
