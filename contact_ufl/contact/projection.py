@@ -2,7 +2,7 @@
 
 Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search), vectorised over
 points and facets: the only Python loops run over a fixed small number of items (edges of a
-facet, Newton iterations, K-doublings of the neighbour search, blocks of points).
+facet, Newton iterations, blocks of points).
 
 Facet kinds and conventions
 ---------------------------
@@ -39,6 +39,8 @@ is on that bound, one that is not clamped is not):
 
 from __future__ import annotations
 
+import itertools
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,7 +71,8 @@ _EDGES = {
     ),
 }
 
-_K0 = 8  # first number of neighbours asked from the KD-tree
+_TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
+_MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
 _BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
@@ -202,6 +205,17 @@ def _unit_normal(a: FloatArray) -> FloatArray:
     return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
 
+def _slab_bound2(x: FloatArray, slab: FloatArray, g: int) -> FloatArray:
+    """Square of the lower bound of :meth:`_Master.lower_bound` for rows ``slab`` (P, 2g+2)
+    ``[c, n, T, R]``: ``(|n . d| - T)_+^2 + (|d - (n . d) n| - R)_+^2``, ``d = x - c``."""
+    d = x - slab[:, :g]
+    normal = np.abs(_dot(d, slab[:, g : 2 * g]))
+    tangent = np.sqrt(np.maximum(_dot(d, d) - normal * normal, 0.0))
+    a = np.maximum(normal - slab[:, 2 * g], 0.0)
+    b = np.maximum(tangent - slab[:, 2 * g + 1], 0.0)
+    return a * a + b * b
+
+
 def _segment_params(x: FloatArray, p: FloatArray, e: FloatArray) -> FloatArray:
     """Clamped parameter of the projection of ``x`` on the segments ``p + u e``, u in [0, 1]."""
     ee = _dot(e, e)
@@ -220,7 +234,13 @@ class _Pairs:
 
 
 class _Master:
-    """Master facets with the per-facet data of the search and the projections."""
+    """Master facets with the per-facet data of the search and the projections.
+
+    The KD-tree of the centroids is taken from :data:`_tree_cache` when a master surface of
+    the same shape was searched before and no node has moved more than ``_MOVE R_max``
+    since that tree was built: ``slack`` is then that movement, a bound of how far every
+    centroid is from the one the tree holds, and the search widens its bounds by it.
+    """
 
     def __init__(self, nodes: FloatArray) -> None:
         self.nodes = nodes
@@ -232,13 +252,15 @@ class _Master:
         # quadrilateral), so it lies within this radius of the centroid, which is on the facet
         self.size = np.linalg.norm(nodes - self.centroid[:, None], axis=2).max(axis=1)
         self.R_max = float(self.size.max()) if self.nf else 0.0
-        self.tree = cKDTree(self.centroid) if self.nf else None
+        self.tree, self.slack = _tree_cache.tree(nodes, self.centroid, self.R_max)
         # slab of the facet: unit normal at the centroid, largest node offset along it
         half = np.full((1, self.fdim), 0.5)
         _, dN, _ = shape_functions(self.nn, self.gdim, half)
         self.axis = _unit_normal(np.einsum("na,fng->fag", dN[0], nodes))
         offset = np.einsum("fng,fg->fn", nodes - self.centroid[:, None], self.axis)
         self.thickness = np.abs(offset).max(axis=1)
+        # the data of the lower bound, one row per facet (one gather per pair)
+        self.slab = np.column_stack([self.centroid, self.axis, self.thickness, self.size])
         if self.kind == "triangle":
             a1 = nodes[:, 1] - nodes[:, 0]
             a2 = nodes[:, 2] - nodes[:, 0]
@@ -258,12 +280,7 @@ class _Master:
         centroid ``c`` and within ``T_f`` of it along the normal ``n`` at the centre: with
         ``d = x - c``, ``|x - p|^2 >= (|n . d| - T_f)_+^2 + (|d - (n . d) n| - R_f)_+^2``.
         """
-        d = x - self.centroid[f]
-        normal = np.abs(_dot(d, self.axis[f]))
-        tangent = np.sqrt(np.maximum(_dot(d, d) - normal * normal, 0.0))
-        return np.hypot(
-            np.maximum(normal - self.thickness[f], 0.0), np.maximum(tangent - self.size[f], 0.0)
-        )
+        return np.sqrt(_slab_bound2(x, self.slab[f], self.gdim))
 
     # -- exact projections on (point, facet) pairs ----------------------------------------
 
@@ -439,34 +456,61 @@ def _quad_newton(
     return xi, np.linalg.norm(r, axis=1), conv, pd
 
 
+class _TreeCache:
+    """KD-trees of facet centroids, reused while the master surface has barely moved.
+
+    One entry per shape ``(nf, nn, gdim)`` of the node array (the ``_TREES`` most recent):
+    the nodes the tree was built from and the tree.
+    """
+
+    def __init__(self) -> None:
+        self.entries: OrderedDict[tuple[int, ...], tuple[FloatArray, cKDTree]] = OrderedDict()
+
+    def tree(
+        self, nodes: FloatArray, centroid: FloatArray, R_max: float
+    ) -> tuple[cKDTree | None, float]:
+        """A KD-tree of centroids within ``slack`` of ``centroid``, and that slack.
+
+        The centroid is the mean of the nodes, so it moves at most as far as the farthest
+        node: a tree of earlier centroids serves with ``slack`` the largest node movement.
+        """
+        if len(nodes) == 0:
+            return None, 0.0
+        key = nodes.shape
+        entry = self.entries.get(key)
+        if entry is not None:
+            built, tree = entry
+            move = float(np.sqrt(np.max(np.einsum("fng,fng->fn", nodes - built, nodes - built))))
+            if move <= _MOVE * R_max:
+                self.entries.move_to_end(key)
+                return tree, move
+        tree = cKDTree(centroid)
+        self.entries[key] = (nodes.copy(), tree)
+        self.entries.move_to_end(key)
+        while len(self.entries) > _TREES:
+            self.entries.popitem(last=False)
+        return tree, 0.0
+
+
+_tree_cache = _TreeCache()
+
+
 def _candidates(
     master: _Master, x: FloatArray, bound: FloatArray, active: IntArray
 ) -> tuple[IntArray, IntArray]:
     """All (point, facet) pairs with the facet's centroid within ``bound`` of the point.
 
-    ``cKDTree.query`` takes one scalar ``distance_upper_bound``; it is given the largest bound
-    of the points queried, and every point's own bound is then applied to its neighbours. A
-    point whose K-th neighbour is within its bound may have more: it is queried again with
-    twice as many neighbours, until none is cut off or K reaches the number of facets.
+    One ball query of the KD-tree per point, with the point's own bound (widened by the
+    slack of a reused tree): no repeated K-nearest queries.
     """
-    nf = master.nf
-    K = min(_K0, nf)
-    pids, fids = [], []
-    pending = active
-    while pending.size:
-        d, i = master.tree.query(
-            x[pending], k=K, distance_upper_bound=float(bound[pending].max()) * (1 + 1e-12)
-        )
-        d, i = d.reshape(-1, K), i.reshape(-1, K)
-        within = d <= bound[pending, None]
-        cut = within[:, -1] if K < nf else np.zeros(pending.size, dtype=bool)
-        keep = within & ~cut[:, None]
-        rows, cols = np.nonzero(keep)
-        pids.append(pending[rows])
-        fids.append(i[rows, cols])
-        pending = pending[cut]
-        K = min(2 * K, nf)
-    return np.concatenate(pids).astype(np.int64), np.concatenate(fids).astype(np.int64)
+    if active.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    lists = master.tree.query_ball_point(
+        x[active], bound[active] + master.slack, return_sorted=False
+    )
+    count = np.fromiter(map(len, lists), dtype=np.int64, count=len(lists))
+    fid = np.fromiter(itertools.chain.from_iterable(lists), dtype=np.int64, count=count.sum())
+    return np.repeat(active, count), fid
 
 
 def _sliding(
@@ -512,20 +556,18 @@ def _sliding(
 def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projection) -> None:
     """Fill ``out`` (arrays of this block of points) with the closest points of ``x``."""
     npts = x.shape[0]
-    d0, nearest = master.tree.query(x, k=1)
-    d0 = np.asarray(d0).reshape(-1)
-    nearest = np.asarray(nearest, dtype=np.int64).reshape(-1)
-    active = np.flatnonzero(d0 <= radius + master.R_max)
+    # the nearest centroid, where one can hold a facet point within the radius
+    reach0 = radius + master.R_max + 2.0 * master.slack
+    d0, nearest = master.tree.query(x, k=1, distance_upper_bound=reach0 * (1 + 1e-12))
+    active = np.flatnonzero(d0 <= reach0 * (1 + 1e-12))
     if active.size == 0:
         return
-    # tighter than d0: the exact distance to the facet of the nearest centroid (<= d0)
+    nearest = nearest[active].astype(np.int64)
+    # an upper bound of the distance: the exact distance to the facet of that centroid
     d1 = np.full(npts, np.inf)
-    d1[active] = master.project(
-        x[active], nearest[active], np.arange(active.size), active.size
-    ).dist
+    d1[active] = master.project(x[active], nearest, np.arange(active.size), active.size).dist
     reach = np.minimum(d1, radius)
-    bound = (reach + master.R_max) * (1 + 1e-12)
-    pid, fid = _candidates(master, x, bound, active)
+    pid, fid = _candidates(master, x, (reach + master.R_max) * (1 + 1e-12), active)
     lower = master.lower_bound(x[pid], fid)
     keep = lower <= reach[pid] * (1 + 1e-9) + 1e-9 * master.size[fid]
     pid, fid = pid[keep], fid[keep]
@@ -542,7 +584,9 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     nu = _unit_normal(np.einsum("pna,png->pag", dN, X))
     rn = np.linalg.norm(r, axis=1)
     align = np.divide(np.abs(_dot(nu, r)), rn, out=np.zeros_like(rn), where=rn > 0)
-    order = np.lexsort((-align, pid[e]))
+    # equal alignments: the nearer centroid, then the lower facet index
+    c = x[pid[e]] - master.centroid[fid[e]]
+    order = np.lexsort((fid[e], _dot(c, c), -align, pid[e]))
     first = np.ones(order.size, dtype=bool)
     first[1:] = pid[e][order[1:]] != pid[e][order[:-1]]
     best = e[order[first]]
@@ -594,15 +638,19 @@ def closest_points(
     Candidate search: a KD-tree of the facet centroids. The centroid of a facet lies on the
     facet and every facet point is within ``R_f`` (largest node distance from the centroid) of
     it, ``R_max = max R_f``. With ``d1 <= d0`` the exact distance of ``x`` to the facet of its
-    nearest centroid (``d0`` away), the closest point is within ``r = min(d1, radius)`` of
-    ``x``, so its facet has its centroid within ``r + R_max`` (KD-tree queries with K = 8, 16,
-    ... neighbours until no point is cut off). The facets whose distance lower bound (node
-    sphere and slab along the normal at the centre) exceeds ``r`` are dropped, the others
-    projected exactly. Points with ``d0 > radius + R_max`` get ``facet = -1`` at once.
+    nearest centroid (``d0`` away, a query bounded by ``radius + R_max``), the closest point
+    is within ``r = min(d1, radius)`` of ``x``, so its facet has its centroid within ``r +
+    R_max`` (one ball query per point, with the point's own ``r``: the work follows ``r``,
+    not the search radius). The facets whose distance lower bound (node sphere and slab along
+    the normal at the centre) exceeds ``r`` are dropped, the others projected exactly. Points
+    with ``d0 > radius + R_max`` get ``facet = -1`` at once. The KD-tree is reused from one
+    call to the next while the master nodes (same array shape) have moved less than ``0.25
+    R_max``, the bounds being widened by that movement.
 
     When several facets are at the same distance up to ``1e-10 (distance + facet size)``
     (the point projects onto a shared edge or vertex), the facet whose normal is the most
-    aligned with ``x - y`` wins.
+    aligned with ``x - y`` wins; at equal alignment the one with the nearer centroid, then the
+    lower index (so that the order the caller gives the facets in decides exact ties).
 
     Quadrilaterals: clamped Newton from the centre (restarted from four other points where it
     does not converge or stops at a saddle), compared with the projections on the four
