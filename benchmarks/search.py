@@ -10,8 +10,9 @@ on three wavy master surfaces:
   cell, each cell split in two triangles for the triangle surface);
 
 with slave points on a perturbed copy of the surface: uniform over the parameter domain (and
-5% beyond it), moved along the vertical by ``+-h 10^U(-2, 2)`` (h the facet size), so that
-a part of them lies within the search radius and a part beyond it. The radii run from ``h``
+5% beyond it), moved along the vertical by ``+-h 10^U(-2, 2)`` (h the facet size), at most
+0.25 (the package's default search radius is a quarter of the surfaces' size), so that a
+part of them lies within the search radius and a part beyond it. The radii run from ``h``
 to infinity. Each timing is the best of several calls (one call if it takes over a second).
 
     python benchmarks/search.py --json benchmarks/results/search.json [--quick]
@@ -83,7 +84,8 @@ def triangles(nf: int, rng: np.random.Generator) -> tuple[np.ndarray, float]:
 
 def slave_points(gdim: int, npts: int, h: float, rng: np.random.Generator) -> np.ndarray:
     """Points on a perturbed copy of the master surface (see the module docstring)."""
-    offset = h * 10.0 ** rng.uniform(-2.0, 2.0, size=npts) * rng.choice([-1.0, 1.0], size=npts)
+    offset = np.minimum(h * 10.0 ** rng.uniform(-2.0, 2.0, size=npts), 0.25)
+    offset *= rng.choice([-1.0, 1.0], size=npts)
     u = rng.uniform(-0.05, 1.05, size=(npts, gdim - 1))
     if gdim == 2:
         return np.stack([u[:, 0], surface_2d(u[:, 0]) + offset], axis=1)

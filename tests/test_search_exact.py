@@ -111,3 +111,17 @@ def test_equidistant_grid_facets():
         for order in (np.arange(len(nodes)), rng.permutation(len(nodes))):
             check(points, nodes[order])
             check(points, nodes[order], radius=0.3)
+
+
+def test_reused_tree_after_the_master_moves():
+    """The KD-tree of a master of the same shape is reused while its nodes move little: the
+    results after small and large movements are those of a fresh projection."""
+    rng = np.random.default_rng(7)
+    nodes = wavy_quads(rng, 36)
+    points = near_and_far(rng, nodes, 30)
+    check(points, nodes)
+    size = np.linalg.norm(nodes - nodes.mean(axis=1, keepdims=True), axis=2).max()
+    for move in (1e-3 * size, 0.2 * size, 2.0 * size):
+        moved = nodes + rng.uniform(-move, move, size=nodes.shape) / np.sqrt(3.0)
+        check(points, moved, radius=0.2)
+        check(points, moved)

@@ -553,6 +553,16 @@ def _sliding(
     return M
 
 
+def _concatenate(a: _Pairs, b: _Pairs) -> _Pairs:
+    """The pairs of ``a`` followed by those of ``b``."""
+    return _Pairs(
+        xi=np.concatenate([a.xi, b.xi]),
+        dist=np.concatenate([a.dist, b.dist]),
+        edge=np.concatenate([a.edge, b.edge]),
+        vertex=np.concatenate([a.vertex, b.vertex]),
+    )
+
+
 def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projection) -> None:
     """Fill ``out`` (arrays of this block of points) with the closest points of ``x``."""
     npts = x.shape[0]
@@ -564,51 +574,53 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
         return
     nearest = nearest[active].astype(np.int64)
     # an upper bound of the distance: the exact distance to the facet of that centroid
+    first = master.project(x[active], nearest, np.arange(active.size), active.size)
     d1 = np.full(npts, np.inf)
-    d1[active] = master.project(x[active], nearest, np.arange(active.size), active.size).dist
+    d1[active] = first.dist
     reach = np.minimum(d1, radius)
     pid, fid = _candidates(master, x, (reach + master.R_max) * (1 + 1e-12), active)
     lower = master.lower_bound(x[pid], fid)
     keep = lower <= reach[pid] * (1 + 1e-9) + 1e-9 * master.size[fid]
+    # the pair of the nearest centroid is projected already
+    done = np.full(npts, -1, dtype=np.int64)
+    done[active] = nearest
+    keep &= fid != done[pid]
     pid, fid = pid[keep], fid[keep]
-    pairs = master.project(x[pid], fid, pid, npts)
+    pairs = _concatenate(master.project(x[pid], fid, pid, npts), first)
+    pid, fid = np.concatenate([pid, active]), np.concatenate([fid, nearest])
 
     # minimum per point; ties (shared edges and vertices) go to the best-aligned normal
     dmin = np.full(npts, np.inf)
     np.minimum.at(dmin, pid, pairs.dist)
     tie = pairs.dist <= dmin[pid] + _TIE * (dmin[pid] + 2.0 * master.size[fid])
     e = np.flatnonzero(tie)
-    N, dN, _ = shape_functions(master.nn, master.gdim, pairs.xi[e])
-    X = master.nodes[fid[e]]
-    r = x[pid[e]] - np.einsum("pn,png->pg", N, X)
-    nu = _unit_normal(np.einsum("pna,png->pag", dN, X))
-    rn = np.linalg.norm(r, axis=1)
-    align = np.divide(np.abs(_dot(nu, r)), rn, out=np.zeros_like(rn), where=rn > 0)
-    # equal alignments: the nearer centroid, then the lower facet index
-    c = x[pid[e]] - master.centroid[fid[e]]
-    order = np.lexsort((fid[e], _dot(c, c), -align, pid[e]))
-    first = np.ones(order.size, dtype=bool)
-    first[1:] = pid[e][order[1:]] != pid[e][order[:-1]]
-    best = e[order[first]]
-
-    p, f, xi = pid[best], fid[best], pairs.xi[best]
+    pe, fe, xi = pid[e], fid[e], pairs.xi[e]
     N, dN, d2N = shape_functions(master.nn, master.gdim, xi)
-    X = master.nodes[f]
+    X = master.nodes[fe]
     y = np.einsum("pn,png->pg", N, X)
-    r = x[p] - y
-    dist = np.linalg.norm(r, axis=1)
-    inside = dist <= radius
-    p, f, xi, y, r, dist = p[inside], f[inside], xi[inside], y[inside], r[inside], dist[inside]
-    dN, d2N, best = dN[inside], d2N[inside], best[inside]
-    a = np.einsum("pna,png->pag", dN, X[inside])
+    r = x[pe] - y
+    a = np.einsum("pna,png->pag", dN, X)
     nu = _unit_normal(a)
+    dist = np.linalg.norm(r, axis=1)
+    align = np.divide(np.abs(_dot(nu, r)), dist, out=np.zeros_like(dist), where=dist > 0)
+    # equal alignments: the nearer centroid, then the lower facet index
+    c = x[pe] - master.centroid[fe]
+    order = np.lexsort((fe, _dot(c, c), -align, pe))
+    head = np.ones(order.size, dtype=bool)
+    head[1:] = pe[order[1:]] != pe[order[:-1]]
+    k = order[head]
+    k = k[dist[k] <= radius]
+    p, f = pe[k], fe[k]
     out.facet[p] = f
-    out.xi[p] = xi
-    out.y[p] = y
-    out.normal[p] = nu
-    out.gap[p] = -_dot(nu, r)
-    out.distance[p] = dist
-    out.sliding[p] = _sliding(master, xi, a, r, d2N, f, pairs.edge[best], pairs.vertex[best])
+    out.xi[p] = xi[k]
+    out.y[p] = y[k]
+    out.normal[p] = nu[k]
+    out.gap[p] = -_dot(nu[k], r[k])
+    out.distance[p] = dist[k]
+    best = e[k]
+    out.sliding[p] = _sliding(
+        master, xi[k], a[k], r[k], d2N[k], f, pairs.edge[best], pairs.vertex[best]
+    )
 
 
 def closest_points(
