@@ -205,17 +205,6 @@ def _unit_normal(a: FloatArray) -> FloatArray:
     return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
 
-def _slab_bound2(x: FloatArray, slab: FloatArray, g: int) -> FloatArray:
-    """Square of the lower bound of :meth:`_Master.lower_bound` for rows ``slab`` (P, 2g+2)
-    ``[c, n, T, R]``: ``(|n . d| - T)_+^2 + (|d - (n . d) n| - R)_+^2``, ``d = x - c``."""
-    d = x - slab[:, :g]
-    normal = np.abs(_dot(d, slab[:, g : 2 * g]))
-    tangent = np.sqrt(np.maximum(_dot(d, d) - normal * normal, 0.0))
-    a = np.maximum(normal - slab[:, 2 * g], 0.0)
-    b = np.maximum(tangent - slab[:, 2 * g + 1], 0.0)
-    return a * a + b * b
-
-
 def _segment_params(x: FloatArray, p: FloatArray, e: FloatArray) -> FloatArray:
     """Clamped parameter of the projection of ``x`` on the segments ``p + u e``, u in [0, 1]."""
     ee = _dot(e, e)
@@ -259,8 +248,12 @@ class _Master:
         self.axis = _unit_normal(np.einsum("na,fng->fag", dN[0], nodes))
         offset = np.einsum("fng,fg->fn", nodes - self.centroid[:, None], self.axis)
         self.thickness = np.abs(offset).max(axis=1)
-        # the data of the lower bound, one row per facet (one gather per pair)
-        self.slab = np.column_stack([self.centroid, self.axis, self.thickness, self.size])
+        # the data of the lower bound as contiguous columns (gathered per pair: cheaper than
+        # rows) c_0 .. c_g-1, n_0 .. n_g-1, T, R
+        self.slab = tuple(
+            np.ascontiguousarray(column)
+            for column in np.column_stack([self.centroid, self.axis, self.thickness, self.size]).T
+        )
         if self.kind == "triangle":
             a1 = nodes[:, 1] - nodes[:, 0]
             a2 = nodes[:, 2] - nodes[:, 0]
@@ -273,14 +266,29 @@ class _Master:
             x0, x1, x2, x3 = (nodes[:, a] for a in range(4))
             self.bilinear = np.stack([x0, x1 - x0, x2 - x0, x0 - x1 - x2 + x3], axis=1)
 
-    def lower_bound(self, x: FloatArray, f: IntArray) -> FloatArray:
-        """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``.
+    def lower_bound(self, x: FloatArray, f: IntArray, pid: IntArray | None = None) -> FloatArray:
+        """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``
+        (of the points ``x[pid]`` if ``pid`` is given).
 
         Every facet point ``p`` lies in the convex hull of the nodes, so within ``R_f`` of the
         centroid ``c`` and within ``T_f`` of it along the normal ``n`` at the centre: with
         ``d = x - c``, ``|x - p|^2 >= (|n . d| - T_f)_+^2 + (|d - (n . d) n| - R_f)_+^2``.
         """
-        return np.sqrt(_slab_bound2(x, self.slab[f], self.gdim))
+        g, slab = self.gdim, self.slab
+        if pid is None:
+            d = [x[:, k] - slab[k][f] for k in range(g)]
+        else:
+            d = [x[:, k][pid] - slab[k][f] for k in range(g)]
+        normal = d[0] * slab[g][f]
+        square = d[0] * d[0]
+        for k in range(1, g):
+            normal += d[k] * slab[g + k][f]
+            square += d[k] * d[k]
+        normal = np.abs(normal)
+        tangent = np.sqrt(np.maximum(square - normal * normal, 0.0))
+        a = np.maximum(normal - slab[2 * g][f], 0.0)
+        b = np.maximum(tangent - slab[2 * g + 1][f], 0.0)
+        return np.sqrt(a * a + b * b)
 
     # -- exact projections on (point, facet) pairs ----------------------------------------
 
@@ -579,8 +587,8 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     d1[active] = first.dist
     reach = np.minimum(d1, radius)
     pid, fid = _candidates(master, x, (reach + master.R_max) * (1 + 1e-12), active)
-    lower = master.lower_bound(x[pid], fid)
-    keep = lower <= reach[pid] * (1 + 1e-9) + 1e-9 * master.size[fid]
+    lower = master.lower_bound(x, fid, pid)
+    keep = lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9)
     # the pair of the nearest centroid is projected already
     done = np.full(npts, -1, dtype=np.int64)
     done[active] = nearest
