@@ -71,6 +71,7 @@ _EDGES = {
     ),
 }
 
+_K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
 _MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
 _BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
@@ -236,24 +237,35 @@ class _Master:
         self.nf, self.nn, self.gdim = nodes.shape
         self.fdim = self.gdim - 1
         self.kind = facet_kind(self.nn, self.gdim)
-        self.centroid = nodes.mean(axis=1)
+        g = self.gdim
+        # per-facet data from the coordinate columns of the nodes (a loop over the few nodes
+        # and coordinates of a facet: reductions over such short axes are slow in NumPy)
+        X = [[nodes[:, a, k] for k in range(g)] for a in range(self.nn)]
+        c = []
+        for k in range(g):
+            ck = X[0][k] + X[1][k]
+            for a in range(2, self.nn):
+                ck += X[a][k]
+            c.append(ck / self.nn)
+        self.centroid = np.stack(c, axis=1)
         # every point of a facet is a convex combination of its nodes (also for the bilinear
         # quadrilateral), so it lies within this radius of the centroid, which is on the facet
-        self.size = np.linalg.norm(nodes - self.centroid[:, None], axis=2).max(axis=1)
+        self.size = np.sqrt(
+            np.maximum.reduce([sum((Xa[k] - c[k]) ** 2 for k in range(g)) for Xa in X])
+        )
         self.R_max = float(self.size.max()) if self.nf else 0.0
         self.tree, self.slack = _tree_cache.tree(nodes, self.centroid, self.R_max)
         # slab of the facet: unit normal at the centroid, largest node offset along it
         half = np.full((1, self.fdim), 0.5)
         _, dN, _ = shape_functions(self.nn, self.gdim, half)
         self.axis = _unit_normal(np.einsum("na,fng->fag", dN[0], nodes))
-        offset = np.einsum("fng,fg->fn", nodes - self.centroid[:, None], self.axis)
-        self.thickness = np.abs(offset).max(axis=1)
+        n = [self.axis[:, k] for k in range(g)]
+        self.thickness = np.maximum.reduce(
+            [np.abs(sum((Xa[k] - c[k]) * n[k] for k in range(g))) for Xa in X]
+        )
         # the data of the lower bound as contiguous columns (gathered per pair: cheaper than
         # rows) c_0 .. c_g-1, n_0 .. n_g-1, T, R
-        self.slab = tuple(
-            np.ascontiguousarray(column)
-            for column in np.column_stack([self.centroid, self.axis, self.thickness, self.size]).T
-        )
+        self.slab = (*c, *(np.ascontiguousarray(nk) for nk in n), self.thickness, self.size)
         if self.kind == "triangle":
             a1 = nodes[:, 1] - nodes[:, 0]
             a2 = nodes[:, 2] - nodes[:, 0]
@@ -488,7 +500,8 @@ class _TreeCache:
         entry = self.entries.get(key)
         if entry is not None:
             built, tree = entry
-            move = float(np.sqrt(np.max(np.einsum("fng,fng->fn", nodes - built, nodes - built))))
+            # largest node movement (bounded by the largest coordinate change times sqrt(gdim))
+            move = float(np.max(np.abs(nodes - built))) * np.sqrt(nodes.shape[2])
             if move <= _MOVE * R_max:
                 self.entries.move_to_end(key)
                 return tree, move
@@ -574,19 +587,30 @@ def _concatenate(a: _Pairs, b: _Pairs) -> _Pairs:
 def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projection) -> None:
     """Fill ``out`` (arrays of this block of points) with the closest points of ``x``."""
     npts = x.shape[0]
-    # the nearest centroid, where one can hold a facet point within the radius
-    reach0 = radius + master.R_max + 2.0 * master.slack
-    d0, nearest = master.tree.query(x, k=1, distance_upper_bound=reach0 * (1 + 1e-12))
-    active = np.flatnonzero(d0 <= reach0 * (1 + 1e-12))
+    # the K nearest centroids, where they can hold a facet point within the radius
+    reach0 = (radius + master.R_max + 2.0 * master.slack) * (1 + 1e-12)
+    K = min(_K[master.gdim], master.nf)
+    d, near = master.tree.query(x, k=K, distance_upper_bound=reach0)
+    d, near = d.reshape(npts, K), near.reshape(npts, K)
+    active = np.flatnonzero(d[:, 0] <= reach0)
     if active.size == 0:
         return
-    nearest = nearest[active].astype(np.int64)
-    # an upper bound of the distance: the exact distance to the facet of that centroid
+    d, near = d[active], near[active].astype(np.int64)
+    nearest = near[:, 0]
+    # an upper bound of the distance: the exact distance to the facet of the nearest centroid
     first = master.project(x[active], nearest, np.arange(active.size), active.size)
     d1 = np.full(npts, np.inf)
     d1[active] = first.dist
     reach = np.minimum(d1, radius)
-    pid, fid = _candidates(master, x, (reach + master.R_max) * (1 + 1e-12), active)
+    # candidates: the centroids within reach + R_max, from the K found (a ball query for the
+    # points whose K-th neighbour is within it: they may have more)
+    bound = (reach + master.R_max) * (1 + 1e-12)
+    within = d <= (bound[active] + master.slack)[:, None]
+    cut = within[:, -1] if K < master.nf else np.zeros(active.size, dtype=bool)
+    rows, cols = np.nonzero(within & ~cut[:, None])
+    pid_ball, fid_ball = _candidates(master, x, bound, active[cut])
+    pid = np.concatenate([active[rows], pid_ball])
+    fid = np.concatenate([near[rows, cols], fid_ball])
     lower = master.lower_bound(x, fid, pid)
     keep = lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9)
     # the pair of the nearest centroid is projected already
