@@ -71,7 +71,7 @@ _EDGES = {
     ),
 }
 
-_K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
+_K0 = 8  # neighbours of the first KD-tree query
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
 _MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
 _BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
@@ -206,13 +206,6 @@ def _unit_normal(a: FloatArray) -> FloatArray:
     return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
 
-def _segment_params(x: FloatArray, p: FloatArray, e: FloatArray) -> FloatArray:
-    """Clamped parameter of the projection of ``x`` on the segments ``p + u e``, u in [0, 1]."""
-    ee = _dot(e, e)
-    u = _dot(x - p, e) / np.where(ee > 0, ee, 1.0)
-    return np.clip(u, 0.0, 1.0)
-
-
 @dataclass
 class _Pairs:
     """Exact projections of (point, facet) pairs."""
@@ -273,7 +266,7 @@ class _Master:
             det = g11 * g22 - g12 * g12
             ok = det > 1e-14 * g11 * g22
             inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)  # degenerate: never inside
-            self.gram_inv = np.stack([g22 * inv, -g12 * inv, g11 * inv], axis=1)
+            self.gram_inv = (g22 * inv, -g12 * inv, g11 * inv)
         elif self.kind == "quadrilateral":
             x0, x1, x2, x3 = (nodes[:, a] for a in range(4))
             self.bilinear = np.stack([x0, x1 - x0, x2 - x0, x0 - x1 - x2 + x3], axis=1)
@@ -310,61 +303,68 @@ class _Master:
         ``pid`` (P,) numbers the points of the pairs (``0 <= pid < npts``); the quadrilateral
         projection uses it to skip the facets that cannot hold the closest point.
         """
+        # coordinate columns of the pairs' nodes and points (cheaper than rows of 2 or 3)
+        g = self.gdim
+        X = [[self.nodes[:, a, k][f] for k in range(g)] for a in range(self.nn)]
+        xs = [x[:, k] for k in range(g)]
+        pairs = self._edges(xs, X)
         if self.kind == "segment":
-            p = self.nodes[f, 0]
-            u = _segment_params(x, p, self.nodes[f, 1] - p)
-            y = p + u[:, None] * (self.nodes[f, 1] - p)
-            return _Pairs(
-                xi=u[:, None],
-                dist=np.linalg.norm(x - y, axis=1),
-                edge=np.full(u.shape, -1, dtype=np.int64),
-                vertex=(u == 0.0) | (u == 1.0),
-            )
-        pairs = self._edges(x, f)
-        if self.kind == "triangle":
-            self._triangle_interior(x, f, pairs)
+            pairs.edge[:] = -1
+        elif self.kind == "triangle":
+            self._triangle_interior(xs, X, f, pairs)
         else:
             self._quadrilateral_interior(x, f, pid, npts, pairs)
         return pairs
 
-    def _edges(self, x: FloatArray, f: IntArray) -> _Pairs:
-        """Closest point on the straight edges of each facet."""
-        P = x.shape[0]
-        best_d = np.full(P, np.inf)
-        best_u = np.zeros(P)
-        best_k = np.zeros(P, dtype=np.int64)
-        for k, (a, b, _, _) in enumerate(_EDGES[self.kind]):
-            p = self.nodes[f, a]
-            e = self.nodes[f, b] - p
-            u = _segment_params(x, p, e)
-            d = np.linalg.norm(x - p - u[:, None] * e, axis=1)
+    def _edges(self, xs: list[FloatArray], X: list[list[FloatArray]]) -> _Pairs:
+        """Closest point on the straight edges of each facet (a segment is its own edge).
+
+        ``xs``: coordinate columns of the points; ``X[a][k]``: coordinate ``k`` of node ``a``
+        of the facet of each pair.
+        """
+        g = len(xs)
+        edges = _EDGES.get(self.kind, ((0, 1, (0.0,), (1.0,)),))
+        best_d = best_u = best_k = None
+        for n, (a, b, _, _) in enumerate(edges):
+            e = [X[b][k] - X[a][k] for k in range(g)]
+            r = [xs[k] - X[a][k] for k in range(g)]
+            ee = sum(e[k] * e[k] for k in range(1, g)) + e[0] * e[0]
+            re = sum(r[k] * e[k] for k in range(1, g)) + r[0] * e[0]
+            u = np.clip(re / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
+            w = [r[k] - u * e[k] for k in range(g)]
+            d = np.sqrt(sum(w[k] * w[k] for k in range(1, g)) + w[0] * w[0])
+            if best_d is None:
+                best_d, best_u, best_k = d, u, np.zeros(d.shape, dtype=np.int64)
+                continue
             better = d < best_d
             best_d = np.where(better, d, best_d)
             best_u = np.where(better, u, best_u)
-            best_k = np.where(better, k, best_k)
-        starts = np.array([s for _, _, s, _ in _EDGES[self.kind]])
-        ends = np.array([e for _, _, _, e in _EDGES[self.kind]])
+            best_k = np.where(better, n, best_k)
+        starts = np.array([s for _, _, s, _ in edges])
+        ends = np.array([e for _, _, _, e in edges])
         xi = starts[best_k] + best_u[:, None] * (ends[best_k] - starts[best_k])
         return _Pairs(xi=xi, dist=best_d, edge=best_k, vertex=(best_u == 0.0) | (best_u == 1.0))
 
-    def _triangle_interior(self, x: FloatArray, f: IntArray, pairs: _Pairs) -> None:
+    def _triangle_interior(
+        self, xs: list[FloatArray], X: list[list[FloatArray]], f: IntArray, pairs: _Pairs
+    ) -> None:
         """Replace the edge result by the projection on the plane where that is inside."""
-        x0 = self.nodes[f, 0]
-        a1 = self.nodes[f, 1] - x0
-        a2 = self.nodes[f, 2] - x0
-        r = x - x0
-        b1, b2 = _dot(r, a1), _dot(r, a2)
-        gi = self.gram_inv[f]
-        xi1 = gi[:, 0] * b1 + gi[:, 1] * b2
-        xi2 = gi[:, 1] * b1 + gi[:, 2] * b2
+        a1 = [X[1][k] - X[0][k] for k in range(3)]
+        a2 = [X[2][k] - X[0][k] for k in range(3)]
+        r = [xs[k] - X[0][k] for k in range(3)]
+        b1 = r[0] * a1[0] + r[1] * a1[1] + r[2] * a1[2]
+        b2 = r[0] * a2[0] + r[1] * a2[1] + r[2] * a2[2]
+        g11, g12, g22 = (column[f] for column in self.gram_inv)
+        xi1 = g11 * b1 + g12 * b2
+        xi2 = g12 * b1 + g22 * b2
         inside = (xi1 > 0.0) & (xi2 > 0.0) & (xi1 + xi2 < 1.0)
         if not inside.any():
             return
         i = np.flatnonzero(inside)
-        xi = np.stack([xi1[i], xi2[i]], axis=1)
-        y = x0[i] + xi[:, :1] * a1[i] + xi[:, 1:] * a2[i]
-        pairs.xi[i] = xi
-        pairs.dist[i] = np.linalg.norm(x[i] - y, axis=1)
+        xi1, xi2 = xi1[i], xi2[i]
+        w = [r[k][i] - xi1 * a1[k][i] - xi2 * a2[k][i] for k in range(3)]
+        pairs.xi[i] = np.stack([xi1, xi2], axis=1)
+        pairs.dist[i] = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
         pairs.edge[i] = -1
         pairs.vertex[i] = False
 
@@ -589,7 +589,7 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     npts = x.shape[0]
     # the K nearest centroids, where they can hold a facet point within the radius
     reach0 = (radius + master.R_max + 2.0 * master.slack) * (1 + 1e-12)
-    K = min(_K[master.gdim], master.nf)
+    K = min(_K0, master.nf)
     d, near = master.tree.query(x, k=K, distance_upper_bound=reach0)
     d, near = d.reshape(npts, K), near.reshape(npts, K)
     active = np.flatnonzero(d[:, 0] <= reach0)
