@@ -71,7 +71,7 @@ _EDGES = {
     ),
 }
 
-_K0 = 8  # neighbours of the first KD-tree query
+_K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
 _MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
 _BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
@@ -420,60 +420,76 @@ def _quad_newton(
     and whether the Hessian is positive definite there.
     """
     P = x.shape[0]
-    xi = xi.copy()
+    # coordinate columns: C[j][k] = coordinate k of c_j, X[k] of the points
+    C = [[np.ascontiguousarray(coef[:, j, k]) for k in range(3)] for j in range(4)]
+    X = [np.ascontiguousarray(x[:, k]) for k in range(3)]
+    s_all, t_all = xi[:, 0].copy(), xi[:, 1].copy()
     conv = np.zeros(P, dtype=bool)
     act = np.arange(P)
+    c, xa, s, t = C, X, s_all, t_all  # the columns of the active points
 
-    def residual(xi_: FloatArray, c: FloatArray, X: FloatArray) -> FloatArray:
-        s, t = xi_[:, :1], xi_[:, 1:]
-        return X - (c[:, 0] + s * c[:, 1] + t * c[:, 2] + s * t * c[:, 3])
+    def residual(s_: FloatArray, t_: FloatArray) -> list[FloatArray]:
+        return [
+            xa[k] - (c[0][k] + s_ * c[1][k] + t_ * c[2][k] + s_ * t_ * c[3][k]) for k in range(3)
+        ]
 
     for _ in range(_NEWTON_ITERATIONS):
         if act.size == 0:
             break
-        c, X, z = coef[act], x[act], xi[act]
-        a1 = c[:, 1] + z[:, 1:] * c[:, 3]
-        a2 = c[:, 2] + z[:, :1] * c[:, 3]
-        r = residual(z, c, X)
-        g1, g2 = -_dot(r, a1), -_dot(r, a2)
-        h11, h22, h12gn = _dot(a1, a1), _dot(a2, a2), _dot(a1, a2)
-        h12 = h12gn - _dot(r, c[:, 3])
+        a1 = [c[1][k] + t * c[3][k] for k in range(3)]
+        a2 = [c[2][k] + s * c[3][k] for k in range(3)]
+        r = residual(s, t)
+        g1, g2 = -_dot3(r, a1), -_dot3(r, a2)
+        h11, h22, h12gn = _dot3(a1, a1), _dot3(a2, a2), _dot3(a1, a2)
+        h12 = h12gn - _dot3(r, c[3])
         det = h11 * h22 - h12 * h12
         indefinite = det <= 1e-12 * h11 * h22
         h12 = np.where(indefinite, h12gn, h12)
         det = h11 * h22 - h12 * h12
         det = np.where(det > 0, det, np.inf)  # degenerate patch: no step
-        step = np.stack([-(h22 * g1 - h12 * g2) / det, -(h11 * g2 - h12 * g1) / det], axis=1)
+        step1, step2 = -(h22 * g1 - h12 * g2) / det, -(h11 * g2 - h12 * g1) / det
         # projected Newton: a coordinate on a bound that the gradient pushes out stays there,
         # the other one takes a one-dimensional Newton step (d2f/dxi_i^2 = |a_i|^2)
-        fix1 = ((z[:, 0] <= 0.0) & (g1 > 0.0)) | ((z[:, 0] >= 1.0) & (g1 < 0.0))
-        fix2 = ((z[:, 1] <= 0.0) & (g2 > 0.0)) | ((z[:, 1] >= 1.0) & (g2 < 0.0))
+        fix1 = ((s <= 0.0) & (g1 > 0.0)) | ((s >= 1.0) & (g1 < 0.0))
+        fix2 = ((t <= 0.0) & (g2 > 0.0)) | ((t >= 1.0) & (g2 < 0.0))
         one = fix1 ^ fix2
-        step[one, 0] = np.where(fix1[one], 0.0, -g1[one] / np.where(h11[one] > 0, h11[one], np.inf))
-        step[one, 1] = np.where(fix2[one], 0.0, -g2[one] / np.where(h22[one] > 0, h22[one], np.inf))
-        step[fix1 & fix2] = 0.0
-        f0 = _dot(r, r)
-        new = np.clip(z + step, 0.0, 1.0)
+        if one.any():
+            step1 = np.where(one, np.where(fix1, 0.0, -g1 / np.where(h11 > 0, h11, np.inf)), step1)
+            step2 = np.where(one, np.where(fix2, 0.0, -g2 / np.where(h22 > 0, h22, np.inf)), step2)
+        both = fix1 & fix2
+        step1, step2 = np.where(both, 0.0, step1), np.where(both, 0.0, step2)
+        f0 = _dot3(r, r)
+        new_s, new_t = np.clip(s + step1, 0.0, 1.0), np.clip(t + step2, 0.0, 1.0)
         for _ in range(3):
-            rn = residual(new, c, X)
-            worse = _dot(rn, rn) > f0 * (1 + 1e-10)  # not rounding noise near the minimum
+            rn = residual(new_s, new_t)
+            worse = _dot3(rn, rn) > f0 * (1 + 1e-10)  # not rounding noise near the minimum
             if not worse.any():
                 break
-            step[worse] *= 0.5
-            new[worse] = np.clip(z[worse] + step[worse], 0.0, 1.0)
-        done = np.abs(new - z).max(axis=1) <= _NEWTON_TOL
-        xi[act] = new
+            step1, step2 = np.where(worse, step1 * 0.5, step1), np.where(worse, step2 * 0.5, step2)
+            new_s = np.where(worse, np.clip(s + step1, 0.0, 1.0), new_s)
+            new_t = np.where(worse, np.clip(t + step2, 0.0, 1.0), new_t)
+        done = np.maximum(np.abs(new_s - s), np.abs(new_t - t)) <= _NEWTON_TOL
+        s_all[act], t_all[act] = new_s, new_t
         conv[act[done]] = True
-        act = act[~done]
+        keep = ~done
+        act = act[keep]
+        c = [[column[keep] for column in cj] for cj in c]
+        xa = [column[keep] for column in xa]
+        s, t = new_s[keep], new_t[keep]
 
-    s, t = xi[:, :1], xi[:, 1:]
-    a1 = coef[:, 1] + t * coef[:, 3]
-    a2 = coef[:, 2] + s * coef[:, 3]
-    r = residual(xi, coef, x)
-    h11, h22 = _dot(a1, a1), _dot(a2, a2)
-    h12 = _dot(a1, a2) - _dot(r, coef[:, 3])
+    c, xa, s, t = C, X, s_all, t_all
+    a1 = [c[1][k] + t * c[3][k] for k in range(3)]
+    a2 = [c[2][k] + s * c[3][k] for k in range(3)]
+    r = residual(s, t)
+    h11, h22 = _dot3(a1, a1), _dot3(a2, a2)
+    h12 = _dot3(a1, a2) - _dot3(r, c[3])
     pd = (h11 > 0) & (h11 * h22 - h12 * h12 > 0)
-    return xi, np.linalg.norm(r, axis=1), conv, pd
+    return np.stack([s, t], axis=1), np.sqrt(_dot3(r, r)), conv, pd
+
+
+def _dot3(a: list[FloatArray], b: list[FloatArray]) -> FloatArray:
+    """Dot products of vectors given as three coordinate columns."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 class _TreeCache:
@@ -589,7 +605,7 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     npts = x.shape[0]
     # the K nearest centroids, where they can hold a facet point within the radius
     reach0 = (radius + master.R_max + 2.0 * master.slack) * (1 + 1e-12)
-    K = min(_K0, master.nf)
+    K = min(_K[master.gdim], master.nf)
     d, near = master.tree.query(x, k=K, distance_upper_bound=reach0)
     d, near = d.reshape(npts, K), near.reshape(npts, K)
     active = np.flatnonzero(d[:, 0] <= reach0)
