@@ -106,15 +106,15 @@ def time_call(
     """Wall time of a first call of ``closest_points`` (no KD-tree kept from an earlier call),
     the best over a few more calls (the tree of the unchanged master reused), and the facets
     found."""
-    if hasattr(projection, "_tree_cache"):
-        projection._tree_cache.entries.clear()
+    trees = projection.TreeCache() if hasattr(projection, "TreeCache") else None
+    options = {} if trees is None else {"trees": trees}
     start = time.perf_counter()
-    closest_points(points, nodes, radius)
+    closest_points(points, nodes, radius, **options)
     first = time.perf_counter() - start
     best, calls = np.inf, 0
     while calls < 5:
         start = time.perf_counter()
-        proj = closest_points(points, nodes, radius)
+        proj = closest_points(points, nodes, radius, **options)
         best = min(best, time.perf_counter() - start)
         calls += 1
         if best > 1.0 or (calls >= 3 and best > 0.2):

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_quads
 
-from contact_ufl.contact.projection import closest_points, shape_functions
+from contact_ufl.contact.projection import TreeCache, closest_points, shape_functions
 
 FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
 
@@ -43,8 +43,8 @@ def reference(points: np.ndarray, nodes: np.ndarray, radius: float = np.inf):
     return facet, {k: np.array(v) for k, v in fields.items()}
 
 
-def check(points, nodes, radius=np.inf):
-    proj = closest_points(points, nodes, radius)
+def check(points, nodes, radius=np.inf, trees=None):
+    proj = closest_points(points, nodes, radius, trees)
     facet, fields = reference(points, nodes, radius)
     np.testing.assert_array_equal(proj.facet, facet)
     found = facet >= 0
@@ -119,9 +119,17 @@ def test_reused_tree_after_the_master_moves():
     rng = np.random.default_rng(7)
     nodes = wavy_quads(rng, 36)
     points = near_and_far(rng, nodes, 30)
-    check(points, nodes)
+    trees = TreeCache()
+    check(points, nodes, trees=trees)
+
+    def tree():
+        (entry,) = trees.entries.values()
+        return entry[1]
+
+    first = tree()
     size = np.linalg.norm(nodes - nodes.mean(axis=1, keepdims=True), axis=2).max()
-    for move in (1e-3 * size, 0.2 * size, 2.0 * size):
+    for move, reused in ((1e-3 * size, True), (0.2 * size, True), (2.0 * size, False)):
         moved = nodes + rng.uniform(-move, move, size=nodes.shape) / np.sqrt(3.0)
-        check(points, moved, radius=0.2)
-        check(points, moved)
+        check(points, moved, radius=0.2, trees=trees)
+        assert (tree() is first) == reused
+        check(points, moved, trees=trees)

@@ -49,7 +49,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-__all__ = ["Projection", "closest_points", "facet_kind", "shape_functions"]
+__all__ = ["Projection", "TreeCache", "closest_points", "facet_kind", "shape_functions"]
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -221,13 +221,14 @@ class _Pairs:
 class _Master:
     """Master facets with the per-facet data of the search and the projections.
 
-    The KD-tree of the centroids is taken from :data:`_tree_cache` when a master surface of
-    the same shape was searched before and no node has moved more than ``_MOVE R_max``
-    since that tree was built: ``slack`` is then that movement, a bound of how far every
-    centroid is from the one the tree holds, and the search widens its bounds by it.
+    The KD-tree of the centroids is taken from ``trees`` (a :class:`TreeCache`, if given)
+    when a master surface of the same shape was searched before and no node has moved more
+    than ``_MOVE R_max`` since that tree was built: ``slack`` is then that movement, a bound
+    of how far every centroid is from the one the tree holds, and the search widens its
+    bounds by it.
     """
 
-    def __init__(self, nodes: FloatArray) -> None:
+    def __init__(self, nodes: FloatArray, trees: TreeCache | None = None) -> None:
         self.nodes = nodes
         self.nf, self.nn, self.gdim = nodes.shape
         self.fdim = self.gdim - 1
@@ -249,7 +250,8 @@ class _Master:
             np.maximum.reduce([sum((Xa[k] - c[k]) ** 2 for k in range(g)) for Xa in X])
         )
         self.R_max = float(self.size.max()) if self.nf else 0.0
-        self.tree, self.slack = _tree_cache.tree(nodes, self.centroid, self.R_max)
+        trees = trees if trees is not None else TreeCache()
+        self.tree, self.slack = trees.tree(nodes, self.centroid, self.R_max)
         # slab of the facet: unit normal at the centroid, largest node offset along it
         half = np.full((1, self.fdim), 0.5)
         _, dN, _ = shape_functions(self.nn, self.gdim, half)
@@ -494,8 +496,12 @@ def _dot3(a: list[FloatArray], b: list[FloatArray]) -> FloatArray:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-class _TreeCache:
+class TreeCache:
     """KD-trees of facet centroids, reused while the master surface has barely moved.
+
+    Held by whoever searches the same master surface again and again (a
+    :class:`~contact_ufl.contact.search.ClosestPointSearch`) and passed to
+    :func:`closest_points`.
 
     One entry per shape ``(nf, nn, gdim)`` of the node array (the ``_TREES`` most recent):
     the nodes the tree was built from and the tree.
@@ -529,9 +535,6 @@ class _TreeCache:
         while len(self.entries) > _TREES:
             self.entries.popitem(last=False)
         return tree, 0.0
-
-
-_tree_cache = _TreeCache()
 
 
 def _candidates(
@@ -674,7 +677,10 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
 
 
 def closest_points(
-    points: npt.ArrayLike, nodes: npt.ArrayLike, radius: float = np.inf
+    points: npt.ArrayLike,
+    nodes: npt.ArrayLike,
+    radius: float = np.inf,
+    trees: TreeCache | None = None,
 ) -> Projection:
     """Closest points of slave points on a master surface, in the current configuration.
 
@@ -687,6 +693,9 @@ def closest_points(
         the facet kinds and their normals).
     radius : float, optional
         Search radius: a point with no facet point within ``radius`` gets ``facet = -1``.
+    trees : TreeCache, optional
+        KD-trees of earlier calls on the same master surface, reused while it has barely
+        moved (and updated); without it the tree is built anew.
 
     Returns
     -------
@@ -744,7 +753,7 @@ def closest_points(
     )
     if npts == 0 or nf == 0:
         return out
-    master = _Master(nodes)
+    master = _Master(nodes, trees)
     for start in range(0, npts, _BLOCK):
         block = slice(start, min(start + _BLOCK, npts))
         view = Projection(
