@@ -36,7 +36,7 @@ from contact_ufl import (
 from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSphere
 from contact_ufl.errors import ContactInputError, ConvergenceError
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerForce, FollowerPressure
-from contact_ufl.materials import NeoHookean, SaintVenantKirchhoff
+from contact_ufl.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff
 from contact_ufl.newton import NewtonSolver
 from contact_ufl.output import ResultWriter
 from contact_ufl.plasticity import J2Plasticity
@@ -60,6 +60,7 @@ __all__ = [
     "FollowerPressure",
     "History",
     "J2Plasticity",
+    "LinearElastic",
     "LoadStepper",
     "MeshData",
     "NeoHookean",

@@ -1,4 +1,4 @@
-"""Hyperelastic materials: strain energies written once in UFL.
+"""Bulk materials: strain energies written once in UFL (hyperelastic, and small-strain Hooke).
 
 Each material is a stored-energy density ``psi(F)`` per unit reference volume. The first
 Piola-Kirchhoff stress is its derivative, taken by UFL. The same expression serves 3D solids
@@ -87,3 +87,29 @@ class SaintVenantKirchhoff(Hyperelastic):
         d = F.ufl_shape[0]
         E = 0.5 * (F.T * F - ufl.Identity(d))
         return 0.5 * self.lmbda * ufl.tr(E) ** 2 + self.mu * ufl.inner(E, E)
+
+
+@dataclass(frozen=True)
+class LinearElastic(Hyperelastic):
+    """Small-strain linear elasticity (Hooke): ``psi = lambda/2 (tr eps)^2 + mu eps : eps``.
+
+    ``eps = sym(F - I)`` is the small-strain tensor of the displacement gradient ``F - I``, and
+    the stress ``P = lambda tr(eps) I + 2 mu eps`` is linear in it. Use it for scenes whose
+    strains *and rotations* are small (the energy is not frame-indifferent: a rigid rotation
+    strains it): it is the cheapest bulk (a constant tangent) and the one Hertz's solution is
+    exact for. The contact kinematics stay large-deformation. In plane strain (``F`` 2x2) the
+    energy equals the 3D one with ``eps_33 = 0``.
+    """
+
+    def small_strain(self, F: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """``eps = sym(F - I)``."""
+        return ufl.sym(F - ufl.Identity(F.ufl_shape[0]))
+
+    def strain_energy(self, F):
+        eps = self.small_strain(F)
+        return 0.5 * self.lmbda * ufl.tr(eps) ** 2 + self.mu * ufl.inner(eps, eps)
+
+    def first_piola(self, F):
+        """Hooke's stress ``lambda tr(eps) I + 2 mu eps`` (the derivative of the energy)."""
+        eps = self.small_strain(F)
+        return self.lmbda * ufl.tr(eps) * ufl.Identity(F.ufl_shape[0]) + 2.0 * self.mu * eps

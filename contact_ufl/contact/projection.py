@@ -1,8 +1,10 @@
 """Closest-point projection of many slave points onto a master surface made of facets.
 
 Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search), vectorised over
-points and facets: the only Python loops run over a fixed small number of items (edges of a
-facet, Newton iterations, K-doublings of the neighbour search, blocks of points).
+points and facets: the only Python loops run over a fixed small number of items (nodes,
+edges and coordinates of a facet, Newton iterations, blocks of points). The hot kernels work
+on coordinate columns (one 1D gather per node coordinate) rather than on rows of 2 or 3
+numbers, which NumPy gathers and reduces slowly. Throughput: ``benchmarks/search.py``.
 
 Facet kinds and conventions
 ---------------------------
@@ -39,13 +41,15 @@ is on that bound, one that is not clamped is not):
 
 from __future__ import annotations
 
+import itertools
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-__all__ = ["Projection", "closest_points", "facet_kind", "shape_functions"]
+__all__ = ["Projection", "TreeCache", "closest_points", "facet_kind", "shape_functions"]
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -69,7 +73,9 @@ _EDGES = {
     ),
 }
 
-_K0 = 8  # first number of neighbours asked from the KD-tree
+_K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
+_TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
+_MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
 _BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
@@ -202,13 +208,6 @@ def _unit_normal(a: FloatArray) -> FloatArray:
     return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
 
-def _segment_params(x: FloatArray, p: FloatArray, e: FloatArray) -> FloatArray:
-    """Clamped parameter of the projection of ``x`` on the segments ``p + u e``, u in [0, 1]."""
-    ee = _dot(e, e)
-    u = _dot(x - p, e) / np.where(ee > 0, ee, 1.0)
-    return np.clip(u, 0.0, 1.0)
-
-
 @dataclass
 class _Pairs:
     """Exact projections of (point, facet) pairs."""
@@ -220,25 +219,50 @@ class _Pairs:
 
 
 class _Master:
-    """Master facets with the per-facet data of the search and the projections."""
+    """Master facets with the per-facet data of the search and the projections.
 
-    def __init__(self, nodes: FloatArray) -> None:
+    The KD-tree of the centroids is taken from ``trees`` (a :class:`TreeCache`, if given)
+    when a master surface of the same shape was searched before and no node has moved more
+    than ``_MOVE R_max`` since that tree was built: ``slack`` is then that movement, a bound
+    of how far every centroid is from the one the tree holds, and the search widens its
+    bounds by it.
+    """
+
+    def __init__(self, nodes: FloatArray, trees: TreeCache | None = None) -> None:
         self.nodes = nodes
         self.nf, self.nn, self.gdim = nodes.shape
         self.fdim = self.gdim - 1
         self.kind = facet_kind(self.nn, self.gdim)
-        self.centroid = nodes.mean(axis=1)
+        g = self.gdim
+        # per-facet data from the coordinate columns of the nodes (a loop over the few nodes
+        # and coordinates of a facet: reductions over such short axes are slow in NumPy)
+        X = [[nodes[:, a, k] for k in range(g)] for a in range(self.nn)]
+        c = []
+        for k in range(g):
+            ck = X[0][k] + X[1][k]
+            for a in range(2, self.nn):
+                ck += X[a][k]
+            c.append(ck / self.nn)
+        self.centroid = np.stack(c, axis=1)
         # every point of a facet is a convex combination of its nodes (also for the bilinear
         # quadrilateral), so it lies within this radius of the centroid, which is on the facet
-        self.size = np.linalg.norm(nodes - self.centroid[:, None], axis=2).max(axis=1)
+        self.size = np.sqrt(
+            np.maximum.reduce([sum((Xa[k] - c[k]) ** 2 for k in range(g)) for Xa in X])
+        )
         self.R_max = float(self.size.max()) if self.nf else 0.0
-        self.tree = cKDTree(self.centroid) if self.nf else None
+        trees = trees if trees is not None else TreeCache()
+        self.tree, self.slack = trees.tree(nodes, self.centroid, self.R_max)
         # slab of the facet: unit normal at the centroid, largest node offset along it
         half = np.full((1, self.fdim), 0.5)
         _, dN, _ = shape_functions(self.nn, self.gdim, half)
         self.axis = _unit_normal(np.einsum("na,fng->fag", dN[0], nodes))
-        offset = np.einsum("fng,fg->fn", nodes - self.centroid[:, None], self.axis)
-        self.thickness = np.abs(offset).max(axis=1)
+        n = [self.axis[:, k] for k in range(g)]
+        self.thickness = np.maximum.reduce(
+            [np.abs(sum((Xa[k] - c[k]) * n[k] for k in range(g))) for Xa in X]
+        )
+        # the data of the lower bound as contiguous columns (gathered per pair: cheaper than
+        # rows) c_0 .. c_g-1, n_0 .. n_g-1, T, R
+        self.slab = (*c, *(np.ascontiguousarray(nk) for nk in n), self.thickness, self.size)
         if self.kind == "triangle":
             a1 = nodes[:, 1] - nodes[:, 0]
             a2 = nodes[:, 2] - nodes[:, 0]
@@ -246,24 +270,34 @@ class _Master:
             det = g11 * g22 - g12 * g12
             ok = det > 1e-14 * g11 * g22
             inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)  # degenerate: never inside
-            self.gram_inv = np.stack([g22 * inv, -g12 * inv, g11 * inv], axis=1)
+            self.gram_inv = (g22 * inv, -g12 * inv, g11 * inv)
         elif self.kind == "quadrilateral":
             x0, x1, x2, x3 = (nodes[:, a] for a in range(4))
             self.bilinear = np.stack([x0, x1 - x0, x2 - x0, x0 - x1 - x2 + x3], axis=1)
 
-    def lower_bound(self, x: FloatArray, f: IntArray) -> FloatArray:
-        """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``.
+    def lower_bound(self, x: FloatArray, f: IntArray, pid: IntArray | None = None) -> FloatArray:
+        """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``
+        (of the points ``x[pid]`` if ``pid`` is given).
 
         Every facet point ``p`` lies in the convex hull of the nodes, so within ``R_f`` of the
         centroid ``c`` and within ``T_f`` of it along the normal ``n`` at the centre: with
         ``d = x - c``, ``|x - p|^2 >= (|n . d| - T_f)_+^2 + (|d - (n . d) n| - R_f)_+^2``.
         """
-        d = x - self.centroid[f]
-        normal = np.abs(_dot(d, self.axis[f]))
-        tangent = np.sqrt(np.maximum(_dot(d, d) - normal * normal, 0.0))
-        return np.hypot(
-            np.maximum(normal - self.thickness[f], 0.0), np.maximum(tangent - self.size[f], 0.0)
-        )
+        g, slab = self.gdim, self.slab
+        if pid is None:
+            d = [x[:, k] - slab[k][f] for k in range(g)]
+        else:
+            d = [x[:, k][pid] - slab[k][f] for k in range(g)]
+        normal = d[0] * slab[g][f]
+        square = d[0] * d[0]
+        for k in range(1, g):
+            normal += d[k] * slab[g + k][f]
+            square += d[k] * d[k]
+        normal = np.abs(normal)
+        tangent = np.sqrt(np.maximum(square - normal * normal, 0.0))
+        a = np.maximum(normal - slab[2 * g][f], 0.0)
+        b = np.maximum(tangent - slab[2 * g + 1][f], 0.0)
+        return np.sqrt(a * a + b * b)
 
     # -- exact projections on (point, facet) pairs ----------------------------------------
 
@@ -273,61 +307,68 @@ class _Master:
         ``pid`` (P,) numbers the points of the pairs (``0 <= pid < npts``); the quadrilateral
         projection uses it to skip the facets that cannot hold the closest point.
         """
+        # coordinate columns of the pairs' nodes and points (cheaper than rows of 2 or 3)
+        g = self.gdim
+        X = [[self.nodes[:, a, k][f] for k in range(g)] for a in range(self.nn)]
+        xs = [x[:, k] for k in range(g)]
+        pairs = self._edges(xs, X)
         if self.kind == "segment":
-            p = self.nodes[f, 0]
-            u = _segment_params(x, p, self.nodes[f, 1] - p)
-            y = p + u[:, None] * (self.nodes[f, 1] - p)
-            return _Pairs(
-                xi=u[:, None],
-                dist=np.linalg.norm(x - y, axis=1),
-                edge=np.full(u.shape, -1, dtype=np.int64),
-                vertex=(u == 0.0) | (u == 1.0),
-            )
-        pairs = self._edges(x, f)
-        if self.kind == "triangle":
-            self._triangle_interior(x, f, pairs)
+            pairs.edge[:] = -1
+        elif self.kind == "triangle":
+            self._triangle_interior(xs, X, f, pairs)
         else:
             self._quadrilateral_interior(x, f, pid, npts, pairs)
         return pairs
 
-    def _edges(self, x: FloatArray, f: IntArray) -> _Pairs:
-        """Closest point on the straight edges of each facet."""
-        P = x.shape[0]
-        best_d = np.full(P, np.inf)
-        best_u = np.zeros(P)
-        best_k = np.zeros(P, dtype=np.int64)
-        for k, (a, b, _, _) in enumerate(_EDGES[self.kind]):
-            p = self.nodes[f, a]
-            e = self.nodes[f, b] - p
-            u = _segment_params(x, p, e)
-            d = np.linalg.norm(x - p - u[:, None] * e, axis=1)
+    def _edges(self, xs: list[FloatArray], X: list[list[FloatArray]]) -> _Pairs:
+        """Closest point on the straight edges of each facet (a segment is its own edge).
+
+        ``xs``: coordinate columns of the points; ``X[a][k]``: coordinate ``k`` of node ``a``
+        of the facet of each pair.
+        """
+        g = len(xs)
+        edges = _EDGES.get(self.kind, ((0, 1, (0.0,), (1.0,)),))
+        best_d = best_u = best_k = None
+        for n, (a, b, _, _) in enumerate(edges):
+            e = [X[b][k] - X[a][k] for k in range(g)]
+            r = [xs[k] - X[a][k] for k in range(g)]
+            ee = sum(e[k] * e[k] for k in range(1, g)) + e[0] * e[0]
+            re = sum(r[k] * e[k] for k in range(1, g)) + r[0] * e[0]
+            u = np.clip(re / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
+            w = [r[k] - u * e[k] for k in range(g)]
+            d = np.sqrt(sum(w[k] * w[k] for k in range(1, g)) + w[0] * w[0])
+            if best_d is None:
+                best_d, best_u, best_k = d, u, np.zeros(d.shape, dtype=np.int64)
+                continue
             better = d < best_d
             best_d = np.where(better, d, best_d)
             best_u = np.where(better, u, best_u)
-            best_k = np.where(better, k, best_k)
-        starts = np.array([s for _, _, s, _ in _EDGES[self.kind]])
-        ends = np.array([e for _, _, _, e in _EDGES[self.kind]])
+            best_k = np.where(better, n, best_k)
+        starts = np.array([s for _, _, s, _ in edges])
+        ends = np.array([e for _, _, _, e in edges])
         xi = starts[best_k] + best_u[:, None] * (ends[best_k] - starts[best_k])
         return _Pairs(xi=xi, dist=best_d, edge=best_k, vertex=(best_u == 0.0) | (best_u == 1.0))
 
-    def _triangle_interior(self, x: FloatArray, f: IntArray, pairs: _Pairs) -> None:
+    def _triangle_interior(
+        self, xs: list[FloatArray], X: list[list[FloatArray]], f: IntArray, pairs: _Pairs
+    ) -> None:
         """Replace the edge result by the projection on the plane where that is inside."""
-        x0 = self.nodes[f, 0]
-        a1 = self.nodes[f, 1] - x0
-        a2 = self.nodes[f, 2] - x0
-        r = x - x0
-        b1, b2 = _dot(r, a1), _dot(r, a2)
-        gi = self.gram_inv[f]
-        xi1 = gi[:, 0] * b1 + gi[:, 1] * b2
-        xi2 = gi[:, 1] * b1 + gi[:, 2] * b2
+        a1 = [X[1][k] - X[0][k] for k in range(3)]
+        a2 = [X[2][k] - X[0][k] for k in range(3)]
+        r = [xs[k] - X[0][k] for k in range(3)]
+        b1 = r[0] * a1[0] + r[1] * a1[1] + r[2] * a1[2]
+        b2 = r[0] * a2[0] + r[1] * a2[1] + r[2] * a2[2]
+        g11, g12, g22 = (column[f] for column in self.gram_inv)
+        xi1 = g11 * b1 + g12 * b2
+        xi2 = g12 * b1 + g22 * b2
         inside = (xi1 > 0.0) & (xi2 > 0.0) & (xi1 + xi2 < 1.0)
         if not inside.any():
             return
         i = np.flatnonzero(inside)
-        xi = np.stack([xi1[i], xi2[i]], axis=1)
-        y = x0[i] + xi[:, :1] * a1[i] + xi[:, 1:] * a2[i]
-        pairs.xi[i] = xi
-        pairs.dist[i] = np.linalg.norm(x[i] - y, axis=1)
+        xi1, xi2 = xi1[i], xi2[i]
+        w = [r[k][i] - xi1 * a1[k][i] - xi2 * a2[k][i] for k in range(3)]
+        pairs.xi[i] = np.stack([xi1, xi2], axis=1)
+        pairs.dist[i] = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
         pairs.edge[i] = -1
         pairs.vertex[i] = False
 
@@ -383,60 +424,117 @@ def _quad_newton(
     and whether the Hessian is positive definite there.
     """
     P = x.shape[0]
-    xi = xi.copy()
+    # coordinate columns: C[j][k] = coordinate k of c_j, X[k] of the points
+    C = [[np.ascontiguousarray(coef[:, j, k]) for k in range(3)] for j in range(4)]
+    X = [np.ascontiguousarray(x[:, k]) for k in range(3)]
+    s_all, t_all = xi[:, 0].copy(), xi[:, 1].copy()
     conv = np.zeros(P, dtype=bool)
     act = np.arange(P)
+    c, xa, s, t = C, X, s_all, t_all  # the columns of the active points
 
-    def residual(xi_: FloatArray, c: FloatArray, X: FloatArray) -> FloatArray:
-        s, t = xi_[:, :1], xi_[:, 1:]
-        return X - (c[:, 0] + s * c[:, 1] + t * c[:, 2] + s * t * c[:, 3])
+    def residual(s_: FloatArray, t_: FloatArray) -> list[FloatArray]:
+        return [
+            xa[k] - (c[0][k] + s_ * c[1][k] + t_ * c[2][k] + s_ * t_ * c[3][k]) for k in range(3)
+        ]
 
     for _ in range(_NEWTON_ITERATIONS):
         if act.size == 0:
             break
-        c, X, z = coef[act], x[act], xi[act]
-        a1 = c[:, 1] + z[:, 1:] * c[:, 3]
-        a2 = c[:, 2] + z[:, :1] * c[:, 3]
-        r = residual(z, c, X)
-        g1, g2 = -_dot(r, a1), -_dot(r, a2)
-        h11, h22, h12gn = _dot(a1, a1), _dot(a2, a2), _dot(a1, a2)
-        h12 = h12gn - _dot(r, c[:, 3])
+        a1 = [c[1][k] + t * c[3][k] for k in range(3)]
+        a2 = [c[2][k] + s * c[3][k] for k in range(3)]
+        r = residual(s, t)
+        g1, g2 = -_dot3(r, a1), -_dot3(r, a2)
+        h11, h22, h12gn = _dot3(a1, a1), _dot3(a2, a2), _dot3(a1, a2)
+        h12 = h12gn - _dot3(r, c[3])
         det = h11 * h22 - h12 * h12
         indefinite = det <= 1e-12 * h11 * h22
         h12 = np.where(indefinite, h12gn, h12)
         det = h11 * h22 - h12 * h12
         det = np.where(det > 0, det, np.inf)  # degenerate patch: no step
-        step = np.stack([-(h22 * g1 - h12 * g2) / det, -(h11 * g2 - h12 * g1) / det], axis=1)
+        step1, step2 = -(h22 * g1 - h12 * g2) / det, -(h11 * g2 - h12 * g1) / det
         # projected Newton: a coordinate on a bound that the gradient pushes out stays there,
         # the other one takes a one-dimensional Newton step (d2f/dxi_i^2 = |a_i|^2)
-        fix1 = ((z[:, 0] <= 0.0) & (g1 > 0.0)) | ((z[:, 0] >= 1.0) & (g1 < 0.0))
-        fix2 = ((z[:, 1] <= 0.0) & (g2 > 0.0)) | ((z[:, 1] >= 1.0) & (g2 < 0.0))
+        fix1 = ((s <= 0.0) & (g1 > 0.0)) | ((s >= 1.0) & (g1 < 0.0))
+        fix2 = ((t <= 0.0) & (g2 > 0.0)) | ((t >= 1.0) & (g2 < 0.0))
         one = fix1 ^ fix2
-        step[one, 0] = np.where(fix1[one], 0.0, -g1[one] / np.where(h11[one] > 0, h11[one], np.inf))
-        step[one, 1] = np.where(fix2[one], 0.0, -g2[one] / np.where(h22[one] > 0, h22[one], np.inf))
-        step[fix1 & fix2] = 0.0
-        f0 = _dot(r, r)
-        new = np.clip(z + step, 0.0, 1.0)
+        if one.any():
+            step1 = np.where(one, np.where(fix1, 0.0, -g1 / np.where(h11 > 0, h11, np.inf)), step1)
+            step2 = np.where(one, np.where(fix2, 0.0, -g2 / np.where(h22 > 0, h22, np.inf)), step2)
+        both = fix1 & fix2
+        step1, step2 = np.where(both, 0.0, step1), np.where(both, 0.0, step2)
+        f0 = _dot3(r, r)
+        new_s, new_t = np.clip(s + step1, 0.0, 1.0), np.clip(t + step2, 0.0, 1.0)
         for _ in range(3):
-            rn = residual(new, c, X)
-            worse = _dot(rn, rn) > f0 * (1 + 1e-10)  # not rounding noise near the minimum
+            rn = residual(new_s, new_t)
+            worse = _dot3(rn, rn) > f0 * (1 + 1e-10)  # not rounding noise near the minimum
             if not worse.any():
                 break
-            step[worse] *= 0.5
-            new[worse] = np.clip(z[worse] + step[worse], 0.0, 1.0)
-        done = np.abs(new - z).max(axis=1) <= _NEWTON_TOL
-        xi[act] = new
+            step1, step2 = np.where(worse, step1 * 0.5, step1), np.where(worse, step2 * 0.5, step2)
+            new_s = np.where(worse, np.clip(s + step1, 0.0, 1.0), new_s)
+            new_t = np.where(worse, np.clip(t + step2, 0.0, 1.0), new_t)
+        done = np.maximum(np.abs(new_s - s), np.abs(new_t - t)) <= _NEWTON_TOL
+        s_all[act], t_all[act] = new_s, new_t
         conv[act[done]] = True
-        act = act[~done]
+        keep = ~done
+        act = act[keep]
+        c = [[column[keep] for column in cj] for cj in c]
+        xa = [column[keep] for column in xa]
+        s, t = new_s[keep], new_t[keep]
 
-    s, t = xi[:, :1], xi[:, 1:]
-    a1 = coef[:, 1] + t * coef[:, 3]
-    a2 = coef[:, 2] + s * coef[:, 3]
-    r = residual(xi, coef, x)
-    h11, h22 = _dot(a1, a1), _dot(a2, a2)
-    h12 = _dot(a1, a2) - _dot(r, coef[:, 3])
+    c, xa, s, t = C, X, s_all, t_all
+    a1 = [c[1][k] + t * c[3][k] for k in range(3)]
+    a2 = [c[2][k] + s * c[3][k] for k in range(3)]
+    r = residual(s, t)
+    h11, h22 = _dot3(a1, a1), _dot3(a2, a2)
+    h12 = _dot3(a1, a2) - _dot3(r, c[3])
     pd = (h11 > 0) & (h11 * h22 - h12 * h12 > 0)
-    return xi, np.linalg.norm(r, axis=1), conv, pd
+    return np.stack([s, t], axis=1), np.sqrt(_dot3(r, r)), conv, pd
+
+
+def _dot3(a: list[FloatArray], b: list[FloatArray]) -> FloatArray:
+    """Dot products of vectors given as three coordinate columns."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+class TreeCache:
+    """KD-trees of facet centroids, reused while the master surface has barely moved.
+
+    Held by whoever searches the same master surface again and again (a
+    :class:`~contact_ufl.contact.search.ClosestPointSearch`) and passed to
+    :func:`closest_points`.
+
+    One entry per shape ``(nf, nn, gdim)`` of the node array (the ``_TREES`` most recent):
+    the nodes the tree was built from and the tree.
+    """
+
+    def __init__(self) -> None:
+        self.entries: OrderedDict[tuple[int, ...], tuple[FloatArray, cKDTree]] = OrderedDict()
+
+    def tree(
+        self, nodes: FloatArray, centroid: FloatArray, R_max: float
+    ) -> tuple[cKDTree | None, float]:
+        """A KD-tree of centroids within ``slack`` of ``centroid``, and that slack.
+
+        The centroid is the mean of the nodes, so it moves at most as far as the farthest
+        node: a tree of earlier centroids serves with ``slack`` the largest node movement.
+        """
+        if len(nodes) == 0:
+            return None, 0.0
+        key = nodes.shape
+        entry = self.entries.get(key)
+        if entry is not None:
+            built, tree = entry
+            # largest node movement (bounded by the largest coordinate change times sqrt(gdim))
+            move = float(np.max(np.abs(nodes - built))) * np.sqrt(nodes.shape[2])
+            if move <= _MOVE * R_max:
+                self.entries.move_to_end(key)
+                return tree, move
+        tree = cKDTree(centroid)
+        self.entries[key] = (nodes.copy(), tree)
+        self.entries.move_to_end(key)
+        while len(self.entries) > _TREES:
+            self.entries.popitem(last=False)
+        return tree, 0.0
 
 
 def _candidates(
@@ -444,29 +542,17 @@ def _candidates(
 ) -> tuple[IntArray, IntArray]:
     """All (point, facet) pairs with the facet's centroid within ``bound`` of the point.
 
-    ``cKDTree.query`` takes one scalar ``distance_upper_bound``; it is given the largest bound
-    of the points queried, and every point's own bound is then applied to its neighbours. A
-    point whose K-th neighbour is within its bound may have more: it is queried again with
-    twice as many neighbours, until none is cut off or K reaches the number of facets.
+    One ball query of the KD-tree per point, with the point's own bound (widened by the
+    slack of a reused tree): no repeated K-nearest queries.
     """
-    nf = master.nf
-    K = min(_K0, nf)
-    pids, fids = [], []
-    pending = active
-    while pending.size:
-        d, i = master.tree.query(
-            x[pending], k=K, distance_upper_bound=float(bound[pending].max()) * (1 + 1e-12)
-        )
-        d, i = d.reshape(-1, K), i.reshape(-1, K)
-        within = d <= bound[pending, None]
-        cut = within[:, -1] if K < nf else np.zeros(pending.size, dtype=bool)
-        keep = within & ~cut[:, None]
-        rows, cols = np.nonzero(keep)
-        pids.append(pending[rows])
-        fids.append(i[rows, cols])
-        pending = pending[cut]
-        K = min(2 * K, nf)
-    return np.concatenate(pids).astype(np.int64), np.concatenate(fids).astype(np.int64)
+    if active.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    lists = master.tree.query_ball_point(
+        x[active], bound[active] + master.slack, return_sorted=False
+    )
+    count = np.fromiter(map(len, lists), dtype=np.int64, count=len(lists))
+    fid = np.fromiter(itertools.chain.from_iterable(lists), dtype=np.int64, count=count.sum())
+    return np.repeat(active, count), fid
 
 
 def _sliding(
@@ -509,66 +595,92 @@ def _sliding(
     return M
 
 
+def _concatenate(a: _Pairs, b: _Pairs) -> _Pairs:
+    """The pairs of ``a`` followed by those of ``b``."""
+    return _Pairs(
+        xi=np.concatenate([a.xi, b.xi]),
+        dist=np.concatenate([a.dist, b.dist]),
+        edge=np.concatenate([a.edge, b.edge]),
+        vertex=np.concatenate([a.vertex, b.vertex]),
+    )
+
+
 def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projection) -> None:
     """Fill ``out`` (arrays of this block of points) with the closest points of ``x``."""
     npts = x.shape[0]
-    d0, nearest = master.tree.query(x, k=1)
-    d0 = np.asarray(d0).reshape(-1)
-    nearest = np.asarray(nearest, dtype=np.int64).reshape(-1)
-    active = np.flatnonzero(d0 <= radius + master.R_max)
+    # the K nearest centroids, where they can hold a facet point within the radius
+    reach0 = (radius + master.R_max + 2.0 * master.slack) * (1 + 1e-12)
+    K = min(_K[master.gdim], master.nf)
+    d, near = master.tree.query(x, k=K, distance_upper_bound=reach0)
+    d, near = d.reshape(npts, K), near.reshape(npts, K)
+    active = np.flatnonzero(d[:, 0] <= reach0)
     if active.size == 0:
         return
-    # tighter than d0: the exact distance to the facet of the nearest centroid (<= d0)
+    d, near = d[active], near[active].astype(np.int64)
+    nearest = near[:, 0]
+    # an upper bound of the distance: the exact distance to the facet of the nearest centroid
+    first = master.project(x[active], nearest, np.arange(active.size), active.size)
     d1 = np.full(npts, np.inf)
-    d1[active] = master.project(
-        x[active], nearest[active], np.arange(active.size), active.size
-    ).dist
+    d1[active] = first.dist
     reach = np.minimum(d1, radius)
+    # candidates: the centroids within reach + R_max, from the K found (a ball query for the
+    # points whose K-th neighbour is within it: they may have more)
     bound = (reach + master.R_max) * (1 + 1e-12)
-    pid, fid = _candidates(master, x, bound, active)
-    lower = master.lower_bound(x[pid], fid)
-    keep = lower <= reach[pid] * (1 + 1e-9) + 1e-9 * master.size[fid]
+    within = d <= (bound[active] + master.slack)[:, None]
+    cut = within[:, -1] if K < master.nf else np.zeros(active.size, dtype=bool)
+    rows, cols = np.nonzero(within & ~cut[:, None])
+    pid_ball, fid_ball = _candidates(master, x, bound, active[cut])
+    pid = np.concatenate([active[rows], pid_ball])
+    fid = np.concatenate([near[rows, cols], fid_ball])
+    lower = master.lower_bound(x, fid, pid)
+    keep = lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9)
+    # the pair of the nearest centroid is projected already
+    done = np.full(npts, -1, dtype=np.int64)
+    done[active] = nearest
+    keep &= fid != done[pid]
     pid, fid = pid[keep], fid[keep]
-    pairs = master.project(x[pid], fid, pid, npts)
+    pairs = _concatenate(master.project(x[pid], fid, pid, npts), first)
+    pid, fid = np.concatenate([pid, active]), np.concatenate([fid, nearest])
 
     # minimum per point; ties (shared edges and vertices) go to the best-aligned normal
     dmin = np.full(npts, np.inf)
     np.minimum.at(dmin, pid, pairs.dist)
     tie = pairs.dist <= dmin[pid] + _TIE * (dmin[pid] + 2.0 * master.size[fid])
     e = np.flatnonzero(tie)
-    N, dN, _ = shape_functions(master.nn, master.gdim, pairs.xi[e])
-    X = master.nodes[fid[e]]
-    r = x[pid[e]] - np.einsum("pn,png->pg", N, X)
-    nu = _unit_normal(np.einsum("pna,png->pag", dN, X))
-    rn = np.linalg.norm(r, axis=1)
-    align = np.divide(np.abs(_dot(nu, r)), rn, out=np.zeros_like(rn), where=rn > 0)
-    order = np.lexsort((-align, pid[e]))
-    first = np.ones(order.size, dtype=bool)
-    first[1:] = pid[e][order[1:]] != pid[e][order[:-1]]
-    best = e[order[first]]
-
-    p, f, xi = pid[best], fid[best], pairs.xi[best]
+    pe, fe, xi = pid[e], fid[e], pairs.xi[e]
     N, dN, d2N = shape_functions(master.nn, master.gdim, xi)
-    X = master.nodes[f]
+    X = master.nodes[fe]
     y = np.einsum("pn,png->pg", N, X)
-    r = x[p] - y
-    dist = np.linalg.norm(r, axis=1)
-    inside = dist <= radius
-    p, f, xi, y, r, dist = p[inside], f[inside], xi[inside], y[inside], r[inside], dist[inside]
-    dN, d2N, best = dN[inside], d2N[inside], best[inside]
-    a = np.einsum("pna,png->pag", dN, X[inside])
+    r = x[pe] - y
+    a = np.einsum("pna,png->pag", dN, X)
     nu = _unit_normal(a)
+    dist = np.linalg.norm(r, axis=1)
+    align = np.divide(np.abs(_dot(nu, r)), dist, out=np.zeros_like(dist), where=dist > 0)
+    # equal alignments: the nearer centroid, then the lower facet index
+    c = x[pe] - master.centroid[fe]
+    order = np.lexsort((fe, _dot(c, c), -align, pe))
+    head = np.ones(order.size, dtype=bool)
+    head[1:] = pe[order[1:]] != pe[order[:-1]]
+    k = order[head]
+    k = k[dist[k] <= radius]
+    p, f = pe[k], fe[k]
     out.facet[p] = f
-    out.xi[p] = xi
-    out.y[p] = y
-    out.normal[p] = nu
-    out.gap[p] = -_dot(nu, r)
-    out.distance[p] = dist
-    out.sliding[p] = _sliding(master, xi, a, r, d2N, f, pairs.edge[best], pairs.vertex[best])
+    out.xi[p] = xi[k]
+    out.y[p] = y[k]
+    out.normal[p] = nu[k]
+    out.gap[p] = -_dot(nu[k], r[k])
+    out.distance[p] = dist[k]
+    best = e[k]
+    out.sliding[p] = _sliding(
+        master, xi[k], a[k], r[k], d2N[k], f, pairs.edge[best], pairs.vertex[best]
+    )
 
 
 def closest_points(
-    points: npt.ArrayLike, nodes: npt.ArrayLike, radius: float = np.inf
+    points: npt.ArrayLike,
+    nodes: npt.ArrayLike,
+    radius: float = np.inf,
+    trees: TreeCache | None = None,
 ) -> Projection:
     """Closest points of slave points on a master surface, in the current configuration.
 
@@ -581,6 +693,9 @@ def closest_points(
         the facet kinds and their normals).
     radius : float, optional
         Search radius: a point with no facet point within ``radius`` gets ``facet = -1``.
+    trees : TreeCache, optional
+        KD-trees of earlier calls on the same master surface, reused while it has barely
+        moved (and updated); without it the tree is built anew.
 
     Returns
     -------
@@ -594,15 +709,19 @@ def closest_points(
     Candidate search: a KD-tree of the facet centroids. The centroid of a facet lies on the
     facet and every facet point is within ``R_f`` (largest node distance from the centroid) of
     it, ``R_max = max R_f``. With ``d1 <= d0`` the exact distance of ``x`` to the facet of its
-    nearest centroid (``d0`` away), the closest point is within ``r = min(d1, radius)`` of
-    ``x``, so its facet has its centroid within ``r + R_max`` (KD-tree queries with K = 8, 16,
-    ... neighbours until no point is cut off). The facets whose distance lower bound (node
-    sphere and slab along the normal at the centre) exceeds ``r`` are dropped, the others
-    projected exactly. Points with ``d0 > radius + R_max`` get ``facet = -1`` at once.
+    nearest centroid (``d0`` away, a query bounded by ``radius + R_max``), the closest point
+    is within ``r = min(d1, radius)`` of ``x``, so its facet has its centroid within ``r +
+    R_max`` (one ball query per point, with the point's own ``r``: the work follows ``r``,
+    not the search radius). The facets whose distance lower bound (node sphere and slab along
+    the normal at the centre) exceeds ``r`` are dropped, the others projected exactly. Points
+    with ``d0 > radius + R_max`` get ``facet = -1`` at once. The KD-tree is reused from one
+    call to the next while the master nodes (same array shape) have moved less than ``0.25
+    R_max``, the bounds being widened by that movement.
 
     When several facets are at the same distance up to ``1e-10 (distance + facet size)``
     (the point projects onto a shared edge or vertex), the facet whose normal is the most
-    aligned with ``x - y`` wins.
+    aligned with ``x - y`` wins; at equal alignment the one with the nearer centroid, then the
+    lower index (so that the order the caller gives the facets in decides exact ties).
 
     Quadrilaterals: clamped Newton from the centre (restarted from four other points where it
     does not converge or stops at a saddle), compared with the projections on the four
@@ -634,7 +753,7 @@ def closest_points(
     )
     if npts == 0 or nf == 0:
         return out
-    master = _Master(nodes)
+    master = _Master(nodes, trees)
     for start in range(0, npts, _BLOCK):
         block = slice(start, min(start + _BLOCK, npts))
         view = Projection(

@@ -20,7 +20,7 @@ from mpi4py import MPI
 
 from contact_ufl.contact.facets import on_edges
 from contact_ufl.contact.master import MeshMaster, smoothed_normals
-from contact_ufl.contact.projection import Projection, closest_points
+from contact_ufl.contact.projection import Projection, TreeCache, closest_points
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
 from contact_ufl.layout import StackedLayout
@@ -80,6 +80,8 @@ class ClosestPointSearch:
         self.gdim = slave.V.mesh.geometry.dim
         #: seconds spent in :meth:`pair` so far
         self.time = 0.0
+        #: KD-trees of the master facets, reused from one search to the next
+        self.trees = TreeCache()
 
     def exchange(self, master_nodes: np.ndarray, points: np.ndarray, payload=None):
         """Master facets of all ranks near this rank's ``points`` (bounding-box filter).
@@ -147,7 +149,7 @@ class ClosestPointSearch:
         nodes, payload = nodes[order], payload[order]
         columns = payload[:, :nx]
         boundary = payload[:, nx + nn : nx + nn + ne].astype(bool)
-        proj = closest_points(points, nodes[:, :nn], self.radius)
+        proj = closest_points(points, nodes[:, :nn], self.radius, self.trees)
         release_beyond_boundary(proj, points, boundary, self.touching)
         paired = proj.facet >= 0
         flags = None

@@ -1,0 +1,135 @@
+"""The pruned closest-point search against a projection onto every facet.
+
+The reference projects each point onto each facet alone (one facet per call, so no candidate
+search is involved) and picks the closest with the documented tie-break: among the facets
+within ``1e-10 (distance + facet size)`` of the smallest distance, the normal most aligned
+with ``x - y``, then the nearer centroid, then the lower facet index. The search must return
+the same facet and, to round-off, the same closest point, reference coordinates, normal, gap
+and linearisation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_quads
+
+from contact_ufl.contact.projection import TreeCache, closest_points, shape_functions
+
+FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
+
+
+def reference(points: np.ndarray, nodes: np.ndarray, radius: float = np.inf):
+    """Facet index and the fields of the closest point of every point, facet by facet."""
+    centroid = nodes.mean(axis=1)
+    size = np.linalg.norm(nodes - centroid[:, None], axis=2).max(axis=1)
+    facet = np.full(len(points), -1)
+    fields = {k: [] for k in FIELDS}
+    for i, x in enumerate(points):
+        each = [closest_points(x[None], nodes[f : f + 1]) for f in range(len(nodes))]
+        dist = np.array([p.distance[0] for p in each])
+        tied = np.flatnonzero(dist <= dist.min() + 1e-10 * (dist.min() + 2 * size))
+        r = [x - each[f].y[0] for f in tied]
+        align = [
+            abs(each[f].normal[0] @ rf) / np.linalg.norm(rf) if rf.any() else 0.0
+            for f, rf in zip(tied, r, strict=True)
+        ]
+        near = [np.sum((x - centroid[f]) ** 2) for f in tied]
+        best = tied[min(range(len(tied)), key=lambda k: (-align[k], near[k], tied[k]))]
+        if each[best].distance[0] <= radius:
+            facet[i] = best
+        for k in FIELDS:
+            fields[k].append(getattr(each[best], k)[0])
+    return facet, {k: np.array(v) for k, v in fields.items()}
+
+
+def check(points, nodes, radius=np.inf, trees=None):
+    proj = closest_points(points, nodes, radius, trees)
+    facet, fields = reference(points, nodes, radius)
+    np.testing.assert_array_equal(proj.facet, facet)
+    found = facet >= 0
+    for k in FIELDS:
+        np.testing.assert_allclose(getattr(proj, k)[found], fields[k][found], rtol=0, atol=1e-12)
+    assert np.all(proj.distance[~found] == np.inf)
+    return proj
+
+
+def near_and_far(rng, nodes, n):
+    """Points on the surface moved by 1e-3 to 1 (log-uniform), and uniform points around."""
+    nf, nn, gdim = nodes.shape
+    f = rng.integers(nf, size=n)
+    N, _, _ = shape_functions(nn, gdim, rng.uniform(0, 0.5, size=(n, gdim - 1)))
+    on = np.einsum("pn,png->pg", N, nodes[f])
+    direction = rng.normal(size=(n, gdim))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    near = on + direction * 10.0 ** rng.uniform(-3, 0, size=(n, 1))
+    lo, hi = nodes.reshape(-1, gdim).min(axis=0), nodes.reshape(-1, gdim).max(axis=0)
+    return np.concatenate([near, rng.uniform(lo - 0.5, hi + 0.5, size=(n // 2, gdim))])
+
+
+@pytest.mark.parametrize(
+    ("make", "nf"),
+    [(segment_polyline, 50), (triangle_soup, 40), (warped_quads, 20), (wavy_quads, 36)],
+    ids=["segments", "triangles", "quadrilaterals", "quad-grid"],
+)
+@pytest.mark.parametrize("radius", [np.inf, 0.05, 0.3])
+def test_random_against_every_facet(make, nf, radius):
+    rng = np.random.default_rng(nf)
+    nodes = make(rng, nf)
+    points = near_and_far(rng, nodes, 30)
+    proj = check(points, nodes, radius)
+    if np.isfinite(radius):  # some points are beyond the radius, some within
+        assert 0 < np.count_nonzero(proj.facet < 0) < len(points)
+
+
+def test_equidistant_segments():
+    """Exact ties: a vertex seen from the bisector (equal alignment, equal centroid
+    distance: the lower index) and two parallel segments (the nearer centroid)."""
+    v = np.array([[[0.0, 1.0], [1.0, 0.0]], [[1.0, 0.0], [2.0, 1.0]]])
+    for nodes in (v, v[::-1]):
+        proj = check(np.array([[1.0, -1.0], [1.0, -0.25]]), nodes)
+        np.testing.assert_array_equal(proj.facet, [0, 0])
+    parallel = np.array([[[0.0, 0.0], [1.0, 0.0]], [[0.25, 1.0], [2.25, 1.0]]])
+    proj = check(np.array([[0.5, 0.5], [1.25, 0.5]]), parallel)
+    np.testing.assert_array_equal(proj.facet, [0, 1])
+
+
+def test_equidistant_grid_facets():
+    """Points above shared edges and vertices of flat unit grids of quadrilaterals and
+    triangles, where several facets are at exactly the same distance and alignment."""
+    s = np.arange(4.0)
+    X, Y = np.meshgrid(s, s, indexing="ij")
+    V = np.stack([X, Y, np.zeros_like(X)], axis=-1)
+    quads = np.stack([V[:-1, :-1], V[1:, :-1], V[:-1, 1:], V[1:, 1:]], axis=2).reshape(-1, 4, 3)
+    lower = np.stack([V[:-1, :-1], V[1:, :-1], V[:-1, 1:]], axis=2).reshape(-1, 3, 3)
+    upper = np.stack([V[1:, :-1], V[1:, 1:], V[:-1, 1:]], axis=2).reshape(-1, 3, 3)
+    points = np.array(
+        [[1.0, 1.0, 0.5], [2.0, 1.0, -0.25], [1.0, 0.3, 0.5], [1.5, 2.0, 0.125], [0.5, 0.5, 1.0]]
+    )
+    for nodes in (quads, np.concatenate([lower, upper])):
+        rng = np.random.default_rng(0)
+        for order in (np.arange(len(nodes)), rng.permutation(len(nodes))):
+            check(points, nodes[order])
+            check(points, nodes[order], radius=0.3)
+
+
+def test_reused_tree_after_the_master_moves():
+    """The KD-tree of a master of the same shape is reused while its nodes move little: the
+    results after small and large movements are those of a fresh projection."""
+    rng = np.random.default_rng(7)
+    nodes = wavy_quads(rng, 36)
+    points = near_and_far(rng, nodes, 30)
+    trees = TreeCache()
+    check(points, nodes, trees=trees)
+
+    def tree():
+        (entry,) = trees.entries.values()
+        return entry[1]
+
+    first = tree()
+    size = np.linalg.norm(nodes - nodes.mean(axis=1, keepdims=True), axis=2).max()
+    for move, reused in ((1e-3 * size, True), (0.2 * size, True), (2.0 * size, False)):
+        moved = nodes + rng.uniform(-move, move, size=nodes.shape) / np.sqrt(3.0)
+        check(points, moved, radius=0.2, trees=trees)
+        assert (tree() is first) == reused
+        check(points, moved, trees=trees)
