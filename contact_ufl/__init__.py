@@ -37,7 +37,7 @@ from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSph
 from contact_ufl.errors import ContactInputError, ConvergenceError
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerForce, FollowerPressure
 from contact_ufl.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff
-from contact_ufl.newton import NewtonSolver
+from contact_ufl.newton import NewtonSolver, NewtonTimings
 from contact_ufl.output import ResultWriter
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.problem import ContactProblem
@@ -65,6 +65,7 @@ __all__ = [
     "MeshData",
     "NeoHookean",
     "NewtonSolver",
+    "NewtonTimings",
     "ResultWriter",
     "RigidCylinder",
     "RigidPlane",

@@ -5,13 +5,16 @@ assembled over the fields ``[u, xhat_1, lambda_1, ...]``; the chain operator ``T
 :mod:`contact_ufl.layout` (identity on the unknowns, the gathers ``xhat = Xhat + P u``)
 maps them onto the unknowns ``[u, lambda_1, ...]``: residual ``T^T r``, tangent
 ``T^T K T``. The search runs at every new state; ``T`` and the tangent's sparsity pattern
-change only when the pairing does.
+change only when the pairing does. The solver times its parts (:class:`NewtonTimings`).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import time
 import weakref
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import dolfinx
@@ -35,6 +38,67 @@ DEFAULT_PETSC_OPTIONS = {
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
 }
+
+
+@dataclass
+class NewtonTimings:
+    """Wall-clock seconds of the parts of the Newton solves of a :class:`NewtonSolver`, on
+    this rank, accumulated since the solver was made or :meth:`reset` (no collectives: on
+    several ranks each rank has its own).
+
+    Attributes
+    ----------
+    search
+        Search and contact data update (``_update_contact``): closest-point projection,
+        contact data, and the chain operator ``T`` where the pairing changed.
+    residual_assembly
+        Assembly of the residual over the fields and its map ``T^T r`` to the unknowns, with
+        the Dirichlet rows.
+    jacobian_assembly
+        Assembly of the tangent ``K`` over the fields (bulk and contact forms together).
+    ptap
+        ``T^T K T``, the copy into the solver's matrix (with a new sparsity pattern and a
+        reset factorisation where the pairing changed) and the Dirichlet rows.
+    newton
+        Time inside ``SNES.solve``.
+    callbacks
+        Time of the residual and Jacobian callbacks inside ``SNES.solve`` (including their
+        searches).
+    searches, residuals, jacobians, iterations
+        Counts: contact updates, residual and Jacobian evaluations (in or out of SNES), and
+        Newton iterations.
+    """
+
+    search: float = 0.0
+    residual_assembly: float = 0.0
+    jacobian_assembly: float = 0.0
+    ptap: float = 0.0
+    newton: float = 0.0
+    callbacks: float = 0.0
+    searches: int = 0
+    residuals: int = 0
+    jacobians: int = 0
+    iterations: int = 0
+
+    @property
+    def linear_solve(self) -> float:
+        """SNES time outside the callbacks: factorisation and solve of the linear systems,
+        plus SNES's own vector work (norms, updates, line search), which is small beside
+        them."""
+        return max(self.newton - self.callbacks, 0.0)
+
+    def reset(self) -> None:
+        """Zero all times and counts."""
+        for f in dataclasses.fields(self):
+            setattr(self, f.name, f.default)
+
+    def per_iteration(self) -> dict[str, float]:
+        """Seconds per Newton iteration of each part (and ``total``, the SNES time)."""
+        n = max(self.iterations, 1)
+        parts = ("search", "residual_assembly", "jacobian_assembly", "ptap", "linear_solve")
+        out = {name: getattr(self, name) / n for name in parts}
+        out["total"] = self.newton / n
+        return out
 
 
 def _weakly(method: Callable) -> Callable:
@@ -79,6 +143,8 @@ class NewtonSolver:
     close_gaps
         Whether a failed step whose start has a contact pair with no point in contact is
         tried once more after a closing iterate (see :meth:`solve_step`).
+    timings
+        Seconds spent in the parts of the Newton solves (:class:`NewtonTimings`).
     """
 
     def __init__(
@@ -91,6 +157,8 @@ class NewtonSolver:
             raise ValueError("this problem has a solver already (problem.solver)")
         self.problem = problem
         self.comm = problem.comm
+        self.timings = NewtonTimings()
+        self._in_snes = False
         spaces = [f.function_space for f in problem.fields]
         self._field_index = {id(f): k for k, f in enumerate(problem.fields)}
         self._r = fem_petsc.create_vector(spaces, kind="mpi")
@@ -155,6 +223,7 @@ class NewtonSolver:
 
     def _update_contact(self, x: PETSc.Vec) -> None:
         """Search, refresh the contact data and (if the pairing changed) the operator T."""
+        start = time.perf_counter()
         contacts = self.problem.contacts
         gathers = [c.update(self.problem.layout) for c in contacts]
         pattern = [cols for g in gathers for _, cols in g]
@@ -167,6 +236,8 @@ class NewtonSolver:
             self._JT = None
         for c in contacts:
             c.update_history(self._T, x, self._block_slice)
+        self.timings.search += time.perf_counter() - start
+        self.timings.searches += 1
 
     def _chain_operator(self, gathers: list[list]) -> PETSc.Mat:
         """``T``: identity from each unknown to its assembled field, gathers for the others."""
@@ -213,19 +284,30 @@ class NewtonSolver:
         return out
 
     def _residual(self, snes, x, F) -> None:
+        start = time.perf_counter()
         self._set_state(x)
         problem = self.problem
+        assembly = time.perf_counter()
         self.assemble(problem.residual_form, F)
         rows = problem.dirichlet_rows
         if len(rows):
             u = problem.u.x.array[rows]
             F.array[rows] = problem.dirichlet_scale * (u - problem.prescribed(problem.t))
+        end = time.perf_counter()
+        self.timings.residual_assembly += end - assembly
+        self.timings.residuals += 1
+        if self._in_snes:
+            self.timings.callbacks += end - start
 
     def _assemble_jacobian_matrix(self, first: bool = False) -> PETSc.Mat:
+        start = time.perf_counter()
         K = self._K
         K.zeroEntries()
         fem_petsc.assemble_matrix(K, self.problem.jacobian_form)
         K.assemble()
+        assembled = time.perf_counter()
+        self.timings.jacobian_assembly += assembled - start
+        self.timings.jacobians += 1
         if self._JT is None:
             self._JT = K.PtAP(self._T)
             new_pattern = True
@@ -236,6 +318,7 @@ class NewtonSolver:
             J = self._JT.duplicate(copy=True)
             J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
             self._zero_dirichlet_rows(J)
+            self.timings.ptap += time.perf_counter() - assembled
             return J
         J = self._J
         J.zeroEntries()
@@ -249,6 +332,7 @@ class NewtonSolver:
             J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
             self.snes.getKSP().getPC().reset()
         self._zero_dirichlet_rows(J)
+        self.timings.ptap += time.perf_counter() - assembled
         return J
 
     def _zero_dirichlet_rows(self, J: PETSc.Mat) -> None:
@@ -257,8 +341,11 @@ class NewtonSolver:
         J.zeroRows(rows, diag=problem.dirichlet_scale)
 
     def _jacobian(self, snes, x, J, P) -> None:
+        start = time.perf_counter()
         self._set_state(x)
         self._assemble_jacobian_matrix()
+        if self._in_snes:
+            self.timings.callbacks += time.perf_counter() - start
 
     def evaluate_residual(self, x: PETSc.Vec) -> PETSc.Vec:
         """The residual at the unknowns ``x`` (a new vector); sets the state to ``x``."""
@@ -353,6 +440,8 @@ class NewtonSolver:
     def _newton(self) -> tuple[int, int]:
         """One SNES solve from :attr:`x`: converged reason and iterations."""
         self._state = None
+        start = time.perf_counter()
+        self._in_snes = True
         try:
             self.snes.solve(None, self.x)
             reason = self.snes.getConvergedReason()
@@ -360,6 +449,10 @@ class NewtonSolver:
             if self.problem.verbose and self.comm.rank == 0:
                 print(f"  PETSc error in the Newton solve: {error}", flush=True)
             reason = PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
+        finally:
+            self._in_snes = False
+            self.timings.newton += time.perf_counter() - start
+        self.timings.iterations += self.snes.getIterationNumber()
         if reason <= 0:
             self.snes.getKSP().getPC().reset()  # no stale factorisation in the next try
         return reason, self.snes.getIterationNumber()

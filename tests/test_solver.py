@@ -1,13 +1,14 @@
 """Load stepping: cut-back of diverging steps, a clear error when cut-backs run out."""
 
 import gc
+import time
 import weakref
 
 import numpy as np
 import pytest
 
 from contact_ufl.errors import ConvergenceError
-from contact_ufl.newton import NewtonSolver
+from contact_ufl.newton import NewtonSolver, NewtonTimings
 from contact_ufl.problem import ContactProblem
 from contact_ufl.stepping import LoadStepper
 from contact_ufl.verification import scenes
@@ -77,3 +78,30 @@ def test_a_dropped_problem_is_freed():
     del problem
     gc.collect()
     assert ref() is None
+
+
+def test_newton_timings_are_filled_and_reset():
+    """The solver times its parts: each part that must run has run, the parts inside SNES fit
+    in the SNES time, all of it fits in the wall time of the solve; reset zeroes them."""
+    problem = hertz_problem()
+    solver = problem.solver
+    timings = solver.timings
+    timings.reset()
+    start = time.perf_counter()
+    problem.solve(num_steps=2)
+    wall = time.perf_counter() - start
+    assert timings.iterations == sum(r.newton_iterations for r in problem.history.steps) > 0
+    assert timings.jacobians >= timings.iterations
+    assert timings.residuals > timings.iterations  # one more than Jacobians per solve
+    assert timings.searches > 0
+    for part in ("search", "residual_assembly", "jacobian_assembly", "ptap", "linear_solve"):
+        assert getattr(timings, part) > 0.0, part
+    assert timings.callbacks <= timings.newton
+    parts = timings.search + timings.residual_assembly + timings.jacobian_assembly
+    assert parts + timings.ptap + timings.linear_solve <= wall
+    assert timings.newton <= wall
+    per_iteration = timings.per_iteration()
+    assert per_iteration["total"] == pytest.approx(timings.newton / timings.iterations)
+    timings.reset()
+    assert timings == NewtonTimings()
+    assert timings.linear_solve == 0.0
