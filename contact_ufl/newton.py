@@ -67,6 +67,9 @@ class NewtonTimings:
     searches, residuals, jacobians, iterations
         Counts: contact updates, residual and Jacobian evaluations (in or out of SNES), and
         Newton iterations.
+    new_patterns
+        Jacobians assembled on a new sparsity pattern (the pairing changed): a symbolic PtAP,
+        and the next factorisation redone from its symbolic part.
     """
 
     search: float = 0.0
@@ -79,6 +82,7 @@ class NewtonTimings:
     residuals: int = 0
     jacobians: int = 0
     iterations: int = 0
+    new_patterns: int = 0
 
     @property
     def linear_solve(self) -> float:
@@ -93,7 +97,11 @@ class NewtonTimings:
             setattr(self, f.name, f.default)
 
     def per_iteration(self) -> dict[str, float]:
-        """Seconds per Newton iteration of each part (and ``total``, the SNES time)."""
+        """Seconds per Newton iteration of each part (and ``total``, the SNES time).
+
+        The parts include their calls outside SNES (the search at the converged state of a
+        step, the evaluations of a closing iterate), so they may add up to more than
+        ``total``."""
         n = max(self.iterations, 1)
         parts = ("search", "residual_assembly", "jacobian_assembly", "ptap", "linear_solve")
         out = {name: getattr(self, name) / n for name in parts}
@@ -311,6 +319,7 @@ class NewtonSolver:
         if self._JT is None:
             self._JT = K.PtAP(self._T)
             new_pattern = True
+            self.timings.new_patterns += 1
         else:
             K.PtAP(self._T, result=self._JT)
             new_pattern = False

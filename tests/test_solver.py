@@ -94,6 +94,7 @@ def test_newton_timings_are_filled_and_reset():
     assert timings.jacobians >= timings.iterations
     assert timings.residuals > timings.iterations  # one more than Jacobians per solve
     assert timings.searches > 0
+    assert 0 <= timings.new_patterns <= timings.jacobians
     for part in ("search", "residual_assembly", "jacobian_assembly", "ptap", "linear_solve"):
         assert getattr(timings, part) > 0.0, part
     assert timings.callbacks <= timings.newton
