@@ -31,11 +31,12 @@ def why(record: dict) -> str:
     return f"{counts}; inverted cells <= {inverted}"
 
 
-def print_table(records: list[dict]) -> None:
-    print(
-        f"{'case':26} {'status':10} {'t':>6} {'steps':>5} {'cuts':>4} {'newton':>10} "
-        f"{'all conv':>8} {'wall s':>7}  why"
-    )
+def print_table(records: list[dict], header: bool = True) -> None:
+    if header:
+        print(
+            f"{'case':26} {'status':10} {'t':>6} {'steps':>5} {'cuts':>4} {'newton':>10} "
+            f"{'all conv':>8} {'wall s':>7}  why"
+        )
     for r in records:
         if r["status"] == "not implemented":
             print(f"{r['name']:26} not implemented: {r['description']}")
@@ -58,7 +59,7 @@ def main() -> None:
     for case in cases(quick=args.quick):
         records.append(run_case(case))
         if comm.rank == 0:
-            print_table(records[-1:])
+            print_table(records[-1:], header=len(records) == 1)
     records += [
         {"name": name, "status": "not implemented", "description": text}
         for name, text in NOT_IMPLEMENTED.items()
