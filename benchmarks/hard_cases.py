@@ -3,8 +3,9 @@ planned ones listed as not implemented.
 
 For each case: steps, cut-backs, Newton iterations per accepted step (max and mean), whether
 every step converged (SNES's converged reasons), wall time, and, where a step failed, why:
-the SNES reason of every failed try, with the number of inverted cells (det F < 0) and of
-contact points in contact at the failed state. A case stopped by a ``ConvergenceError`` is
+the SNES reason of every failed try, with the number of inverted cells (det F < 0), of
+contact points in contact and of those whose contact status differs from the last accepted
+step, at the failed state. A case stopped by a ``ConvergenceError`` is
 recorded as ``stopped`` with the error, not raised. See
 :mod:`contact_ufl.verification.hard_cases`.
 
@@ -28,7 +29,9 @@ def why(record: dict) -> str:
     reasons = [f["reason"] for f in failures]
     counts = ", ".join(f"{r} x{reasons.count(r)}" for r in sorted(set(reasons)))
     inverted = max(f["inverted_cells"] for f in failures)
-    return f"{counts}; inverted cells <= {inverted}"
+    changes = [f["status_changes"] for f in failures if f["status_changes"] is not None]
+    changed = f"; status changes <= {max(changes)}" if changes else ""
+    return f"{counts}; inverted cells <= {inverted}{changed}"
 
 
 def print_table(records: list[dict], header: bool = True) -> None:

@@ -33,6 +33,8 @@ def test_deep_indentation_record():
     assert all(f["reason"].startswith("DIVERGED") for f in record["failures"])
     assert all(f["time"] > f["from_time"] for f in record["failures"])
     assert all(f["inverted_cells"] >= 0 and f["active_points"] > 0 for f in record["failures"])
+    assert all(f["status_changes"] is not None for f in record["failures"])  # after step 1
+    assert all(f["status_changes"] >= 0 for f in record["failures"])
 
 
 def test_planned_cases_are_listed():

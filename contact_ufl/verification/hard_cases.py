@@ -1,7 +1,7 @@
 """The hard-case suite (issue 13, item 7): runs that test the numerical stability of the
 solver, each reported by its steps, cut-backs, Newton iterations and, where a step failed,
-why (the SNES reasons of the failed tries, the inverted elements and the contact points in
-contact at the failed state).
+why (the SNES reasons of the failed tries; at the failed state the inverted elements, the
+contact points in contact and those whose status differs from the last accepted step).
 
 :func:`cases` lists the cases (quick or full), :func:`run_case` runs one and returns its
 record (a ``dict`` ready for JSON); ``benchmarks/hard_cases.py`` runs them all.
@@ -126,18 +126,45 @@ def cases(quick: bool = False) -> list[Case]:
     return out
 
 
-def _observe_failures(problem: ContactProblem, failures: list[dict]) -> None:
-    """Record the failed tries of the problem's Newton solver: pseudo-times, SNES reason,
-    iterations, inverted cells and points in contact at the failed state (the solver leaves
-    its last iterate in the fields until the stepper restores the step's start)."""
-    solver = problem.solver
-    solve_step = solver.solve_step
+class _FailureObserver:
+    """Records the failed tries of a problem's Newton solver: pseudo-times, SNES reason,
+    iterations, inverted cells, points in contact and points whose contact status differs
+    from the last accepted step, at the failed state: the last iterate of the solver's last
+    try (with the backtracking line search where the full-step Newton failed), which the
+    solver leaves in the fields until the stepper restores the step's start.
 
-    def observed(t: float) -> tuple[bool, int, str]:
+    Wraps the solver's ``solve_step``; :meth:`accepted` is the stepping callback that keeps
+    the contact status of the accepted steps.
+    """
+
+    def __init__(self, problem: ContactProblem):
+        self.problem = problem
+        self.failures: list[dict] = []
+        self._accepted_active: list | None = None
+        self._solve_step = problem.solver.solve_step
+        problem.solver.solve_step = self._observed
+
+    def accepted(self, problem: ContactProblem, record: object) -> None:
+        self._accepted_active = [c.active().copy() for c in problem.contacts]
+
+    def _status_changes(self) -> int | None:
+        """Points (all ranks) whose contact status differs from the last accepted step
+        (``None`` before the first accepted step)."""
+        if self._accepted_active is None:
+            return None
+        contacts = self.problem.contacts
+        changed = sum(
+            int((c.active() != a).sum())
+            for c, a in zip(contacts, self._accepted_active, strict=True)
+        )
+        return self.problem.comm.allreduce(changed)
+
+    def _observed(self, t: float) -> tuple[bool, int, str]:
+        problem = self.problem
         t_start = problem.t
-        ok, its, reason = solve_step(t)
+        ok, its, reason = self._solve_step(t)
         if not ok:
-            failures.append(
+            self.failures.append(
                 {
                     "from_time": t_start,
                     "time": t,
@@ -145,11 +172,10 @@ def _observe_failures(problem: ContactProblem, failures: list[dict]) -> None:
                     "newton_iterations": its,
                     "inverted_cells": inverted_cells(problem),
                     "active_points": problem.active_points(),
+                    "status_changes": self._status_changes(),
                 }
             )
         return ok, its, reason
-
-    solver.solve_step = observed
 
 
 def run_case(case: Case) -> dict:
@@ -163,17 +189,22 @@ def run_case(case: Case) -> dict:
         ``all_converged`` (the run completed and every accepted step has a ``CONVERGED_*``
         SNES reason), ``step_reasons`` (the distinct reasons of the accepted steps),
         ``failures`` (one record per failed try: ``from_time``, ``time``, ``reason``,
-        ``newton_iterations``, ``inverted_cells``, ``active_points``), ``error`` (the
+        ``newton_iterations``, ``inverted_cells``, ``active_points``, ``status_changes``:
+        the points whose contact status differs from the last accepted step), ``error`` (the
         message of the :class:`ConvergenceError`, or ``None``), ``unknowns``, ``wall_s``.
     """
     start = time.perf_counter()
     problem = case.build()
-    failures: list[dict] = []
-    _observe_failures(problem, failures)
+    observer = _FailureObserver(problem)
     error = None
     try:
         for num_steps, t_end in case.stages:
-            problem.solve(num_steps=num_steps, t_end=t_end, max_cutbacks=case.max_cutbacks)
+            problem.solve(
+                num_steps=num_steps,
+                t_end=t_end,
+                max_cutbacks=case.max_cutbacks,
+                callback=observer.accepted,
+            )
     except ConvergenceError as e:
         error = str(e)
     wall = problem.comm.allreduce(time.perf_counter() - start, op=MPI.MAX)
@@ -191,7 +222,7 @@ def run_case(case: Case) -> dict:
         "newton_mean": sum(its) / len(its) if its else 0.0,
         "all_converged": error is None and all(r.startswith("CONVERGED") for r in reasons),
         "step_reasons": sorted(set(reasons)),
-        "failures": failures,
+        "failures": observer.failures,
         "error": error,
         "unknowns": problem.layout.global_size,
         "wall_s": wall,
