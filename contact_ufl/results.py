@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import basix
 import dolfinx
 import numpy as np
 import ufl
@@ -346,3 +347,20 @@ def coulomb_law(problem, pair: int = 0, floor: float = 0.0) -> CoulombCheck:
         comm.allreduce(int(slipping.sum()), MPI.SUM),
         comm.allreduce(int(active.sum()), MPI.SUM),
     )
+
+
+def inverted_cells(problem) -> int:
+    """Number of cells (all ranks) in which ``det F < 0`` at one of the cell's vertices or
+    its midpoint, at the current displacement: the elements a Newton iterate has turned
+    inside out. A sample, not a bound (``det F`` of a quadratic displacement is not linear
+    in the cell), cheap enough to be called at a failed step.
+    """
+    from contact_ufl.loads import deformation_gradient
+
+    mesh = problem.V.mesh
+    vertices = basix.geometry(basix.CellType[mesh.topology.cell_type.name])
+    points = np.vstack([vertices, vertices.mean(axis=0)])
+    J = dolfinx.fem.Expression(ufl.det(deformation_gradient(problem.u)), points)
+    owned = mesh.topology.index_map(mesh.topology.dim).size_local
+    values = J.eval(mesh, np.arange(owned, dtype=np.int32)).reshape(owned, len(points))
+    return problem.comm.allreduce(int((values.min(axis=1, initial=np.inf) < 0.0).sum()))

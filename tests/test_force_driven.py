@@ -9,40 +9,20 @@ force (2D Hertz, stiff realistic moduli), and the closed form of the patch test 
 gap).
 """
 
-import dataclasses
-
 import numpy as np
 import pytest
 from mpi4py import MPI
 
 import contact_ufl as cu
 from contact_ufl.results import contact_samples
-from contact_ufl.verification import geometries, scenes
+from contact_ufl.verification import scenes
 
-E_STEEL = 200e9
+E_STEEL = scenes.E_STEEL
 
 
 def hertz_scene(driven_by: str, value: float, gap: float = 0.0) -> cu.Scene:
-    """The 2D Hertz half disc on a block (steel), driven through the disc's flat top either
-    by a prescribed displacement ``value`` or by a dead traction of resultant ``value``
-    (horizontal motion of the top held)."""
-    mesh = geometries.hertz_2d(h_contact=0.02, h_far=0.2, gap=gap)
-    steel = cu.NeoHookean(E_STEEL, 0.3)
-    supports = [cu.Dirichlet("block_bottom", (0.0, 0.0))]
-    loads = []
-    if driven_by == "force":
-        width = 2.0  # the flat top of the half disc of radius 1
-        supports.append(cu.Dirichlet("cylinder_top", 0.0, component=0))
-        loads.append(cu.DeadTraction("cylinder_top", lambda t: (0.0, -value * t / width)))
-    else:
-        supports.append(cu.Dirichlet("cylinder_top", lambda t: (0.0, -value * t)))
-    return cu.Scene.from_mesh_data(
-        mesh,
-        bodies=[cu.Body("cylinder", steel), cu.Body("block", steel)],
-        contacts=[cu.ContactPair("cylinder_contact", "block_contact")],
-        dirichlet=supports,
-        loads=loads,
-    )
+    """The 2D Hertz half disc on a block (:func:`scenes.hertz_2d_driven`)."""
+    return scenes.hertz_2d_driven(driven_by, value, gap=gap)
 
 
 def solved(scene: cu.Scene, steps: int = 2) -> cu.ContactProblem:
@@ -110,16 +90,9 @@ def test_force_driven_patch_3d_from_a_gap(cell, degree, subdivisions, tolerance)
     pressure = 1e-4 * E_STEEL
 
     def run(gap):
-        scene = scenes.patch(
-            3,
-            pressure,
-            E=E_STEEL,
-            quadrature_degree=degree,
-            subdivisions=subdivisions,
-            cell=cell,
-            gap=gap,
+        scene = scenes.patch_3d_pressed(
+            pressure, gap, cell=cell, quadrature_degree=degree, subdivisions=subdivisions
         )
-        scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=None)
         problem = solved(scene, steps=1)
         assert not problem.history.cutbacks
         return problem.contacts[0].lambda_N.x.array.copy(), problem

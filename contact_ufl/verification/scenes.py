@@ -188,6 +188,78 @@ def patch(
     )
 
 
+E_STEEL = 200e9
+"""Young's modulus of steel (Pa), of the force-driven scenes."""
+
+
+def hertz_2d_driven(
+    driven_by: str,
+    value: float,
+    gap: float = 0.0,
+    h_contact: float = 0.02,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """The 2D Hertz half disc on a block (steel), driven through the disc's flat top.
+
+    Parameters
+    ----------
+    driven_by
+        ``"force"``: a dead traction of resultant ``value`` (downwards, at t = 1) on the top,
+        whose horizontal motion is held; the disc is held in the vertical direction only by
+        the contact. ``"displacement"``: the top is moved down by ``value``.
+    value
+        The force or the displacement at t = 1.
+    gap
+        Initial gap between the disc and the block.
+    h_contact
+        Element size near the contact (0.2 far from it).
+    """
+    if driven_by not in ("force", "displacement"):
+        raise ValueError(f"driven_by must be 'force' or 'displacement', not {driven_by!r}")
+    mesh = geometries.hertz_2d(h_contact=h_contact, h_far=0.2, gap=gap, comm=comm)
+    steel = NeoHookean(E_STEEL, 0.3)
+    supports = [Dirichlet("block_bottom", (0.0, 0.0))]
+    loads = []
+    if driven_by == "force":
+        width = 2.0  # the flat top of the half disc of radius 1
+        supports.append(Dirichlet("cylinder_top", 0.0, component=0))
+        loads.append(DeadTraction("cylinder_top", lambda t: (0.0, -value * t / width)))
+    else:
+        supports.append(Dirichlet("cylinder_top", lambda t: (0.0, -value * t)))
+    return Scene.from_mesh_data(
+        mesh,
+        bodies=[Body("cylinder", steel), Body("block", steel)],
+        contacts=[ContactPair("cylinder_contact", "block_contact")],
+        dirichlet=supports,
+        loads=loads,
+    )
+
+
+def patch_3d_pressed(
+    pressure: float,
+    gap: float,
+    cell: str = "tetrahedron",
+    quadrature_degree: int = 2,
+    subdivisions: int = 4,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """The 3D contact patch test of :func:`patch` in steel, from a ``gap``: the upper block
+    is held in the pressing direction only by the contact and pushed by the dead
+    ``pressure``; the default augmentation parameter (``eps_N = None``)."""
+    scene = patch(
+        3,
+        pressure,
+        E=E_STEEL,
+        quadrature_degree=quadrature_degree,
+        subdivisions=subdivisions,
+        cell=cell,
+        gap=gap,
+        comm=comm,
+    )
+    scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=None)
+    return scene
+
+
 def curved_pair(
     dim: int, comm: MPI.Comm = MPI.COMM_WORLD, E: float = 1.0, nu: float = 0.3, eps_N: float = 10.0
 ) -> Scene:

@@ -1,0 +1,229 @@
+"""The hard-case suite (issue 13, item 7): runs that test the numerical stability of the
+solver, each reported by its steps, cut-backs, Newton iterations and, where a step failed,
+why (the SNES reasons of the failed tries; at the failed state the inverted elements, the
+contact points in contact and those whose status differs from the last accepted step).
+
+:func:`cases` lists the cases (quick or full), :func:`run_case` runs one and returns its
+record (a ``dict`` ready for JSON); ``benchmarks/hard_cases.py`` runs them all.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from mpi4py import MPI
+
+from contact_ufl.errors import ConvergenceError
+from contact_ufl.problem import ContactProblem
+from contact_ufl.results import inverted_cells
+from contact_ufl.verification import scenes
+
+FORCE_2D = 8e7
+"""Resultant of the dead traction on the force-driven Hertz half disc (N per unit
+thickness; a contact half-width of about 0.07)."""
+
+NOT_IMPLEMENTED = {
+    "3d_large_sliding": "3D ironing (Puso & Laursen 2004), mu = 0 and 0.3 (issue 13, item 2)",
+    "self_contact": "a ring squeezed until its inner surface closes (issue 13, item 3)",
+    "limit_point": "path following past a snap-through (issue 13, item 4)",
+    "deep_indentation_3d": "the 3D Hertz sphere pressed to half its radius (issue 13, item 6)",
+}
+"""Planned cases that do not exist yet, reported as ``"not implemented"``."""
+
+
+@dataclass
+class Case:
+    """One hard case.
+
+    Attributes
+    ----------
+    name
+        Name in the report.
+    build
+        Makes the problem (not yet solved).
+    stages
+        Load stepping: ``(num_steps, t_end)`` of each call of :meth:`ContactProblem.solve`.
+    max_cutbacks
+        Cut-backs of one step before the run stops.
+    """
+
+    name: str
+    build: Callable[[], ContactProblem]
+    stages: list[tuple[int, float]]
+    max_cutbacks: int = 8
+
+
+def _ironing(mu: float, h_punch: float, h_block: float) -> Callable[[], ContactProblem]:
+    """The problem of :func:`contact_ufl.verification.runs.ironing_run`."""
+
+    def build() -> ContactProblem:
+        scene = scenes.ironing(mu=mu, h_punch=h_punch, h_block=h_block)
+        return ContactProblem(scene, verbose=False, petsc_options={"snes_max_it": 40})
+
+    return build
+
+
+def _problem(make_scene: Callable[[], object]) -> Callable[[], ContactProblem]:
+    def build() -> ContactProblem:
+        scene = make_scene()
+        return ContactProblem(getattr(scene, "scene", scene), verbose=False)
+
+    return build
+
+
+def force_driven_2d(steps: int = 2) -> Case:
+    """The Hertz half disc pushed by a dead traction onto the block (steel)."""
+    return Case(
+        "force_driven_2d",
+        _problem(lambda: scenes.hertz_2d_driven("force", FORCE_2D)),
+        [(steps, 1.0)],
+    )
+
+
+def deep_indentation(h_contact: float = 0.02, steps: int = 10, max_cutbacks: int = 8) -> Case:
+    """The 2D Hertz half disc pressed down by half its radius."""
+    return Case(
+        f"deep_indentation_h{h_contact:g}",
+        _problem(lambda: scenes.hertz_2d(h_contact=h_contact, depth=0.5)),
+        [(steps, 1.0)],
+        max_cutbacks,
+    )
+
+
+def cases(quick: bool = False) -> list[Case]:
+    """The hard cases that exist today (``quick``: the ironing on coarse meshes, with
+    larger sliding steps, and the deep indentation on the coarser mesh only)."""
+    ironing_mesh = (0.05, 0.2, 100) if quick else (0.025, 0.1, 200)
+    out = [
+        Case(
+            f"ironing_2d_mu{mu:g}",
+            _ironing(mu, *ironing_mesh[:2]),
+            [(20, 1.0), (ironing_mesh[2], 2.0)],
+        )
+        for mu in (0.0, 0.3)
+    ]
+    out += [
+        Case(
+            f"beams_mu{mu:g}",
+            _problem(lambda mu=mu: scenes.beams(mu=mu, divisions=3, load=6.0)),
+            [(20, 1.0)],
+        )
+        for mu in (0.0, 0.3)
+    ]
+    out.append(force_driven_2d())
+    out.append(
+        Case(
+            "force_driven_patch_3d",
+            _problem(lambda: scenes.patch_3d_pressed(1e-4 * scenes.E_STEEL, gap=1e-3)),
+            [(2, 1.0)],
+        )
+    )
+    out.append(deep_indentation(0.02, 10))
+    if not quick:
+        out.append(deep_indentation(0.01, 20))
+    return out
+
+
+class _FailureObserver:
+    """Records the failed tries of a problem's Newton solver: pseudo-times, SNES reason,
+    iterations, inverted cells, points in contact and points whose contact status differs
+    from the last accepted step, at the failed state: the last iterate of the solver's last
+    try (with the backtracking line search where the full-step Newton failed), which the
+    solver leaves in the fields until the stepper restores the step's start.
+
+    Wraps the solver's ``solve_step``; :meth:`accepted` is the stepping callback that keeps
+    the contact status of the accepted steps.
+    """
+
+    def __init__(self, problem: ContactProblem):
+        self.problem = problem
+        self.failures: list[dict] = []
+        self._accepted_active: list | None = None
+        self._solve_step = problem.solver.solve_step
+        problem.solver.solve_step = self._observed
+
+    def accepted(self, problem: ContactProblem, record: object) -> None:
+        self._accepted_active = [c.active().copy() for c in problem.contacts]
+
+    def _status_changes(self) -> int | None:
+        """Points (all ranks) whose contact status differs from the last accepted step
+        (``None`` before the first accepted step)."""
+        if self._accepted_active is None:
+            return None
+        contacts = self.problem.contacts
+        changed = sum(
+            int((c.active() != a).sum())
+            for c, a in zip(contacts, self._accepted_active, strict=True)
+        )
+        return self.problem.comm.allreduce(changed)
+
+    def _observed(self, t: float) -> tuple[bool, int, str]:
+        problem = self.problem
+        t_start = problem.t
+        ok, its, reason = self._solve_step(t)
+        if not ok:
+            self.failures.append(
+                {
+                    "from_time": t_start,
+                    "time": t,
+                    "reason": reason,
+                    "newton_iterations": its,
+                    "inverted_cells": inverted_cells(problem),
+                    "active_points": problem.active_points(),
+                    "status_changes": self._status_changes(),
+                }
+            )
+        return ok, its, reason
+
+
+def run_case(case: Case) -> dict:
+    """Run one case; a run stopped by :class:`ConvergenceError` is recorded, not raised.
+
+    Returns
+    -------
+    dict
+        ``name``, ``status`` (``"completed"`` or ``"stopped"``), ``t_end``, ``t_reached``,
+        ``steps``, ``cutbacks``, ``newton_max``, ``newton_mean`` (per accepted step),
+        ``all_converged`` (the run completed and every accepted step has a ``CONVERGED_*``
+        SNES reason), ``step_reasons`` (the distinct reasons of the accepted steps),
+        ``failures`` (one record per failed try: ``from_time``, ``time``, ``reason``,
+        ``newton_iterations``, ``inverted_cells``, ``active_points``, ``status_changes``:
+        the points whose contact status differs from the last accepted step), ``error`` (the
+        message of the :class:`ConvergenceError`, or ``None``), ``unknowns``, ``wall_s``.
+    """
+    start = time.perf_counter()
+    problem = case.build()
+    observer = _FailureObserver(problem)
+    error = None
+    try:
+        for num_steps, t_end in case.stages:
+            problem.solve(
+                num_steps=num_steps,
+                t_end=t_end,
+                max_cutbacks=case.max_cutbacks,
+                callback=observer.accepted,
+            )
+    except ConvergenceError as e:
+        error = str(e)
+    wall = problem.comm.allreduce(time.perf_counter() - start, op=MPI.MAX)
+    history = problem.history
+    its = [r.newton_iterations for r in history.steps]
+    reasons = [r.reason for r in history.steps]
+    return {
+        "name": case.name,
+        "status": "stopped" if error else "completed",
+        "t_end": case.stages[-1][1],
+        "t_reached": float(problem.t),
+        "steps": len(history.steps),
+        "cutbacks": len(history.cutbacks),
+        "newton_max": max(its, default=0),
+        "newton_mean": sum(its) / len(its) if its else 0.0,
+        "all_converged": error is None and all(r.startswith("CONVERGED") for r in reasons),
+        "step_reasons": sorted(set(reasons)),
+        "failures": observer.failures,
+        "error": error,
+        "unknowns": problem.layout.global_size,
+        "wall_s": wall,
+    }
