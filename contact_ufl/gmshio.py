@@ -188,33 +188,16 @@ def read_gmsh(
     is_file = comm.bcast(
         isinstance(source, str | os.PathLike) if comm.rank == rank else None, root=rank
     )
+    mine = comm.rank == rank
+
+    def distribute(model: Any, origin: str) -> MeshData:
+        return _distribute(model, comm, rank, gdim, ghost_mode, require_names, tdim, origin)
+
     if not is_file:
-        return _distribute(
-            source if comm.rank == rank else None,
-            comm,
-            rank,
-            gdim,
-            ghost_mode,
-            require_names,
-            tdim,
-            "the gmsh model",
-        )
-    origin = f"mesh file '{source}'" if comm.rank == rank else ""
+        return distribute(source if mine else None, "the gmsh model")
     with _session_on(comm, rank, "msh"):
-        error = None
-        if comm.rank == rank:
-            error = _merge(Path(source))
-        _raise_from(comm, rank, error)
-        return _distribute(
-            gmsh.model if comm.rank == rank else None,
-            comm,
-            rank,
-            gdim,
-            ghost_mode,
-            require_names,
-            tdim,
-            origin,
-        )
+        _raise_from(comm, rank, _merge(Path(source)) if mine else None)
+        return distribute(gmsh.model if mine else None, f"mesh file '{source}'" if mine else "")
 
 
 def _merge(path: Path) -> str | None:

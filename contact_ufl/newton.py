@@ -430,8 +430,7 @@ class NewtonSolver:
     def _closing_iterate(self, pairs: list) -> None:
         """One Newton iterate from :attr:`x` in which the open points of ``pairs`` near the
         master surface count as in contact (see :meth:`solve_step`)."""
-        self._state = None
-        self._set_state(self.x)
+        self._set_state(self.x)  # the search of :meth:`_open_pairs` at x, if still current
         for c in pairs:
             nearest = self.comm.allreduce(c.normal.nearest_open_gap(c.projection), MPI.MIN)
             if np.isfinite(nearest):
