@@ -20,9 +20,13 @@ A scene is read from a gmsh mesh with named physical groups, and solved::
     problem.solve(num_steps=4)
     print(problem.contact_force())
 
-The parts, as modules: :mod:`.scene` (bodies, supports, loads, pairs), :mod:`.gmshio`
-(meshes from gmsh), :mod:`.materials`, :mod:`.plasticity`, :mod:`.loads`, :mod:`.contact`
-(the contact pair as composed parts), :mod:`.problem` (fields and forms), :mod:`.newton`
+Bodies on meshes of their own are :class:`Domain` s of one scene
+(``Scene(domains=[...], contacts=[...])``), each with its own displacement field.
+
+The parts, as modules: :mod:`.scene` (bodies, domains, supports, loads, pairs),
+:mod:`.gmshio` (meshes from gmsh), :mod:`.materials`, :mod:`.plasticity`, :mod:`.loads`,
+:mod:`.contact` (the contact pair as composed parts), :mod:`.bulk` (the displacement and bulk
+weak form of one mesh), :mod:`.problem` (fields and forms), :mod:`.newton`
 (the SNES solver), :mod:`.stepping` (load stepping), :mod:`.results`, :mod:`.output`,
 :mod:`.taylor`. Verification scenes and references live in :mod:`.verification`, which the
 library never imports.
@@ -41,7 +45,7 @@ from contact_ufl.newton import NewtonSolver, NewtonTimings
 from contact_ufl.output import ResultWriter
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.problem import ContactProblem
-from contact_ufl.scene import Body, Scene
+from contact_ufl.scene import Body, Domain, Scene
 from contact_ufl.stepping import History, LoadStepper, StepRecord
 from contact_ufl.taylor import taylor_test
 
@@ -56,6 +60,7 @@ __all__ = [
     "ConvergenceError",
     "DeadTraction",
     "Dirichlet",
+    "Domain",
     "FollowerForce",
     "FollowerPressure",
     "History",

@@ -212,7 +212,7 @@ class NewtonSolver:
     def _default_atol(self) -> float:
         """A force scale: 1e-11 of ``E_max L^(d-1)`` with L the scene's diameter."""
         size, E = self.problem.scales()
-        return 1e-11 * E * size ** (self.problem.V.mesh.geometry.dim - 1)
+        return 1e-11 * E * size ** (self.problem.gdim - 1)
 
     # -- state, search and the chain operator -----------------------------------------
     def _set_state(self, x: PETSc.Vec) -> None:
@@ -299,7 +299,7 @@ class NewtonSolver:
         self.assemble(problem.residual_form, F)
         rows = problem.dirichlet_rows
         if len(rows):
-            u = problem.u.x.array[rows]
+            u = x.array_r[rows]
             F.array[rows] = problem.dirichlet_scale * (u - problem.prescribed(problem.t))
         end = time.perf_counter()
         self.timings.residual_assembly += end - assembly
@@ -346,7 +346,8 @@ class NewtonSolver:
 
     def _zero_dirichlet_rows(self, J: PETSc.Mat) -> None:
         problem = self.problem
-        rows = problem.layout.owned(0, problem.dirichlet_rows).astype(PETSc.IntType)
+        layout = problem.layout
+        rows = (layout.rank_offsets[layout.rank] + problem.dirichlet_rows).astype(PETSc.IntType)
         J.zeroRows(rows, diag=problem.dirichlet_scale)
 
     def _jacobian(self, snes, x, J, P) -> None:

@@ -31,9 +31,10 @@ class ResultWriter:
     problem
         The contact problem.
     folder
-        Output folder; ``displacement.bp``, ``contact_<k>.bp`` (the multipliers of pair
-        ``k``) and, for each elastoplastic body, ``plastic_strain_<tag>.bp`` (the cell means
-        of its equivalent plastic strain) are written there.
+        Output folder; ``displacement.bp`` (with several meshes ``displacement_<k>.bp``, one
+        per mesh ``k``), ``contact_<k>.bp`` (the multipliers of pair ``k``) and, for each
+        elastoplastic body, ``plastic_strain_<tag>.bp`` (the cell means of its equivalent
+        plastic strain) are written there.
     """
 
     def __init__(self, problem, folder: str | Path):
@@ -42,12 +43,21 @@ class ResultWriter:
             folder.mkdir(parents=True, exist_ok=True)
         problem.comm.barrier()
         comm = problem.comm
-        self.writers = [dolfinx.io.VTXWriter(comm, folder / "displacement.bp", [problem.u])]
+        bulks = problem.bulks
+        names = (
+            ["displacement"]
+            if len(bulks) == 1
+            else [f"displacement_{k}" for k in range(len(bulks))]
+        )
+        self.writers = [
+            dolfinx.io.VTXWriter(comm, folder / f"{name}.bp", [b.u])
+            for name, b in zip(names, bulks, strict=True)
+        ]
         for k, c in enumerate(problem.contacts):
             multipliers = [c.lambda_N] + ([c.friction.lambda_T] if c.friction else [])
             self.writers.append(dolfinx.io.VTXWriter(comm, folder / f"contact_{k}.bp", multipliers))
-        self.histories = list(problem.histories.values())
-        for tag, h in problem.histories.items():
+        self.histories = [h for b in bulks for h in b.histories.values()]
+        for tag, h in ((tag, h) for b in bulks for tag, h in b.histories.items()):
             path = folder / f"plastic_strain_{tag}.bp"
             self.writers.append(dolfinx.io.VTXWriter(comm, path, [h.plastic_strain]))
 
@@ -78,48 +88,65 @@ def _pyvista():
 def gathered_grid(
     problem, deformed: bool = True, cell_data: dict[str, dolfinx.fem.Function] | None = None
 ) -> pyvista.UnstructuredGrid | None:
-    """The mesh of all ranks as one pyvista grid on rank 0 (``None`` on the other ranks).
+    """The meshes of all ranks as one pyvista grid on rank 0 (``None`` on the other ranks).
 
-    Each rank contributes its owned cells; the point data hold the displacement, and the
-    cell data ``"body"`` the cell tag of each cell, plus the cellwise (DG0) functions of
-    ``cell_data`` under their keys. With ``deformed`` the grid is warped by the displacement.
+    Each rank contributes the owned cells of every mesh; the point data hold the
+    displacement, and the cell data ``"body"`` the cell tag of each cell, plus the cellwise
+    (DG0) functions of ``cell_data`` under their keys (NaN on the cells of other meshes).
+    With ``deformed`` the grid is warped by the displacement.
     """
     pv = _pyvista()
-    V = problem.V
+    mine = [_owned_cells(b, cell_data or {}) for b in problem.bulks]
+    local = (
+        [part[0] for part in mine],
+        *(np.concatenate([p[i] for p in mine]) for i in range(1, 5)),
+        {name: np.concatenate([p[5][name] for p in mine]) for name in cell_data or {}},
+    )
+    parts = problem.comm.gather(local, root=0)
+    if problem.comm.rank != 0:
+        return None
+    offset, all_cells = 0, []
+    for blocks, *_ in parts:
+        for block, count in blocks:  # one block of cells of one mesh on one rank
+            shifted = block.copy()
+            shifted[:, 1:] += offset
+            all_cells.append(shifted.ravel())
+            offset += count
+    grid = pv.UnstructuredGrid(
+        np.concatenate(all_cells),
+        np.concatenate([p[1] for p in parts]),
+        np.concatenate([p[2] for p in parts]),
+    )
+    grid.point_data["displacement"] = np.concatenate([p[3] for p in parts])
+    grid.cell_data["body"] = np.concatenate([p[4] for p in parts])
+    for name in cell_data or {}:
+        grid.cell_data[name] = np.concatenate([p[5][name] for p in parts])
+    return grid.warp_by_vector("displacement") if deformed else grid
+
+
+def _owned_cells(bulk, cell_data: dict[str, dolfinx.fem.Function]) -> tuple:
+    """The owned cells of the mesh of ``bulk`` as VTK arrays: the cells ``(n, 1 + nv)``
+    (count first) with the number of points, the cell types, points, displacement
+    ``(npts, 3)``, body tags and cell data."""
+    V = bulk.V
     mesh = V.mesh
     tdim, gdim = mesh.topology.dim, mesh.geometry.dim
     topology, cell_types, x = dolfinx.plot.vtk_mesh(V)
     owned = mesh.topology.index_map(tdim).size_local
     cells = topology.reshape(len(cell_types), -1)[:owned]
     u = np.zeros((x.shape[0], 3))
-    u[:, :gdim] = problem.u.x.array.reshape(-1, gdim)[: x.shape[0]]
+    u[:, :gdim] = bulk.u.x.array.reshape(-1, gdim)[: x.shape[0]]
     body = np.zeros(owned, dtype=np.int32)
-    tags = problem.scene.cell_tags
+    tags = bulk.domain.cell_tags
     local = tags.indices < owned
     body[tags.indices[local]] = tags.values[local]
     fields = {
         name: f.x.array[f.function_space.dofmap.list[:owned, 0]]
-        for name, f in (cell_data or {}).items()
+        if f.function_space.mesh is mesh
+        else np.full(owned, np.nan)
+        for name, f in cell_data.items()
     }
-    parts = problem.comm.gather((cells, cell_types[:owned], x, u, body, fields), root=0)
-    if problem.comm.rank != 0:
-        return None
-    offset, all_cells = 0, []
-    for c, _, xx, *_ in parts:
-        shifted = c.copy()
-        shifted[:, 1:] += offset
-        all_cells.append(shifted)
-        offset += len(xx)
-    grid = pv.UnstructuredGrid(
-        np.concatenate(all_cells).ravel(),
-        np.concatenate([p[1] for p in parts]),
-        np.concatenate([p[2] for p in parts]),
-    )
-    grid.point_data["displacement"] = np.concatenate([p[3] for p in parts])
-    grid.cell_data["body"] = np.concatenate([p[4] for p in parts])
-    for name in fields:
-        grid.cell_data[name] = np.concatenate([p[5][name] for p in parts])
-    return grid.warp_by_vector("displacement") if deformed else grid
+    return (cells, len(x)), cell_types[:owned], x, u, body, fields
 
 
 _DIRECTIONS = {"iso": (0.7, -1.0, 0.6), "xz": (0.0, -1.0, 0.0), "xy": (0.0, 0.0, 1.0)}
@@ -229,7 +256,7 @@ def gathered_contact_surface(problem, pair: int = 0) -> pyvista.PolyData | None:
     gdim = c.gdim
     n = c.slave.X.shape[0] * c.slave.X.shape[1]
     x, t = np.zeros((n, 3)), np.zeros((n, 3))
-    x[:, :gdim] = c.slave.positions(problem.u).reshape(-1, gdim)
+    x[:, :gdim] = c.slave.positions(c.u).reshape(-1, gdim)
     t_N = c.normal_traction_at_points()
     t[:, :gdim] = c.traction_at_points()
     t_T = t.copy()
@@ -403,7 +430,7 @@ def plot_deformed(
         cmap="viridis",
         scalar_bar_args={"title": label},
     )
-    if problem.V.mesh.geometry.dim == 2:
+    if problem.gdim == 2:
         plotter.view_xy()
     if focus is not None:
         plotter.set_focus(focus)

@@ -12,7 +12,7 @@ convenience), and the results that need the chain rule (:meth:`ContactProblem.re
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import dolfinx
@@ -21,34 +21,38 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from contact_ufl.bulk import Bulk
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.layout import StackedLayout
-from contact_ufl.loads import BodyForce, deformation_gradient, evaluate, load_constant
 from contact_ufl.mpi import global_bounds
-from contact_ufl.plasticity import J2Plasticity, PlasticHistory
-from contact_ufl.scene import Scene
+from contact_ufl.scene import Domain, Scene
 
 if TYPE_CHECKING:
     from contact_ufl.newton import NewtonSolver
     from contact_ufl.stepping import History, LoadStepper, StepRecord
 
 
-def softer_modulus(scene: Scene, pair: ContactPair) -> float:
+def softer_modulus(parts: list[Domain], pair: ContactPair) -> float:
     """The smallest Young's modulus of the bodies whose cells hold the facets of ``pair``
-    (the slave body alone when the master is a rigid obstacle)."""
-    mesh = scene.mesh
-    tdim = mesh.topology.dim
-    mesh.topology.create_connectivity(tdim - 1, tdim)
-    f2c = mesh.topology.connectivity(tdim - 1, tdim)
-    sides = [pair.slave] if pair.on_obstacle else [pair.slave, pair.master]
-    facets = np.concatenate([scene.facet_tags.find(tag) for tag in sides])
-    cells = f2c.array[f2c.offsets[facets]]
-    num_cells = mesh.topology.index_map(tdim).size_local + mesh.topology.index_map(tdim).num_ghosts
-    cell_tag = np.full(num_cells, -1, dtype=np.int64)
-    cell_tag[scene.cell_tags.indices] = scene.cell_tags.values
-    found = mesh.comm.allreduce(set(cell_tag[cells].tolist()), MPI.BOR)
-    moduli = [b.material.E for b in scene.bodies if b.tag in found]
+    (the slave body alone when the master is a rigid obstacle); ``parts`` are the scene's
+    domains, indexed by the pair's ``slave_domain`` and ``master_domain``."""
+    sides = [(pair.slave_domain, pair.slave)]
+    if not pair.on_obstacle:
+        sides.append((pair.master_domain, pair.master))
+    moduli = []
+    for k, tag in sides:
+        domain = parts[k or 0]
+        mesh = domain.mesh
+        tdim = mesh.topology.dim
+        mesh.topology.create_connectivity(tdim - 1, tdim)
+        f2c = mesh.topology.connectivity(tdim - 1, tdim)
+        cells = f2c.array[f2c.offsets[domain.facet_tags.find(tag)]]
+        imap = mesh.topology.index_map(tdim)
+        cell_tag = np.full(imap.size_local + imap.num_ghosts, -1, dtype=np.int64)
+        cell_tag[domain.cell_tags.indices] = domain.cell_tags.values
+        found = mesh.comm.allreduce(set(cell_tag[cells].tolist()), MPI.BOR)
+        moduli += [b.material.E for b in domain.bodies if b.tag in found]
     return min(moduli) if moduli else float("nan")
 
 
@@ -60,9 +64,10 @@ def _nonempty(form: ufl.Form) -> ufl.Form | None:
 class ContactProblem:
     """Quasi-static large-deformation contact of the bodies of a scene.
 
-    The problem holds the displacement, the contact interfaces and plastic histories, the
-    residual and Jacobian forms over the assembled fields, the Dirichlet rows and the load
-    constants of the pseudo-time. It is solved by a
+    The problem holds one :class:`~contact_ufl.bulk.Bulk` per mesh (its displacement,
+    bodies, loads, plastic histories and supports), the contact interfaces between them, the
+    residual and Jacobian forms over the assembled fields, the Dirichlet rows and the
+    pseudo-time. It is solved by a
     :class:`~contact_ufl.newton.NewtonSolver` (:attr:`solver`) stepped by a
     :class:`~contact_ufl.stepping.LoadStepper` (:attr:`stepper`), both made on first use::
 
@@ -72,7 +77,7 @@ class ContactProblem:
     Parameters
     ----------
     scene
-        Mesh, bodies, supports, loads and contact pairs.
+        Meshes, bodies, supports, loads and contact pairs.
     degree
         Polynomial degree of the displacement.
     quadrature_degree
@@ -88,25 +93,26 @@ class ContactProblem:
 
     Attributes
     ----------
-    u
-        The displacement.
+    bulks
+        The bulk of each mesh, in the order of :attr:`Scene.parts
+        <contact_ufl.scene.Scene.parts>`.
+    u, V, dx, ds, histories
+        Those of the one mesh of a one-mesh problem (``bulks[k].u`` etc. for mesh ``k``).
     t
         The pseudo-time (load factor) of loads and prescribed displacements.
     contacts
         The contact interfaces, one per contact pair of the scene.
-    histories
-        The :class:`~contact_ufl.plasticity.PlasticHistory` of each elastoplastic body, by
-        cell tag.
     fields, unknowns
-        The assembled fields ``[u, xhat_1, lambda_1, ...]`` and the unknowns
-        ``[u, lambda_1, ...]``.
+        The assembled fields ``[u_1, ..., u_m, xhat_1, lambda_1, ...]`` and the unknowns
+        ``[u_1, ..., u_m, lambda_1, ...]`` (one displacement per mesh).
     layout, full_layout
         Numbering of the unknowns and of the assembled fields.
     residual_form, jacobian_form
         The compiled blocked residual (rows: ``fields``) and Jacobian (``fields`` x
         ``fields``).
     dirichlet_rows
-        Local (owned) indices of the prescribed displacement dofs (unrolled).
+        Local (owned) indices of the prescribed displacement dofs (unrolled) in a vector of
+        the unknowns.
     dirichlet_scale
         The stiffness ``k = E L^(d-2)`` of the prescribed-displacement equations
         ``k (u - g) = 0`` (every row of the residual is then a force).
@@ -123,66 +129,95 @@ class ContactProblem:
     ):
         scene.validate()
         self.scene = scene
-        mesh = scene.mesh
-        self.comm = mesh.comm
+        parts = scene.parts
+        self.comm = parts[0].mesh.comm
+        self.gdim = parts[0].mesh.geometry.dim
         self.verbose = verbose
         self.petsc_options = dict(petsc_options or {})
         self.petsc_options_prefix = petsc_options_prefix
-        gdim = mesh.geometry.dim
-        self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (gdim,)))
-        self.u = dolfinx.fem.Function(self.V, name="displacement")
-        simplex = mesh.topology.cell_type in (
-            dolfinx.mesh.CellType.triangle,
-            dolfinx.mesh.CellType.tetrahedron,
-        )
-        qdeg = quadrature_degree or (2 * degree - 1 if simplex else 2 * degree)
-        self.dx = ufl.Measure(
-            "dx", domain=mesh, subdomain_data=scene.cell_tags, metadata={"quadrature_degree": qdeg}
-        )
-        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=scene.facet_tags)
         self.t = 0.0
-        self._energy_form = None
-        #: history of the elastoplastic bodies, by cell tag (moved on each converged step)
-        self.histories = {
-            b.tag: PlasticHistory(b.material, self.u, qdeg, scene.cell_tags.find(b.tag))
-            for b in scene.bodies
-            if isinstance(b.material, J2Plasticity)
-        }
-        self.contacts = [
-            ContactInterface(self.u, scene.facet_tags, p, softer_modulus(scene, p))
-            for p in scene.contacts
-        ]
+        #: the bulk of each mesh (its displacement, bodies and loads), in the order of
+        #: :attr:`Scene.parts <contact_ufl.scene.Scene.parts>`
+        self.bulks = [Bulk(d, degree, quadrature_degree) for d in parts]
+        self.contacts = [self._interface(p, parts) for p in scene.contacts]
         self._build_forms()
         self._build_dirichlet()
         self._solver: NewtonSolver | None = None
         self._stepper: LoadStepper | None = None
 
-    # -- forms ------------------------------------------------------------------------
-    def first_piola(self, body) -> ufl.core.expr.Expr:
-        """First Piola-Kirchhoff stress of ``body`` at the current displacement (and, for an
-        elastoplastic body, the history of the last converged step)."""
-        if body.tag in self.histories:
-            return self.histories[body.tag].first_piola()
-        return body.material.first_piola(deformation_gradient(self.u))
-
-    def _build_forms(self) -> None:
-        u, v = self.u, ufl.TestFunction(self.V)
-        F_u = sum(
-            ufl.inner(self.first_piola(b), ufl.grad(v)) * self.dx(b.tag) for b in self.scene.bodies
+    def _interface(self, pair: ContactPair, parts: list) -> ContactInterface:
+        """The contact interface of ``pair`` between the bulks that hold its surfaces."""
+        slave = self.bulks[pair.slave_domain]
+        master = self.bulks[pair.master_domain] if not pair.on_obstacle else slave
+        return ContactInterface(
+            slave.u,
+            slave.domain.facet_tags,
+            pair,
+            softer_modulus(parts, pair),
+            master_u=master.u,
+            master_facet_tags=master.domain.facet_tags,
+            master_block=self.bulks.index(master),
         )
-        self._load_constants = []
-        for load in self.scene.loads:
-            c = load_constant(self.V.mesh, load)
-            self._load_constants.append((load, c))
-            measure = self.dx if isinstance(load, BodyForce) else self.ds
-            F_u -= load.virtual_work(u, v, measure, c)
-        residuals = [F_u]
-        contact_residuals = [0]
-        fields, unknowns = [u], [u]
+
+    # -- one mesh: the attributes of a one-mesh problem ----------------------------------
+    def _single(self) -> Bulk:
+        if len(self.bulks) != 1:
+            raise AttributeError(
+                f"this problem has {len(self.bulks)} meshes: use problem.bulks[k] for mesh k"
+            )
+        return self.bulks[0]
+
+    @property
+    def u(self) -> dolfinx.fem.Function:
+        """The displacement (a one-mesh problem; :attr:`bulks` ``[k].u`` for mesh k)."""
+        return self._single().u
+
+    @property
+    def V(self) -> dolfinx.fem.FunctionSpace:
+        """The displacement space (a one-mesh problem)."""
+        return self._single().V
+
+    @property
+    def dx(self) -> ufl.Measure:
+        """The cell measure (a one-mesh problem)."""
+        return self._single().dx
+
+    @property
+    def ds(self) -> ufl.Measure:
+        """The exterior-facet measure (a one-mesh problem)."""
+        return self._single().ds
+
+    @property
+    def histories(self) -> dict:
+        """The plastic histories by cell tag (a one-mesh problem)."""
+        return self._single().histories
+
+    def first_piola(self, body) -> ufl.core.expr.Expr:
+        """First Piola-Kirchhoff stress of ``body`` (a one-mesh problem; see
+        :meth:`Bulk.first_piola <contact_ufl.bulk.Bulk.first_piola>`)."""
+        return self._single().first_piola(body)
+
+    def locate(self, tag: int | str, kind: str = "facet") -> tuple[Bulk, int]:
+        """The bulk whose mesh holds the facets (or cells) ``tag``, and the integer tag."""
+        k, tag = self.scene.locate(tag, kind)
+        return self.bulks[k], tag
+
+    def bulk_of(self, contact: ContactInterface, side: str = "slave") -> Bulk:
+        """The bulk that holds the ``side`` surface of ``contact``."""
+        return self.bulks[getattr(contact.pair, f"{side}_domain")]
+
+    # -- forms ------------------------------------------------------------------------
+    def _build_forms(self) -> None:
+        tests = [ufl.TestFunction(b.V) for b in self.bulks]
+        residuals = [b.residual(v) for b, v in zip(self.bulks, tests, strict=True)]
+        contact_residuals: list = [0] * len(self.bulks)
+        fields = [b.u for b in self.bulks]
+        unknowns = list(fields)
         for c in self.contacts:
-            Fu_c, F_fields = c.residuals(v)
-            residuals[0] = residuals[0] + Fu_c
-            contact_residuals[0] = contact_residuals[0] + Fu_c
+            k = c.pair.slave_domain
+            Fu_c, F_fields = c.residuals(tests[k])
+            residuals[k] = residuals[k] + Fu_c
+            contact_residuals[k] = contact_residuals[k] + Fu_c
             residuals += F_fields
             contact_residuals += F_fields
             fields += c.fields
@@ -194,62 +229,58 @@ class ContactProblem:
         ]
         entity_maps = [c.slave.entity_map for c in self.contacts]
         self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
-        self._contact_residual_ufl = contact_residuals
+        zero = [  # an empty block of the blocked form: a zero form over its mesh
+            dolfinx.fem.Constant(b.V.mesh, 0.0) * v[0] * b.dx
+            for b, v in zip(self.bulks, tests, strict=True)
+        ]
+        self._contact_residual_ufl = [
+            r if r != 0 else zero[k] if k < len(zero) else r
+            for k, r in enumerate(contact_residuals)
+        ]
         self._contact_residual_form = None
-        self._load_resultant_forms = None
         self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
         self.full_layout = StackedLayout([f.function_space for f in fields])
         self.layout = StackedLayout([f.function_space for f in unknowns])
 
     def _build_dirichlet(self) -> None:
-        mesh, fdim = self.V.mesh, self.V.mesh.topology.dim - 1
-        gdim = mesh.geometry.dim
-        self._bc_dofs, self._bc_values = [], []
-        owned = self.V.dofmap.index_map.size_local * gdim
-        for bc in self.scene.dirichlet:
-            facets = self.scene.facet_tags.find(bc.tag)
-            comps = range(gdim) if bc.component is None else [bc.component]
-            for i in comps:
-                blocks = dolfinx.fem.locate_dofs_topological(self.V.sub(i), fdim, facets)
-                dofs = blocks[blocks < owned]
-                self._bc_dofs.append(dofs)
-                self._bc_values.append((bc, i))
         # prescribed-displacement equations k (u - g) = 0 are scaled by a stiffness k = E L^(d-2)
         # so that every row of the residual is a force (one absolute tolerance for all)
         size, E = self.scales()
-        self.dirichlet_scale = E * size ** (gdim - 2)
-        self.dirichlet_rows = (
-            np.concatenate(self._bc_dofs).astype(np.int64)
-            if self._bc_dofs
-            else np.zeros(0, np.int64)
-        )
+        self.dirichlet_scale = E * size ** (self.gdim - 2)
+        offsets = np.concatenate([[0], np.cumsum(self.layout.local_sizes)])
+        self.dirichlet_rows = np.concatenate(
+            [offsets[k] + b.dirichlet_dofs for k, b in enumerate(self.bulks)]
+        ).astype(np.int64)
+
+    def block_rows(self, k: int) -> slice:
+        """Local (owned) range of the displacement of mesh ``k`` in a vector of the
+        unknowns."""
+        offsets = np.concatenate([[0], np.cumsum(self.layout.local_sizes)])
+        return slice(int(offsets[k]), int(offsets[k + 1]))
 
     def prescribed(self, t: float) -> np.ndarray:
         """The prescribed displacements ``g(t)`` of the rows :attr:`dirichlet_rows`."""
-        values = []
-        for dofs, (bc, i) in zip(self._bc_dofs, self._bc_values, strict=True):
-            value = evaluate(bc.value, t)
-            value = value if bc.component is not None or value.ndim == 0 else value[i]
-            values.append(np.full(len(dofs), float(value)))
-        return np.concatenate(values) if values else np.zeros(0)
+        return np.concatenate([b.prescribed(t) for b in self.bulks])
 
     def scales(self) -> tuple[float, float]:
         """The scene's diameter L and largest Young's modulus E (collective)."""
-        lo, hi = global_bounds(self.comm, self.V.mesh.geometry.x)
-        return float(np.linalg.norm(hi - lo)), max(b.material.E for b in self.scene.bodies)
+        x = np.vstack([b.V.mesh.geometry.x for b in self.bulks])
+        lo, hi = global_bounds(self.comm, x)
+        E = max(body.material.E for b in self.bulks for body in b.bodies)
+        return float(np.linalg.norm(hi - lo)), E
 
     # -- pseudo-time and the step protocol ----------------------------------------------
     def set_time(self, t: float) -> None:
         """Set the pseudo-time (load factor) of loads, prescribed displacements and the
         motion of rigid obstacles."""
         self.t = t
-        for load, c in self._load_constants:
-            c.value = evaluate(load.value, t)
+        for b in self.bulks:
+            b.set_time(t)
         for c in self.contacts:
             c.set_time(t)
 
     def _parts_with_history(self) -> list:
-        return [*self.contacts, *self.histories.values()]
+        return [*self.contacts, *(h for b in self.bulks for h in b.histories.values())]
 
     def begin_step(self) -> None:
         """Begin a load step from the last committed state, in every part with history
@@ -312,21 +343,28 @@ class ContactProblem:
         return self.stepper.solve(num_steps, t_end, max_cutbacks, callback)
 
     # -- results --------------------------------------------------------------------
-    def reaction(self, tag: int | str) -> np.ndarray:
+    def reaction(
+        self, tag: int | str | Sequence[int | str], domain: int | str | None = None
+    ) -> np.ndarray:
         """Resultant of the support reaction on the facets ``tag`` (an integer or the name of
-        a physical group) at the current state.
+        a physical group, or several: their nodes counted once; in a scene of several
+        meshes, of the mesh ``domain`` or the one whose groups have that name) at the current
+        state.
 
         It is the residual of the displacement equations (internal minus external forces,
         contact included) summed over the dofs of those facets, without the equations that
         prescribe them (assembled by :attr:`solver`, which owns the chain rule).
         """
+        keys = [tag] if isinstance(tag, int | str) else list(tag)
+        nodes: dict[int, list[np.ndarray]] = {}
+        for key in keys:
+            k, t = self.scene.locate(key, "facet", domain)
+            nodes.setdefault(k, []).append(self.bulks[k].facet_dofs(t))
         R = self.solver.assemble(self.residual_form)
-        gdim = self.V.mesh.geometry.dim
-        owned = self.V.dofmap.index_map.size_local
-        facets = self.scene.facet_tags.find(self.scene.facet_tag(tag))
-        blocks = dolfinx.fem.locate_dofs_topological(self.V, gdim - 1, facets)
-        blocks = blocks[blocks < owned]
-        local = R.array[: owned * gdim].reshape(-1, gdim)[blocks].sum(axis=0)
+        local = np.zeros(self.gdim)
+        for k, blocks in nodes.items():
+            values = R.array[self.block_rows(k)].reshape(-1, self.gdim)
+            local += values[np.unique(np.concatenate(blocks))].sum(axis=0)
         return self.comm.allreduce(local, MPI.SUM)
 
     def obstacle_reaction(self, obstacle: RigidObstacle) -> np.ndarray:
@@ -344,28 +382,11 @@ class ContactProblem:
         pairs = [c for c in self.contacts if c.pair.on_obstacle and c.pair.master == obstacle]
         if not pairs:
             raise ValueError(f"no contact pair of this problem has the master {obstacle}")
-        return sum((c.integrate("traction") for c in pairs), np.zeros(self.V.mesh.geometry.dim))
+        return sum((c.integrate("traction") for c in pairs), np.zeros(self.gdim))
 
     def load_resultant(self) -> np.ndarray:
         """Resultant of all applied loads (dead and follower) at the current state."""
-        if self._load_resultant_forms is None:
-            mesh = self.V.mesh
-            gdim = mesh.geometry.dim
-            self._load_resultant_forms = []
-            for i in range(gdim):
-                e_i = dolfinx.fem.Constant(mesh, np.eye(gdim)[i])
-                work = sum(
-                    load.virtual_work(
-                        self.u, e_i, self.dx if isinstance(load, BodyForce) else self.ds, c
-                    )
-                    for load, c in self._load_constants
-                )
-                self._load_resultant_forms.append(dolfinx.fem.form(work) if work else None)
-        local = [
-            dolfinx.fem.assemble_scalar(f) if f is not None else 0.0
-            for f in self._load_resultant_forms
-        ]
-        return self.comm.allreduce(np.asarray(local, dtype=float), MPI.SUM)
+        return sum((b.load_resultant() for b in self.bulks), np.zeros(self.gdim))
 
     def contact_residual(self) -> PETSc.Vec:
         """The contact terms alone of the residual at the current state, as a vector of the
@@ -380,21 +401,18 @@ class ContactProblem:
         """Resultant contact force on the slave body, ``int (t_N nu - P(q)) dS_o`` (all pairs;
         the frictional part only with friction)."""
         pairs = self.contacts if k is None else [self.contacts[k]]
-        return sum((c.integrate("traction") for c in pairs), np.zeros(self.V.mesh.geometry.dim))
+        return sum((c.integrate("traction") for c in pairs), np.zeros(self.gdim))
 
     def stored_energy(self) -> float:
         """Elastic energy ``sum_b int psi_b(F) dV`` of all bodies (reference volume), for
         hyperelastic bodies (an elastoplastic one raises)."""
-        if self.histories:
+        plastic = sorted(tag for b in self.bulks for tag in b.histories)
+        if plastic:
             raise ValueError(
                 "stored_energy covers hyperelastic bodies only; this scene has "
-                f"elastoplastic bodies (cell tags {sorted(self.histories)})"
+                f"elastoplastic bodies (cell tags {plastic})"
             )
-        if self._energy_form is None:
-            F = deformation_gradient(self.u)
-            energy = sum(b.material.strain_energy(F) * self.dx(b.tag) for b in self.scene.bodies)
-            self._energy_form = dolfinx.fem.form(energy)
-        return self.comm.allreduce(dolfinx.fem.assemble_scalar(self._energy_form))
+        return sum(b.stored_energy() for b in self.bulks)
 
     def active_points(self) -> int:
         """Number of slave quadrature points in contact (all pairs)."""

@@ -39,9 +39,9 @@ def contact_samples(problem, pair: int = 0) -> ContactSamples:
     c = problem.contacts[pair]
     comm = problem.comm
     gdim = c.gdim
-    x = c.slave.positions(problem.u).reshape(-1, gdim)
+    x = c.slave.positions(c.u).reshape(-1, gdim)
     lam = c.multiplier_at_points()
-    ratio = c.slave.area_ratio(problem.u).ravel()
+    ratio = c.slave.area_ratio(c.u).ravel()
     gap = np.where(c.projection.facet >= 0, c.projection.gap, -np.inf)
 
     def gather(a):
@@ -55,12 +55,13 @@ def contact_samples(problem, pair: int = 0) -> ContactSamples:
 def slave_body(problem, pair: int = 0):
     """The body that owns the slave facets of contact pair ``pair``."""
     c = problem.contacts[pair]
-    tags = problem.scene.cell_tags
+    bulk = problem.bulk_of(c)
+    tags = bulk.domain.cell_tags
     order = np.argsort(tags.indices)
     pos = np.searchsorted(tags.indices, c.slave.parent_cells, sorter=order)
     local = set(tags.values[order[pos]].tolist()) if len(pos) else set()
     found = problem.comm.allreduce(local, MPI.BOR)
-    bodies = [b for b in problem.scene.bodies if b.tag in found]
+    bodies = [b for b in bulk.bodies if b.tag in found]
     if len(bodies) != 1:
         raise ValueError(f"slave facets of pair {pair} belong to {len(bodies)} bodies")
     return bodies[0]
@@ -71,13 +72,14 @@ def traction_mismatch(problem, pair: int = 0) -> float:
     contact traction of the multipliers ``lambda_N nu`` (property (c) of the formulation)."""
     c = problem.contacts[pair]
     body = slave_body(problem, pair)
-    if body.tag in problem.histories:
+    bulk = problem.bulk_of(c)
+    if body.tag in bulk.histories:
         # its stress lives at the cell quadrature points, not on the facets
         raise NotImplementedError(
             f"traction_mismatch needs a hyperelastic slave body; body {body.tag} is elastoplastic"
         )
-    Pi = problem.first_piola(body)
-    N = ufl.FacetNormal(problem.V.mesh)
+    Pi = bulk.first_piola(body)
+    N = ufl.FacetNormal(bulk.V.mesh)
     diff = Pi * N - c.lambda_N * c.kinematics.nu
     forms = [ufl.dot(diff, diff) * c.ds, c.lambda_N**2 * c.ds]
     values = [
@@ -94,18 +96,21 @@ def body_resultants(problem, vector) -> dict[int, np.ndarray]:
     """Sum of the displacement components of a vector over the dofs of each body.
 
     ``vector`` is a vector of the unknowns (for instance a residual); the result maps each
-    body's cell tag to its resultant ``(gdim,)``.
+    body's cell tag to its resultant ``(gdim,)`` (bodies of all meshes; their tags must then
+    differ).
     """
-    V = problem.V
-    bs = V.dofmap.index_map_bs
-    owned = V.dofmap.index_map.size_local
-    values = vector.array[: owned * bs].reshape(-1, bs)
     out = {}
-    for body in problem.scene.bodies:
-        blocks = np.unique(V.dofmap.list[problem.scene.cell_tags.find(body.tag)])
-        blocks = blocks[blocks < owned]
-        local = values[blocks].sum(axis=0) if len(blocks) else np.zeros(bs)
-        out[body.tag] = problem.comm.allreduce(local, MPI.SUM)
+    for k, bulk in enumerate(problem.bulks):
+        V = bulk.V
+        owned = V.dofmap.index_map.size_local
+        values = vector.array[problem.block_rows(k)].reshape(-1, problem.gdim)
+        for body in bulk.bodies:
+            if body.tag in out:
+                raise ValueError(f"two bodies have the cell tag {body.tag} (on two meshes)")
+            blocks = np.unique(V.dofmap.list[bulk.domain.cell_tags.find(body.tag)])
+            blocks = blocks[blocks < owned]
+            local = values[blocks].sum(axis=0) if len(blocks) else np.zeros(problem.gdim)
+            out[body.tag] = problem.comm.allreduce(local, MPI.SUM)
     return out
 
 
@@ -148,7 +153,7 @@ def stick_zone_half_width(problem, pair: int = 0) -> float:
     next slipping one on either side (the zone is taken along x).
     """
     c = problem.contacts[pair]
-    x = c.slave.positions(problem.u).reshape(-1, c.gdim)[:, 0]
+    x = c.slave.positions(c.u).reshape(-1, c.gdim)[:, 0]
     active = c.active()
     stick = c.friction.last_stick & active
     slip = ~c.friction.last_stick & active
@@ -166,13 +171,14 @@ def stick_zone_half_width(problem, pair: int = 0) -> float:
     return 0.5 * (right - left)
 
 
-def _facet_integral(problem, expr, tag: int) -> np.ndarray:
-    """``int_{tag} expr dS_o`` (a vector expression), summed over all ranks."""
+def _facet_integral(bulk, expr, tag: int) -> np.ndarray:
+    """``int_{tag} expr dS_o`` (a vector expression) over the mesh of ``bulk``, summed over
+    all ranks."""
     values = [
-        dolfinx.fem.assemble_scalar(dolfinx.fem.form(expr[i] * problem.ds(tag)))
+        dolfinx.fem.assemble_scalar(dolfinx.fem.form(expr[i] * bulk.ds(tag)))
         for i in range(expr.ufl_shape[0])
     ]
-    return problem.comm.allreduce(np.asarray(values), MPI.SUM)
+    return bulk.comm.allreduce(np.asarray(values), MPI.SUM)
 
 
 def contact_force_parts(problem, pair: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -227,11 +233,11 @@ def lowest_displacement(problem, tag: int | str, component: int = -1) -> float:
         The smallest value: e.g. the depth of an imprint is minus that of the indented
         surface.
     """
-    tag = problem.scene.facet_tag(tag)
-    mesh = problem.V.mesh
-    facets = problem.scene.facet_tags.find(tag)
-    dofs = dolfinx.fem.locate_dofs_topological(problem.V, mesh.topology.dim - 1, facets)
-    values = problem.u.x.array.reshape(-1, mesh.geometry.dim)[dofs, component]
+    bulk, tag = problem.locate(tag)
+    mesh = bulk.V.mesh
+    facets = bulk.domain.facet_tags.find(tag)
+    dofs = dolfinx.fem.locate_dofs_topological(bulk.V, mesh.topology.dim - 1, facets)
+    values = bulk.u.x.array.reshape(-1, mesh.geometry.dim)[dofs, component]
     return problem.comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
 
 
@@ -243,15 +249,15 @@ def section_motion(problem, tag: int | str) -> tuple[np.ndarray, np.ndarray]:
     the deformed area vector ``int J F^-T N dS_o`` (the section's rotation is the angle
     between ``n`` and the reference normal).
     """
-    tag = problem.scene.facet_tag(tag)
-    u = problem.u
-    mesh = problem.V.mesh
-    area = _facet_integral(problem, ufl.as_vector([dolfinx.fem.Constant(mesh, 1.0)]), tag)[0]
+    bulk, tag = problem.locate(tag)
+    u = bulk.u
+    mesh = bulk.V.mesh
+    area = _facet_integral(bulk, ufl.as_vector([dolfinx.fem.Constant(mesh, 1.0)]), tag)[0]
     if not area > 0.0:
         raise ValueError(f"facet tag {tag} has no facet")
     F = ufl.Identity(len(u)) + ufl.grad(u)
-    n = _facet_integral(problem, ufl.cofac(F) * ufl.FacetNormal(mesh), tag)
-    return _facet_integral(problem, u, tag) / area, n / np.linalg.norm(n)
+    n = _facet_integral(bulk, ufl.cofac(F) * ufl.FacetNormal(mesh), tag)
+    return _facet_integral(bulk, u, tag) / area, n / np.linalg.norm(n)
 
 
 def equilibrium_error(problem, supports: list[str | int], obstacles: Sequence = ()) -> float:
@@ -264,10 +270,10 @@ def equilibrium_error(problem, supports: list[str | int], obstacles: Sequence = 
     reactions, :meth:`~contact_ufl.problem.ContactProblem.obstacle_reaction`, count like the
     supports').
     """
-    tags = [problem.scene.facet_tag(s) for s in supports]
     # reaction() is the residual without the prescribed-displacement equations on the
     # support dofs, internal minus external forces: the force of the support on the body
-    reactions = sum(problem.reaction(tag) for tag in tags)
+    # (all supports at once: a node on two of them, a corner, counts once)
+    reactions = problem.reaction(list(supports))
     reactions = reactions + sum(problem.obstacle_reaction(o) for o in obstacles)
     load = problem.load_resultant()
     return float(np.linalg.norm(load + reactions) / np.linalg.norm(load))
@@ -355,12 +361,17 @@ def inverted_cells(problem) -> int:
     inside out. A sample, not a bound (``det F`` of a quadratic displacement is not linear
     in the cell), cheap enough to be called at a failed step.
     """
+    return problem.comm.allreduce(sum(_inverted(b) for b in problem.bulks))
+
+
+def _inverted(bulk) -> int:
+    """Owned cells of the mesh of ``bulk`` with ``det F < 0`` at a sample point."""
     from contact_ufl.loads import deformation_gradient
 
-    mesh = problem.V.mesh
+    mesh = bulk.V.mesh
     vertices = basix.geometry(basix.CellType[mesh.topology.cell_type.name])
     points = np.vstack([vertices, vertices.mean(axis=0)])
-    J = dolfinx.fem.Expression(ufl.det(deformation_gradient(problem.u)), points)
+    J = dolfinx.fem.Expression(ufl.det(deformation_gradient(bulk.u)), points)
     owned = mesh.topology.index_map(mesh.topology.dim).size_local
     values = J.eval(mesh, np.arange(owned, dtype=np.int32)).reshape(owned, len(points))
-    return problem.comm.allreduce(int((values.min(axis=1, initial=np.inf) < 0.0).sum()))
+    return int((values.min(axis=1, initial=np.inf) < 0.0).sum())

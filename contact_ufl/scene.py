@@ -1,9 +1,19 @@
-"""A scene: bodies of one mesh, their materials, supports, loads and contact pairs.
+"""A scene: meshes with their bodies, materials, supports and loads, and the contact pairs
+between them.
 
-Tags may be given by integer or by the name of their physical group (gmsh): the scene
-resolves the names to integers once, when it is made, so the forms and the solver see
-integers only. :meth:`Scene.from_gmsh` reads a ``.msh`` file or a live gmsh model and builds
-the scene in one call.
+A :class:`Domain` is one mesh and what lives on it: bodies (cell tags and materials),
+supports and loads. A :class:`Scene` is one or more domains and the contact pairs between
+their surfaces. A one-mesh scene gives its mesh, tags, bodies, supports and loads directly
+(``Scene(mesh, cell_tags, facet_tags, bodies, contacts, ...)``); a scene of bodies on
+meshes of their own lists them as ``domains`` (each mesh then has its own displacement
+field). Both may be combined: the scene's own mesh is then the first domain.
+
+Tags may be given by integer or by the name of their physical group (gmsh): names are
+resolved to integers once, when the scene is made, so the forms and the solver see integers
+only. A contact pair's surfaces are found in the domain whose facet groups have their name
+(or in the domain the pair names: ``ContactPair(slave_domain=..., master_domain=...)``).
+:meth:`Scene.from_gmsh` and :meth:`Domain.from_gmsh` read a ``.msh`` file or a live gmsh
+model in one call.
 """
 
 from __future__ import annotations
@@ -19,13 +29,15 @@ import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.contact import ContactPair
+from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.errors import ContactInputError, collective_check
-from contact_ufl.loads import BodyForce, Dirichlet, FollowerForce, FollowerPressure, Load, evaluate
+from contact_ufl.loads import BodyForce, FollowerForce, FollowerPressure, Load, evaluate
 from contact_ufl.materials import Hyperelastic
 from contact_ufl.plasticity import J2Plasticity
 
 if TYPE_CHECKING:
     from contact_ufl.gmshio import MeshData
+    from contact_ufl.loads import Dirichlet
 
 #: A tag: its integer value or the name of its physical group.
 Tag = int | str
@@ -42,19 +54,17 @@ class Body:
 
 
 @dataclass
-class Scene:
-    """Everything the forms are built from.
+class Domain:
+    """One mesh and what lives on it: bodies, supports and loads.
 
     Parameters
     ----------
     mesh
-        One mesh holding all bodies (disjoint, non-matching).
+        The mesh (its bodies are disjoint or non-matching; it has one displacement field).
     cell_tags, facet_tags
         Tags of the bodies and of the boundary parts.
     bodies
         The bodies (cell tag and material).
-    contacts
-        Contact pairs (slave and master facet tags, parameters).
     dirichlet
         Prescribed displacements.
     loads
@@ -65,14 +75,14 @@ class Scene:
         Physical groups (name -> ``(dimension, tag)``), e.g.
         :attr:`contact_ufl.gmshio.MeshData.groups`; derived from ``tags`` (and the dimension
         whose tags hold each value) when not given.
+    name
+        A name for messages and output files (default: ``mesh <index>``).
 
     Notes
     -----
-    Every tag (``Body.tag``, ``Dirichlet.tag``, the loads' ``tag``, ``ContactPair.slave``
-    and ``.master``) may be a physical group name (a rigid obstacle as ``.master`` is left as
-    it is): it is replaced by its integer when the
-    scene is made. An unknown name, or a group of the wrong dimension (a cell group as a
-    contact surface, a facet group as a body), raises
+    Every tag (``Body.tag``, ``Dirichlet.tag``, the loads' ``tag``) may be a physical group
+    name: it is replaced by its integer when the domain is made. An unknown name, or a group of
+    the wrong dimension (a facet group as a body), raises
     :class:`~contact_ufl.errors.ContactInputError` on every rank.
     """
 
@@ -80,11 +90,11 @@ class Scene:
     cell_tags: dolfinx.mesh.MeshTags
     facet_tags: dolfinx.mesh.MeshTags
     bodies: list[Body]
-    contacts: list[ContactPair] = field(default_factory=list)
     dirichlet: list[Dirichlet] = field(default_factory=list)
     loads: list[Load] = field(default_factory=list)
     tags: dict[str, int] = field(default_factory=dict)
     groups: dict[str, tuple[int, int]] = field(default_factory=dict)
+    name: str = ""
 
     def __post_init__(self) -> None:
         if self.tags and not self.groups:
@@ -98,67 +108,43 @@ class Scene:
         cls,
         source: str | os.PathLike | Any,
         bodies: Sequence[Body],
-        contacts: Sequence[ContactPair] = (),
         dirichlet: Sequence[Dirichlet] = (),
         loads: Sequence[Load] = (),
         comm: MPI.Comm = MPI.COMM_WORLD,
         gdim: int | None = None,
         rank: int = 0,
         ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
-    ) -> Scene:
-        """The scene on the mesh of a ``.msh`` file or a live gmsh model, in one call.
+        name: str = "",
+    ) -> Domain:
+        """The domain on the mesh of a ``.msh`` file or a live gmsh model, in one call.
 
-        Parameters
-        ----------
-        source
-            Path of a ``.msh`` file, or ``gmsh.model`` (meshed, with named physical groups)
-            on rank ``rank`` (the other ranks may pass ``None``).
-        bodies, contacts, dirichlet, loads
-            As in :class:`Scene`; tags by physical group name or by integer.
-        comm
-            Communicator of the mesh.
-        gdim
-            Dimension of the bodies, 2 (plane strain) or 3 (default: that of the mesh); a
-            mesh of another dimension is refused.
-        rank, ghost_mode
-            As in :func:`contact_ufl.gmshio.read_gmsh`.
+        Parameters are those of :meth:`Scene.from_gmsh` (and ``name``, as in
+        :class:`Domain`).
         """
-        from contact_ufl.gmshio import read_gmsh
-
-        parts = [*bodies, *dirichlet, *loads]
-        keys = [p.tag for p in parts] + [k for c in contacts for k in (c.slave, c.master)]
-        # (rigid obstacles among the keys are not strings: they need no physical group)
-        data = read_gmsh(
-            source,
-            comm,
-            gdim=gdim,
-            rank=rank,
-            ghost_mode=ghost_mode,
-            require_names=any(isinstance(k, str) for k in keys),
-            tdim=gdim,
-        )
-        return cls.from_mesh_data(data, bodies, contacts, dirichlet, loads)
+        data = _read(source, [*bodies, *dirichlet, *loads], [], comm, gdim, rank, ghost_mode)
+        return cls.from_mesh_data(data, bodies, dirichlet, loads, name)
 
     @classmethod
     def from_mesh_data(
         cls,
         data: MeshData,
         bodies: Sequence[Body],
-        contacts: Sequence[ContactPair] = (),
         dirichlet: Sequence[Dirichlet] = (),
         loads: Sequence[Load] = (),
-    ) -> Scene:
-        """The scene on a mesh read by :mod:`contact_ufl.gmshio` (tags by name or integer)."""
+        name: str = "",
+    ) -> Domain:
+        """The domain on a mesh read by :mod:`contact_ufl.gmshio` (tags by name or
+        integer)."""
         return cls(
             data.mesh,
             data.cell_tags,
             data.facet_tags,
             list(bodies),
-            list(contacts),
             list(dirichlet),
             list(loads),
             tags=data.tags,
             groups=dict(data.groups),
+            name=name,
         )
 
     def cell_tag(self, key: Tag) -> int:
@@ -168,6 +154,14 @@ class Scene:
     def facet_tag(self, key: Tag) -> int:
         """The integer facet tag of ``key`` (an integer, or a facet group's name)."""
         return self._lookup(key, self.mesh.topology.dim - 1, f"facet tag {key!r}")
+
+    def group_names(self) -> dict[str, list[str]]:
+        """The names of the cell and of the facet groups (``"cell"``, ``"facet"``)."""
+        tdim = self.mesh.topology.dim
+        return {
+            kind: sorted(n for n, (d, _) in self.groups.items() if d in (k, -1))
+            for kind, k in (("cell", tdim), ("facet", tdim - 1))
+        }
 
     def _groups_from_tags(self) -> dict[str, tuple[int, int]]:
         """Name -> (dimension, tag) from :attr:`tags`: the dimension whose tags hold the
@@ -190,13 +184,11 @@ class Scene:
             return key
         tdim = self.mesh.topology.dim
         if key not in self.groups:
-            names = {
-                kind: sorted(n for n, (d, _) in self.groups.items() if d == k)
-                for kind, k in (("cell", tdim), ("facet", tdim - 1))
-            }
+            names = self.group_names()
+            where = f" of {self.name}" if self.name else ""
             raise ContactInputError(
-                f"{what}: no physical group is named {key!r}; cell groups: {names['cell']}, "
-                f"facet groups: {names['facet']}"
+                f"{what}: no physical group{where} is named {key!r}; cell groups: "
+                f"{names['cell']}, facet groups: {names['facet']}"
             )
         group_dim, tag = self.groups[key]
         if group_dim not in (dim, -1):
@@ -211,19 +203,7 @@ class Scene:
         """Replace every tag given by name with its integer; errors on every rank."""
         tdim = self.mesh.topology.dim
         errors: list[str] = []
-
-        def resolve(item: Any, attribute: str, dim: int, what: str, **extra: Any) -> Any:
-            key = getattr(item, attribute)
-            if not isinstance(key, str):
-                return item
-            try:
-                return dataclasses.replace(
-                    item, **{attribute: self._lookup(key, dim, what)}, **extra
-                )
-            except ContactInputError as error:
-                errors.append(str(error))
-                return item
-
+        resolve = _resolver(self._lookup, errors)
         self.bodies = [
             resolve(b, "tag", tdim, f"body {b.name or b.tag!r}", name=b.name or str(b.tag))
             for b in self.bodies
@@ -240,43 +220,38 @@ class Scene:
             )
             for ld in self.loads
         ]
-        contacts = []
-        for k, pair in enumerate(self.contacts):
-            for side in ("slave", "master"):
-                pair = resolve(pair, side, tdim - 1, f"contact pair {k}, {side} surface")
-            contacts.append(pair)
-        self.contacts = contacts
         if errors:
             raise ContactInputError(errors[0])
 
     def validate(self) -> None:
-        """Check the scene against its mesh; raise a clear error on every rank."""
+        """Check the domain against its mesh; raise a clear error on every rank."""
         self._resolve_names()
         comm = self.mesh.comm
         gdim, tdim = self.mesh.geometry.dim, self.mesh.topology.dim
+        where = f"{self.name}: " if self.name else ""
         collective_check(
             comm,
             gdim == tdim and gdim in (2, 3),
-            f"solid bodies need a 2D (plane strain) or 3D mesh of full dimension; "
+            f"{where}solid bodies need a 2D (plane strain) or 3D mesh of full dimension; "
             f"got topological dimension {tdim} in {gdim}D",
         )
         collective_check(
             comm,
             self.cell_tags.dim == tdim,
-            f"cell_tags have dimension {self.cell_tags.dim}, the mesh {tdim}",
+            f"{where}cell_tags have dimension {self.cell_tags.dim}, the mesh {tdim}",
         )
         collective_check(
             comm,
             self.facet_tags.dim == tdim - 1,
-            f"facet_tags have dimension {self.facet_tags.dim}, expected {tdim - 1}",
+            f"{where}facet_tags have dimension {self.facet_tags.dim}, expected {tdim - 1}",
         )
-        collective_check(comm, len(self.bodies) > 0, "a scene needs at least one body")
-        for pair in self.contacts:
-            pair.validate(comm)
+        collective_check(comm, len(self.bodies) > 0, f"{where}a mesh needs at least one body")
         for body in self.bodies:
             count = comm.allreduce(len(self.cell_tags.find(body.tag)), MPI.SUM)
             collective_check(
-                comm, count > 0, f"body {body.name or body.tag}: cell tag {body.tag} has no cells"
+                comm,
+                count > 0,
+                f"{where}body {body.name or body.tag}: cell tag {body.tag} has no cells",
             )
         facet_values = comm.allreduce(set(np.unique(self.facet_tags.values).tolist()), MPI.BOR)
         surface_loads = [ld for ld in self.loads if not isinstance(ld, BodyForce)]
@@ -284,26 +259,300 @@ class Scene:
             collective_check(
                 comm,
                 item.tag in facet_values,
-                f"{type(item).__name__}: facet tag {item.tag} does not exist "
+                f"{where}{type(item).__name__}: facet tag {item.tag} does not exist "
                 f"(facet tags: {sorted(facet_values)})",
             )
         for load in self.loads:
-            if isinstance(load, FollowerPressure | FollowerForce):
-                shape = evaluate(load.value, 0.0).shape
-                collective_check(
-                    comm,
-                    shape == (),
-                    f"{type(load).__name__} on facet tag {load.tag}: the value is a scalar "
-                    f"magnitude, got shape {shape}",
+            _validate_load(comm, load, gdim, where)
+
+
+@dataclass
+class Scene:
+    """Everything the forms are built from: domains (meshes with their bodies, supports and
+    loads) and the contact pairs between their surfaces.
+
+    Parameters
+    ----------
+    mesh
+        The mesh of a one-mesh scene (or of the first of several; ``None`` when all meshes
+        are given as ``domains``).
+    cell_tags, facet_tags, bodies, dirichlet, loads, tags, groups
+        Those of ``mesh``, as in :class:`Domain`.
+    contacts
+        Contact pairs (slave and master surfaces, parameters).
+    domains
+        Further meshes with their bodies, supports and loads (:class:`Domain`): bodies on
+        meshes of their own.
+
+    Notes
+    -----
+    Every tag may be a physical group name (a rigid obstacle as ``ContactPair.master`` is
+    left as it is): it is replaced by its integer when the scene is made. A contact
+    surface's name is looked up in the facet groups of all domains; the pair's
+    ``slave_domain`` and ``master_domain`` become the indices of the domains that hold them
+    (in :attr:`parts`). An integer tag needs the domain named when the scene has several. An
+    unknown name, a name found in two domains, or a group of the wrong dimension raises
+    :class:`~contact_ufl.errors.ContactInputError` on every rank.
+    """
+
+    mesh: dolfinx.mesh.Mesh | None = None
+    cell_tags: dolfinx.mesh.MeshTags | None = None
+    facet_tags: dolfinx.mesh.MeshTags | None = None
+    bodies: list[Body] = field(default_factory=list)
+    contacts: list[ContactPair] = field(default_factory=list)
+    dirichlet: list[Dirichlet] = field(default_factory=list)
+    loads: list[Load] = field(default_factory=list)
+    tags: dict[str, int] = field(default_factory=dict)
+    groups: dict[str, tuple[int, int]] = field(default_factory=dict)
+    domains: list[Domain] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if self.mesh is None and not self.domains:
+            raise ContactInputError("a scene needs a mesh, or domains=[Domain(...), ...]")
+        if self.mesh is not None:
+            own = self._own_domain()  # resolves the names of the scene's own mesh
+            self.bodies, self.dirichlet, self.loads = own.bodies, own.dirichlet, own.loads
+            self.tags, self.groups = own.tags, own.groups
+        self._resolve_contacts()
+
+    @classmethod
+    def from_gmsh(
+        cls,
+        source: str | os.PathLike | Any,
+        bodies: Sequence[Body],
+        contacts: Sequence[ContactPair] = (),
+        dirichlet: Sequence[Dirichlet] = (),
+        loads: Sequence[Load] = (),
+        comm: MPI.Comm = MPI.COMM_WORLD,
+        gdim: int | None = None,
+        rank: int = 0,
+        ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+    ) -> Scene:
+        """The one-mesh scene on the mesh of a ``.msh`` file or a live gmsh model, in one call.
+
+        Parameters
+        ----------
+        source
+            Path of a ``.msh`` file, or ``gmsh.model`` (meshed, with named physical groups)
+            on rank ``rank`` (the other ranks may pass ``None``).
+        bodies, contacts, dirichlet, loads
+            As in :class:`Scene`; tags by physical group name or by integer.
+        comm
+            Communicator of the mesh.
+        gdim
+            Dimension of the bodies, 2 (plane strain) or 3 (default: that of the mesh); a
+            mesh of another dimension is refused.
+        rank, ghost_mode
+            As in :func:`contact_ufl.gmshio.read_gmsh`.
+        """
+        parts = [*bodies, *dirichlet, *loads]
+        data = _read(source, parts, contacts, comm, gdim, rank, ghost_mode)
+        return cls.from_mesh_data(data, bodies, contacts, dirichlet, loads)
+
+    @classmethod
+    def from_mesh_data(
+        cls,
+        data: MeshData,
+        bodies: Sequence[Body],
+        contacts: Sequence[ContactPair] = (),
+        dirichlet: Sequence[Dirichlet] = (),
+        loads: Sequence[Load] = (),
+    ) -> Scene:
+        """The one-mesh scene on a mesh read by :mod:`contact_ufl.gmshio` (tags by name or
+        integer)."""
+        return cls(
+            data.mesh,
+            data.cell_tags,
+            data.facet_tags,
+            list(bodies),
+            list(contacts),
+            list(dirichlet),
+            list(loads),
+            tags=data.tags,
+            groups=dict(data.groups),
+        )
+
+    # -- the domains ------------------------------------------------------------------
+    @property
+    def parts(self) -> list[Domain]:
+        """All domains: the scene's own mesh (if any) first, then :attr:`domains`. A
+        contact pair's ``slave_domain`` and ``master_domain`` index this list."""
+        own = [self._own_domain()] if self.mesh is not None else []
+        parts = own + list(self.domains)
+        for k, part in enumerate(parts):
+            if not part.name:
+                part.name = f"mesh {k}" if len(parts) > 1 else ""
+        return parts
+
+    def _own_domain(self) -> Domain:
+        return Domain(
+            self.mesh,
+            self.cell_tags,
+            self.facet_tags,
+            list(self.bodies),
+            list(self.dirichlet),
+            list(self.loads),
+            dict(self.tags),
+            dict(self.groups),
+        )
+
+    def cell_tag(self, key: Tag) -> int:
+        """The integer cell tag of ``key`` (an integer, or a cell group's name in any
+        domain)."""
+        return self.locate(key, "cell")[1]
+
+    def facet_tag(self, key: Tag) -> int:
+        """The integer facet tag of ``key`` (an integer, or a facet group's name in any
+        domain)."""
+        return self.locate(key, "facet")[1]
+
+    def locate(
+        self, key: Tag, kind: str = "facet", domain: int | str | None = None, what: str = ""
+    ) -> tuple[int, int]:
+        """The domain (index in :attr:`parts`) and integer tag of ``key``.
+
+        Parameters
+        ----------
+        key
+            An integer tag, or the name of a physical group.
+        kind
+            ``"facet"`` or ``"cell"``.
+        domain
+            The domain (index or name) that holds ``key``; default: the one whose groups
+            have the name ``key``, or the only domain.
+        what
+            What ``key`` is, for the error messages (default: ``"<kind> tag <key>"``).
+        """
+        parts = self.parts
+        what = what or f"{kind} tag {key!r}"
+        if domain is not None:
+            k = self._domain_index(domain, parts)
+        elif len(parts) == 1:
+            k = 0
+        elif isinstance(key, str):
+            holders = [k for k, d in enumerate(parts) if key in d.group_names()[kind]]
+            if len(holders) != 1:
+                names = {d.name: d.group_names()[kind] for d in parts}
+                if holders:
+                    raise ContactInputError(
+                        f"{what}: several domains of the scene "
+                        f"({', '.join(parts[k].name for k in holders)}) have a {kind} group "
+                        f"named {key!r}: name the domain (a contact pair's slave_domain or "
+                        "master_domain)"
+                    )
+                raise ContactInputError(
+                    f"{what}: no domain of the scene has a {kind} group named {key!r}; "
+                    f"{kind} groups: {names}"
                 )
-            if isinstance(load, FollowerForce):
-                d0 = np.asarray(load.direction, dtype=float)
-                collective_check(
-                    comm,
-                    d0.shape == (gdim,) and bool(np.linalg.norm(d0) > 0.0),
-                    f"FollowerForce on facet tag {load.tag}: direction must be a nonzero "
-                    f"vector of dimension {gdim}, got {tuple(d0.tolist())}",
-                )
+            (k,) = holders
+        else:
+            raise ContactInputError(
+                f"{what}: an integer tag in a scene of {len(parts)} meshes needs its domain "
+                "(give the group's name, or the domain)"
+            )
+        tdim = parts[k].mesh.topology.dim
+        return k, parts[k]._lookup(key, tdim - 1 if kind == "facet" else tdim, what)
+
+    def _domain_index(self, domain: int | str, parts: list[Domain]) -> int:
+        names = [d.name for d in parts]
+        if isinstance(domain, str):
+            if domain not in names:
+                raise ContactInputError(f"no domain of the scene is named {domain!r}: {names}")
+            return names.index(domain)
+        if not 0 <= domain < len(parts):
+            raise ContactInputError(
+                f"domain index {domain} out of range: the scene has {len(parts)} meshes"
+            )
+        return int(domain)
+
+    def _resolve_contacts(self) -> None:
+        """Each pair's surfaces as integer tags of the domains that hold them; errors on
+        every rank (the groups are the same on every rank)."""
+        contacts = []
+        for k, pair in enumerate(self.contacts):
+            changes: dict[str, Any] = {}
+            for side in ("slave", "master"):
+                key = getattr(pair, side)
+                if not isinstance(key, RigidObstacle):
+                    domain = getattr(pair, f"{side}_domain")
+                    what = f"contact pair {k}, {side} surface"
+                    d, tag = self.locate(key, "facet", domain, what)
+                    changes[side], changes[f"{side}_domain"] = tag, d
+            contacts.append(dataclasses.replace(pair, **changes))
+        self.contacts = contacts
+
+    def validate(self) -> None:
+        """Check the scene against its meshes; raise a clear error on every rank."""
+        parts = self.parts
+        comm = parts[0].mesh.comm
+        gdims = {d.mesh.geometry.dim for d in parts}
+        collective_check(
+            comm,
+            len(gdims) == 1,
+            f"the meshes of a scene must have one geometric dimension, got {sorted(gdims)}",
+        )
+        sizes = {d.mesh.comm.size for d in parts}
+        collective_check(
+            comm, len(sizes) == 1, "the meshes of a scene must share one MPI communicator"
+        )
+        for part in parts:
+            part.validate()
+        for pair in self.contacts:
+            pair.validate(comm)
+
+
+def _resolver(lookup, errors: list[str]):
+    """A function replacing ``item.attribute`` given by name with its integer tag (errors
+    collected in ``errors``)."""
+
+    def resolve(item: Any, attribute: str, dim: int, what: str, **extra: Any) -> Any:
+        key = getattr(item, attribute)
+        if not isinstance(key, str):
+            return item
+        try:
+            return dataclasses.replace(item, **{attribute: lookup(key, dim, what)}, **extra)
+        except ContactInputError as error:
+            errors.append(str(error))
+            return item
+
+    return resolve
+
+
+def _read(source, parts, contacts, comm, gdim, rank, ghost_mode) -> MeshData:
+    """The mesh data of ``source`` (names required where any tag is a name)."""
+    from contact_ufl.gmshio import read_gmsh
+
+    keys = [p.tag for p in parts] + [k for c in contacts for k in (c.slave, c.master)]
+    # (rigid obstacles among the keys are not strings: they need no physical group)
+    return read_gmsh(
+        source,
+        comm,
+        gdim=gdim,
+        rank=rank,
+        ghost_mode=ghost_mode,
+        require_names=any(isinstance(k, str) for k in keys),
+        tdim=gdim,
+    )
+
+
+def _validate_load(comm: MPI.Comm, load: Load, gdim: int, where: str) -> None:
+    """Check a follower load's value and direction (on every rank)."""
+    if isinstance(load, FollowerPressure | FollowerForce):
+        shape = evaluate(load.value, 0.0).shape
+        collective_check(
+            comm,
+            shape == (),
+            f"{where}{type(load).__name__} on facet tag {load.tag}: the value is a scalar "
+            f"magnitude, got shape {shape}",
+        )
+    if isinstance(load, FollowerForce):
+        d0 = np.asarray(load.direction, dtype=float)
+        collective_check(
+            comm,
+            d0.shape == (gdim,) and bool(np.linalg.norm(d0) > 0.0),
+            f"{where}FollowerForce on facet tag {load.tag}: direction must be a nonzero "
+            f"vector of dimension {gdim}, got {tuple(d0.tolist())}",
+        )
 
 
 def _kind(dim: int, tdim: int) -> str:

@@ -145,7 +145,7 @@ def test_points_beyond_the_master_surface_are_released():
     problem.solve(num_steps=10, t_end=2.0)
     c = problem.contacts[0]
     x = c.slave.positions(problem.u).reshape(-1, 2)[:, 0]
-    end = c.master.current_nodes(problem.u)[..., 0].max(initial=-np.inf)
+    end = c.master.current_nodes()[..., 0].max(initial=-np.inf)
     end = problem.comm.allreduce(end, op=MPI.MAX)
     overhang = x > end + 1e-9
     assert problem.comm.allreduce(int(overhang.sum())) > 0

@@ -49,14 +49,19 @@ class ContactInterface:
     Parameters
     ----------
     u
-        The displacement (one function over the mesh of all bodies).
+        The displacement of the slave's mesh.
     facet_tags
-        Facet tags of the mesh.
+        Facet tags of that mesh.
     pair
         The contact pair (integer tags).
     modulus
         Young's modulus of the softer of the two bodies: the scale of the default ``eps_N``
         (needed only when ``pair.eps_N`` is ``None``).
+    master_u, master_facet_tags
+        The displacement and facet tags of the master's mesh (default: those of the slave:
+        both surfaces on one mesh).
+    master_block
+        The block of ``master_u`` in the unknowns of the problem (one block per mesh).
 
     Attributes
     ----------
@@ -77,6 +82,9 @@ class ContactInterface:
         facet_tags: dolfinx.mesh.MeshTags,
         pair: ContactPair,
         modulus: float | None = None,
+        master_u: dolfinx.fem.Function | None = None,
+        master_facet_tags: dolfinx.mesh.MeshTags | None = None,
+        master_block: int = 0,
     ):
         V = u.function_space
         mesh = V.mesh
@@ -98,9 +106,12 @@ class ContactInterface:
             V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions, pair.quadrature_rule
         )
         #: the master side as the laws see it (gap, normal, projected point, master fields)
-        self.kinematics = (
-            self._obstacle_side(pair) if pair.on_obstacle else self._mesh_side(facet_tags, pair)
-        )
+        if pair.on_obstacle:
+            self.kinematics = self._obstacle_side(pair)
+        else:
+            master_u = u if master_u is None else master_u
+            master_tags = facet_tags if master_facet_tags is None else master_facet_tags
+            self.kinematics = self._mesh_side(master_u, master_tags, master_block, pair)
         eps_N = pair.eps_N if pair.eps_N is not None else default_eps(self.slave, modulus)
         self.normal = NormalLaw(self.slave, eps_N, self.touching)
         self.t_N = self.normal.traction(self.kinematics.gap, self.kinematics.mask)
@@ -112,7 +123,13 @@ class ContactInterface:
         )
         self._surface_forms: dict[str, list[dolfinx.fem.Form]] = {}
 
-    def _mesh_side(self, facet_tags: dolfinx.mesh.MeshTags, pair: ContactPair) -> MeshKinematics:
+    def _mesh_side(
+        self,
+        master_u: dolfinx.fem.Function,
+        facet_tags: dolfinx.mesh.MeshTags,
+        block: int,
+        pair: ContactPair,
+    ) -> MeshKinematics:
         """The kinematics of a meshed master surface (with its search)."""
         comm, gdim = self.V.mesh.comm, self.gdim
         smoothed = pair.master_normal == "smoothed"
@@ -121,7 +138,7 @@ class ContactInterface:
             not smoothed or gdim == 2,
             "master_normal='smoothed' is implemented for 2D (segment) master surfaces only",
         )
-        self.master = MeshMaster(self.V, facet_tags, pair.master, smoothed)
+        self.master = MeshMaster(master_u, facet_tags, pair.master, smoothed, block)
         size = global_diameter(
             comm,
             np.vstack([self.slave.X.reshape(-1, gdim), self.master.X_nodes.reshape(-1, gdim)]),
@@ -182,12 +199,12 @@ class ContactInterface:
         Parameters
         ----------
         layout
-            Layout of the unknowns; block 0 is the displacement.
+            Layout of the unknowns (one displacement block per mesh, then the multipliers).
 
         Returns
         -------
         The gathered fields: pairs of a field and, for every owned dof of it (unrolled, local
-        order), the stacked index of the displacement unknown it gathers, or -1.
+        order), the stacked index of the (master) displacement unknown it gathers, or -1.
         """
         gathers = self.kinematics.update(layout)
         return gathers + (self.friction.gathers() if self.friction else [])

@@ -35,6 +35,17 @@ class MeshMaster:
     quadrilaterals), ordered so that the normal of :mod:`.projection` points out of
     the master body.
 
+    Parameters
+    ----------
+    u
+        The displacement of the master's mesh (its nodes are dofs of ``u``).
+    facet_tags, tag
+        The facet tags of that mesh and the master surface's tag.
+    smoothed
+        Whether the normal is smoothed (2D): the neighbours of every segment are gathered.
+    block
+        The block of ``u`` in the unknowns of the problem (one block per mesh).
+
     Attributes
     ----------
     nodes
@@ -51,23 +62,31 @@ class MeshMaster:
         surface (2D: which of its two nodes are end points of the surface), ``(nf, ne)``.
     """
 
-    def __init__(self, V: dolfinx.fem.FunctionSpace, facet_tags, tag: int, smoothed: bool):
-        self.V, self.facet_tags, self.tag, self.smoothed = V, facet_tags, tag, smoothed
+    def __init__(
+        self,
+        u: dolfinx.fem.Function,
+        facet_tags: dolfinx.mesh.MeshTags,
+        tag: int,
+        smoothed: bool,
+        block: int = 0,
+    ):
+        self.u, self.V = u, u.function_space
+        self.facet_tags, self.tag, self.smoothed, self.block = facet_tags, tag, smoothed, block
         self._build()
         #: nodes of a facet (the largest over the ranks: a rank may have no facet)
-        self.nn = int(V.mesh.comm.allreduce(self.nodes.shape[1], MPI.MAX))
+        self.nn = int(self.V.mesh.comm.allreduce(self.nodes.shape[1], MPI.MAX))
         #: nodes carried to a slave point: the facet's, and (smoothed) its two neighbours
         self.nx = self.nn + (2 if smoothed else 0)
         if smoothed:
             self._neighbours, self._has_neighbour = segment_neighbours(
-                V.mesh.comm, self.global_nodes
+                self.V.mesh.comm, self.global_nodes
             )
 
-    def candidates(self, u: dolfinx.fem.Function, layout: StackedLayout) -> MasterCandidates:
-        """This rank's facets at the displacement ``u`` (collective with ``smoothed``)."""
+    def candidates(self, layout: StackedLayout) -> MasterCandidates:
+        """This rank's facets at the current displacement (collective with ``smoothed``)."""
         comm = self.V.mesh.comm
         bs = self.V.dofmap.index_map_bs
-        current = self.current_nodes(u)
+        current = self.current_nodes()
         global_nodes = self.global_nodes.astype(np.int64)
         flags = np.zeros((len(current), 0), dtype=np.int64)
         if self.smoothed:  # carry the neighbour nodes of every segment along
@@ -75,7 +94,7 @@ class MeshMaster:
             current = np.concatenate([current, before_after], axis=1)
             global_nodes = np.hstack([global_nodes, self._neighbours])
             flags = self._has_neighbour.astype(np.int64)
-        columns = layout.from_block_global(0, global_nodes * bs)
+        columns = layout.from_block_global(self.block, global_nodes * bs)
         return MasterCandidates(
             current, columns, self.keys.astype(np.int64), self.boundary_edges, flags
         )
@@ -123,10 +142,10 @@ class MeshMaster:
         """Owned master facets on this rank."""
         return len(self.nodes)
 
-    def current_nodes(self, u: dolfinx.fem.Function) -> np.ndarray:
+    def current_nodes(self) -> np.ndarray:
         """Current node positions ``(nf, nn, gdim)``."""
         bs = self.V.dofmap.index_map_bs
-        return self.X_nodes + u.x.array.reshape(-1, bs)[self.nodes]
+        return self.X_nodes + self.u.x.array.reshape(-1, bs)[self.nodes]
 
 
 def _boundary_edges(comm: MPI.Comm, node_keys: np.ndarray, nodes: np.ndarray, flip, swap):

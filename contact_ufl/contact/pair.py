@@ -56,6 +56,11 @@ class ContactPair:
         one segment to the next; a slave point sliding over a master vertex then meets no
         jump of the contact force's direction (large sliding, ironing). The nodal normals
         depend on the neighbouring nodes, which are gathered with the segment's own.
+    slave_domain, master_domain
+        The domains (meshes) of the scene that hold the two surfaces: an index in
+        :attr:`Scene.parts <contact_ufl.scene.Scene.parts>` or a domain's name. Needed only
+        to tell apart integer tags in a scene of several meshes; by default a surface is
+        found by its group name. The scene sets both to indices when it is made.
     """
 
     slave: int | str
@@ -68,6 +73,8 @@ class ContactPair:
     quadrature_subdivisions: int = 1
     quadrature_rule: str = "gauss"
     master_normal: str = "facet"
+    slave_domain: int | str | None = None
+    master_domain: int | str | None = None
 
     @property
     def frictional(self) -> bool:
@@ -118,6 +125,6 @@ class ContactPair:
         )
         collective_check(
             comm,
-            self.slave != self.master,
-            f"slave and master tags must differ (both {self.slave})",
+            (self.slave_domain, self.slave) != (self.master_domain, self.master),
+            f"slave and master surfaces must differ (both are facet tag {self.slave})",
         )

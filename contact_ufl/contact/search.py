@@ -133,14 +133,15 @@ class ClosestPointSearch:
         Parameters
         ----------
         u
-            The displacement.
+            The displacement of the slave's mesh.
         layout
-            Layout of the unknowns; block 0 is the displacement.
+            Layout of the unknowns (the master's displacement is its block
+            ``master.block``).
         """
         start = time.perf_counter()
         gdim, nn, nx = self.gdim, self.master.nn, self.master.nx
         points = self.slave.positions(u).reshape(-1, gdim)
-        mine = self.master.candidates(u, layout)
+        mine = self.master.candidates(layout)
         ne = mine.boundary.shape[1]
         payload = np.hstack([mine.columns, mine.keys, mine.boundary.astype(np.int64), mine.flags])
         nodes, payload = self.exchange(mine.nodes, points, payload)

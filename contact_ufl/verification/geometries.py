@@ -1037,3 +1037,34 @@ def beams_3d(
         gmsh.model.mesh.generate(3)
 
     return generate_mesh(comm, "beams_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)
+
+
+def split_by_cells(data: MeshData, cell_groups: list[int | str]) -> list[MeshData]:
+    """Meshes of their own for cell groups (tags or names) of one mesh: one submesh per
+    group, with its cell and facet tags and the names of the groups it holds.
+
+    The submeshes have the parent's geometry exactly and its partition, so a scene on them is
+    the scene on ``data`` with each body on a mesh of its own (and its own displacement).
+    """
+    mesh = data.mesh
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    parts = []
+    for name in cell_groups:
+        tag = data.tags[name] if isinstance(name, str) else name
+        cells = data.cell_tags.find(tag)
+        sub, cell_map, vertex_map, _ = dolfinx.mesh.create_submesh(mesh, tdim, cells)
+        sub.topology.create_connectivity(tdim - 1, tdim)
+        cell_tags = dolfinx.mesh.transfer_meshtags_to_submesh(
+            data.cell_tags, sub, vertex_map, cell_map
+        )
+        facet_tags = dolfinx.mesh.transfer_meshtags_to_submesh(
+            data.facet_tags, sub, vertex_map, cell_map
+        )
+        held = {
+            dim: mesh.comm.allreduce(set(np.unique(tags.values).tolist()), MPI.BOR)
+            for dim, tags in ((tdim, cell_tags), (tdim - 1, facet_tags))
+        }
+        groups = {n: (d, t) for n, (d, t) in data.groups.items() if t in held.get(d, ())}
+        parts.append(MeshData(sub, cell_tags, facet_tags, groups))
+    return parts

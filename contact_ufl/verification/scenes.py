@@ -15,10 +15,11 @@ import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.contact import ContactPair, RigidPlane, RigidSphere
+from contact_ufl.gmshio import MeshData
 from contact_ufl.loads import DeadTraction, Dirichlet, FollowerForce
 from contact_ufl.materials import NeoHookean
 from contact_ufl.plasticity import J2Plasticity
-from contact_ufl.scene import Body, Scene
+from contact_ufl.scene import Body, Domain, Scene
 from contact_ufl.verification import geometries
 from contact_ufl.verification.analytic import plane_strain_modulus
 
@@ -595,3 +596,44 @@ def pushed_block_on_plane(
     scene = pushed_block(mu=mu, pressure=pressure, push=push, nu=nu, comm=comm)
     pair = dataclasses.replace(scene.contacts[0], master=RigidPlane((0.0, 0.0), (0.0, 1.0)))
     return dataclasses.replace(scene, contacts=[pair])
+
+
+def on_meshes_of_their_own(scene: Scene) -> Scene:
+    """The one-mesh ``scene`` with each body on a mesh of its own (a submesh of its cells,
+    the same geometry and partition): each body then has its own displacement field.
+
+    Supports and loads go to the meshes whose facets they tag; each contact pair names the
+    domains of its two surfaces (integer tags need them in a scene of several meshes).
+    """
+    data = MeshData(scene.mesh, scene.cell_tags, scene.facet_tags, dict(scene.groups))
+    parts = geometries.split_by_cells(data, [b.tag for b in scene.bodies])
+    comm = scene.mesh.comm
+
+    def holds(part: MeshData, tag: int) -> bool:
+        return comm.allreduce(len(part.facet_tags.find(tag)), MPI.SUM) > 0
+
+    domains = [
+        Domain(
+            part.mesh,
+            part.cell_tags,
+            part.facet_tags,
+            [body],
+            [d for d in scene.dirichlet if holds(part, d.tag)],
+            [ld for ld in scene.loads if holds(part, ld.tag)],
+            groups=part.groups,
+            name=body.name or f"body {body.tag}",
+        )
+        for part, body in zip(parts, scene.bodies, strict=True)
+    ]
+
+    def domain_of(tag) -> int | None:
+        if not isinstance(tag, int | np.integer):
+            return None
+        (k,) = [k for k, part in enumerate(parts) if holds(part, tag)]
+        return k
+
+    contacts = [
+        dataclasses.replace(p, slave_domain=domain_of(p.slave), master_domain=domain_of(p.master))
+        for p in scene.contacts
+    ]
+    return Scene(domains=domains, contacts=contacts)

@@ -17,7 +17,7 @@ from petsc4py import PETSc
 
 from contact_ufl.contact.obstacles import RigidCylinder, RigidObstacle, RigidSphere
 from contact_ufl.problem import ContactProblem
-from contact_ufl.verification.scenes import curved_pair
+from contact_ufl.verification.scenes import curved_pair, on_meshes_of_their_own
 
 __all__ = [
     "CURVED_STATES",
@@ -53,13 +53,9 @@ def contact_state(
     """Put ``problem`` in a generic state of contact: every body deformed by a smooth field,
     the body ``body_tag`` also translated by ``shift`` (into the other), smooth positive
     multipliers. Sets the unknowns (not a solution: a point to test the tangent at)."""
-    gdim = problem.V.mesh.geometry.dim
-    cells = problem.scene.cell_tags.find(body_tag)
-    u = problem.u
-    u.interpolate(lambda x: smooth_field(x, amplitude, gdim))
-    u.interpolate(
-        lambda x: smooth_field(x, amplitude, gdim) + np.asarray(shift)[:, None], cells0=cells
-    )
+    gdim = problem.gdim
+    for bulk in problem.bulks:
+        _deform(bulk, body_tag, amplitude, shift, gdim, bulk.u)
     for c in problem.contacts:
         c.lambda_N.interpolate(lambda x: multiplier * (1.0 + 0.2 * np.sin(5.0 * x[0])))
         if c.friction:
@@ -77,16 +73,11 @@ def sliding_direction(
 ) -> PETSc.Vec:
     """A direction dz that slides body ``body_tag`` by ``slide`` over the other, deforms both
     bodies (rotating the master normals) and changes the multipliers; rank independent."""
-    gdim = problem.V.mesh.geometry.dim
-    cells = problem.scene.cell_tags.find(body_tag)
     fields = []
-    du = dolfinx.fem.Function(problem.V)
-    du.interpolate(lambda x: smooth_field(x, amplitude, gdim, phase=0.7))
-    du.interpolate(
-        lambda x: smooth_field(x, amplitude, gdim, phase=0.7) + np.asarray(slide)[:, None],
-        cells0=cells,
-    )
-    fields.append(du)
+    for bulk in problem.bulks:
+        du = dolfinx.fem.Function(bulk.V)
+        _deform(bulk, body_tag, amplitude, slide, problem.gdim, du, phase=0.7)
+        fields.append(du)
     for c in problem.contacts:
         dl = dolfinx.fem.Function(c.normal.L)
         dl.interpolate(lambda x: multiplier * np.cos(4.0 * x[0] + 0.3))
@@ -94,6 +85,18 @@ def sliding_direction(
     dz = problem.solver.x.duplicate()
     dolfinx.fem.petsc.assign(fields, dz)
     return dz
+
+
+def _deform(bulk, body_tag: int, amplitude: float, shift, gdim: int, u, phase: float = 0.0):
+    """``u`` = the smooth field over the mesh of ``bulk``, plus ``shift`` on the cells of
+    the body ``body_tag`` if that body is on this mesh."""
+    u.interpolate(lambda x: smooth_field(x, amplitude, gdim, phase))
+    if any(b.tag == body_tag for b in bulk.bodies):
+        cells = bulk.domain.cell_tags.find(body_tag)
+        u.interpolate(
+            lambda x: smooth_field(x, amplitude, gdim, phase) + np.asarray(shift)[:, None],
+            cells0=cells,
+        )
 
 
 #: Generic contact states of :func:`~contact_ufl.verification.scenes.curved_pair`: the translation
@@ -104,21 +107,30 @@ CURVED_STATES = {
 }
 
 
-def curved_case(dim: int, num_steps: int = 4, mu: float = 0.0, master_normal: str = "facet"):
+def curved_case(
+    dim: int,
+    num_steps: int = 4,
+    mu: float = 0.0,
+    master_normal: str = "facet",
+    own_meshes: bool = False,
+):
     """The Taylor test case on curved surfaces: problem at its state, direction, steps.
 
     With ``mu > 0`` the state has a slip history: the step is committed half-way along the
     translation, and the tangential multipliers are smooth and non-zero (a small ``mu``
     puts the contact points in slip, a large one in stick). Over the steps no slave point
     changes master facet, contact status or stick/slip status. ``master_normal`` is that
-    of :class:`~contact_ufl.contact.ContactPair`.
+    of :class:`~contact_ufl.contact.ContactPair`. With ``own_meshes`` each body is on a
+    mesh of its own (:func:`~contact_ufl.verification.scenes.on_meshes_of_their_own`).
     """
     scene = curved_pair(dim)
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu, master_normal=master_normal)
+    if own_meshes:
+        scene = on_meshes_of_their_own(scene)
     problem = ContactProblem(scene, verbose=False)
     solver = problem.solver  # made at the reference state, the converged state of step 0
     state = CURVED_STATES[dim]
-    tag = scene.bodies[0].tag
+    tag = problem.bulks[0].bodies[0].tag
     shift = np.array(state["shift"])
     if mu > 0:
         contact_state(problem, tag, 0.5 * shift)

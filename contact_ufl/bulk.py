@@ -1,0 +1,163 @@
+"""The bulk of one mesh: its displacement field and the weak form of its bodies and loads.
+
+A :class:`Bulk` holds, for one :class:`~contact_ufl.scene.Domain` (a mesh and its bodies,
+supports and loads), the displacement ``u``, the measures, the virtual work of the bodies'
+stresses and of the loads in UFL, the plastic histories of elastoplastic bodies, and the
+prescribed-displacement dofs. The problem (:mod:`contact_ufl.problem`) composes one bulk per
+mesh with the contact interfaces between them.
+"""
+
+from __future__ import annotations
+
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from contact_ufl.loads import BodyForce, deformation_gradient, evaluate, load_constant
+from contact_ufl.plasticity import J2Plasticity, PlasticHistory
+from contact_ufl.scene import Body, Domain
+
+
+class Bulk:
+    """The displacement field of one mesh and the bulk weak form of its bodies and loads.
+
+    Parameters
+    ----------
+    domain
+        The mesh with its bodies, supports and loads (integer tags).
+    degree
+        Polynomial degree of the displacement.
+    quadrature_degree
+        Quadrature degree of the bulk integrals (default: exact for P1 simplices, ``2 p``
+        otherwise).
+
+    Attributes
+    ----------
+    V, u
+        The displacement space and the displacement.
+    dx, ds
+        Measures over the cells (subdomain data: the cell tags) and exterior facets (the
+        facet tags).
+    histories
+        The :class:`~contact_ufl.plasticity.PlasticHistory` of each elastoplastic body, by
+        cell tag.
+    dirichlet_dofs
+        Local (owned) indices of the prescribed displacement dofs (unrolled).
+    """
+
+    def __init__(self, domain: Domain, degree: int = 1, quadrature_degree: int | None = None):
+        self.domain = domain
+        mesh = domain.mesh
+        self.comm = mesh.comm
+        gdim = mesh.geometry.dim
+        self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (gdim,)))
+        name = "displacement" + (f" ({domain.name})" if domain.name else "")
+        self.u = dolfinx.fem.Function(self.V, name=name)
+        simplex = mesh.topology.cell_type in (
+            dolfinx.mesh.CellType.triangle,
+            dolfinx.mesh.CellType.tetrahedron,
+        )
+        qdeg = quadrature_degree or (2 * degree - 1 if simplex else 2 * degree)
+        self.dx = ufl.Measure(
+            "dx", domain=mesh, subdomain_data=domain.cell_tags, metadata={"quadrature_degree": qdeg}
+        )
+        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=domain.facet_tags)
+        self.histories = {
+            b.tag: PlasticHistory(b.material, self.u, qdeg, domain.cell_tags.find(b.tag))
+            for b in domain.bodies
+            if isinstance(b.material, J2Plasticity)
+        }
+        self.load_constants = [(load, load_constant(mesh, load)) for load in domain.loads]
+        self._energy_form = None
+        self._load_resultant_forms = None
+        self._locate_dirichlet()
+
+    @property
+    def bodies(self) -> list[Body]:
+        """The bodies of this mesh."""
+        return self.domain.bodies
+
+    def first_piola(self, body: Body) -> ufl.core.expr.Expr:
+        """First Piola-Kirchhoff stress of ``body`` at the current displacement (and, for an
+        elastoplastic body, the history of the last converged step)."""
+        if body.tag in self.histories:
+            return self.histories[body.tag].first_piola()
+        return body.material.first_piola(deformation_gradient(self.u))
+
+    def residual(self, v: ufl.Argument) -> ufl.Form:
+        """``int P : Grad v dV - (external virtual work)``: the bulk residual of this mesh."""
+        F = sum(ufl.inner(self.first_piola(b), ufl.grad(v)) * self.dx(b.tag) for b in self.bodies)
+        for load, c in self.load_constants:
+            F -= load.virtual_work(self.u, v, self.measure(load), c)
+        return F
+
+    def measure(self, load) -> ufl.Measure:
+        """The measure a load acts on (cells for a body force, facets otherwise)."""
+        return self.dx if isinstance(load, BodyForce) else self.ds
+
+    def set_time(self, t: float) -> None:
+        """Set the load constants to their values at pseudo-time ``t``."""
+        for load, c in self.load_constants:
+            c.value = evaluate(load.value, t)
+
+    # -- supports -----------------------------------------------------------------------
+    def _locate_dirichlet(self) -> None:
+        fdim, gdim = self.V.mesh.topology.dim - 1, self.V.mesh.geometry.dim
+        self._bc_dofs, self._bc_values = [], []
+        owned = self.V.dofmap.index_map.size_local * gdim
+        for bc in self.domain.dirichlet:
+            facets = self.domain.facet_tags.find(bc.tag)
+            comps = range(gdim) if bc.component is None else [bc.component]
+            for i in comps:
+                blocks = dolfinx.fem.locate_dofs_topological(self.V.sub(i), fdim, facets)
+                self._bc_dofs.append(blocks[blocks < owned])
+                self._bc_values.append((bc, i))
+        self.dirichlet_dofs = (
+            np.concatenate(self._bc_dofs).astype(np.int64)
+            if self._bc_dofs
+            else np.zeros(0, np.int64)
+        )
+
+    def prescribed(self, t: float) -> np.ndarray:
+        """The prescribed displacements ``g(t)`` of :attr:`dirichlet_dofs`."""
+        values = []
+        for dofs, (bc, i) in zip(self._bc_dofs, self._bc_values, strict=True):
+            value = evaluate(bc.value, t)
+            value = value if bc.component is not None or value.ndim == 0 else value[i]
+            values.append(np.full(len(dofs), float(value)))
+        return np.concatenate(values) if values else np.zeros(0)
+
+    def facet_dofs(self, tag: int) -> np.ndarray:
+        """Owned dof blocks (nodes) of the facets ``tag``."""
+        facets = self.domain.facet_tags.find(tag)
+        blocks = dolfinx.fem.locate_dofs_topological(self.V, self.V.mesh.topology.dim - 1, facets)
+        return blocks[blocks < self.V.dofmap.index_map.size_local]
+
+    # -- what a state says ------------------------------------------------------------
+    def load_resultant(self) -> np.ndarray:
+        """Resultant of the loads of this mesh at the current state (all ranks)."""
+        if self._load_resultant_forms is None:
+            mesh = self.V.mesh
+            gdim = mesh.geometry.dim
+            self._load_resultant_forms = []
+            for i in range(gdim):
+                e_i = dolfinx.fem.Constant(mesh, np.eye(gdim)[i])
+                work = sum(
+                    load.virtual_work(self.u, e_i, self.measure(load), c)
+                    for load, c in self.load_constants
+                )
+                self._load_resultant_forms.append(dolfinx.fem.form(work) if work else None)
+        local = [
+            dolfinx.fem.assemble_scalar(f) if f is not None else 0.0
+            for f in self._load_resultant_forms
+        ]
+        return self.comm.allreduce(np.asarray(local, dtype=float), MPI.SUM)
+
+    def stored_energy(self) -> float:
+        """Elastic energy ``sum_b int psi_b(F) dV`` of the (hyperelastic) bodies."""
+        if self._energy_form is None:
+            F = deformation_gradient(self.u)
+            energy = sum(b.material.strain_energy(F) * self.dx(b.tag) for b in self.bodies)
+            self._energy_form = dolfinx.fem.form(energy)
+        return self.comm.allreduce(dolfinx.fem.assemble_scalar(self._energy_form))
