@@ -31,6 +31,14 @@ A membrane has no bending and no compressive stiffness: at ``u = 0`` a flat memb
 stiffness normal to itself. A solve starts from a curved reference (a tube, a sphere), a
 pre-stress, or an inflation first, with load stepping; where the membrane goes slack
 (compressed) the tangent becomes singular and Newton fails or wrinkles are smeared.
+
+Forms, on the membrane mesh's own ``dx`` (``quadrature_degree`` 2 is exact for P1 on flat
+triangles, where everything but ``v`` is constant per cell; 4 for P2)::
+
+    n0 = reference_normal(mesh)                  # or orientation * vertex_order_normal(mesh)
+    energy = law.strain_energy(u, n0) * dx
+    residual = ufl.derivative(energy, u, v) - pressure_virtual_work(u, v, n0, p) * dx
+    jacobian = ufl.derivative(residual, u, du)
 """
 
 from __future__ import annotations
@@ -44,7 +52,7 @@ import ufl
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from contact_ufl.errors import collective_check
+from contact_ufl.errors import ContactInputError, collective_check
 from contact_ufl.loads import deformation_gradient
 from contact_ufl.materials import lame_parameters
 
@@ -137,27 +145,24 @@ class _Surface:
 
 
 def _signs_within_components(keys: np.ndarray, senses: np.ndarray):
-    """Signs making neighbouring cells agree, per connected component, or an error message.
+    """Signs making neighbouring cells agree, and the connected component of each cell.
 
     The cells are the nodes of a graph whose edges are the shared facets, each marked with
     whether its two cells disagree (same sense). The doubled graph has the nodes ``(cell,
     flipped)`` and joins ``(c1, s)`` to ``(c2, s xor disagree)``: a component is orientable iff
     no cell is joined to its own flip, and a cell's sign is then whether its node is in the
     same doubled component as the unflipped root of its component (scipy connected components,
-    no loop over cells). Returns ``(sign, component, message)``.
+    no loop over cells). Returns ``(sign, component)``; raises ``ContactInputError`` (on the
+    calling rank only) for a non-manifold or non-orientable surface.
     """
     num_cells, num_facets = senses.shape
     flat_keys = keys.reshape(-1, 2)
     _, facet, counts = np.unique(flat_keys, axis=0, return_inverse=True, return_counts=True)
     facet = facet.ravel()
     if counts.size and counts.max() > 2:
-        return (
-            None,
-            None,
-            (
-                f"the membrane is not a manifold: {int((counts > 2).sum())} facets are shared by "
-                "more than two cells"
-            ),
+        raise ContactInputError(
+            f"the membrane is not a manifold: {int((counts > 2).sum())} facets are shared by "
+            "more than two cells"
         )
     order = np.argsort(facet, kind="stable")
     shared = np.flatnonzero(counts[facet[order]] == 2)[::2]
@@ -172,21 +177,31 @@ def _signs_within_components(keys: np.ndarray, senses: np.ndarray):
     base = coo_matrix((np.ones(c1.size), (c1, c2)), shape=(n, n))
     _, component = connected_components(base, directed=False)
     if np.any(label[:n] == label[n:]):
-        return (
-            None,
-            None,
-            (
-                "the membrane cannot be oriented consistently (a non-orientable surface such as "
-                "a Moebius strip): no choice of normal agrees across all shared edges"
-            ),
+        raise ContactInputError(
+            "the membrane cannot be oriented consistently (a non-orientable surface such as "
+            "a Moebius strip): no choice of normal agrees across all shared edges"
         )
     _, root = np.unique(component, return_index=True)
     sign = np.where(label[:n] == label[root[component]], 1.0, -1.0)
-    return sign, component, None
+    return sign, component
 
 
-def _outward_signs(surface: _Surface, sign: np.ndarray, component: np.ndarray, outward, direction):
-    """Flip whole components so that each points to the outward side; or an error message.
+def _orient(
+    surface: _Surface, outward: Sequence[float] | None, direction: Sequence[float] | None
+) -> np.ndarray:
+    """The sign of every gathered cell (rank 0): consistent, then outward per component."""
+    sign, component = _signs_within_components(surface.keys, surface.senses)
+    return _outward_signs(surface, sign, component, outward, direction)
+
+
+def _outward_signs(
+    surface: _Surface,
+    sign: np.ndarray,
+    component: np.ndarray,
+    outward: Sequence[float] | None,
+    direction: Sequence[float] | None,
+) -> np.ndarray:
+    """Flip whole components so that each points to its outward side.
 
     The side is the sign of ``m = sum_c s_c int_c N . (x - p)`` (away from the point ``p``:
     ``outward``, or by default the area centroid of the component) or ``sum_c s_c int_c N . d``
@@ -214,12 +229,12 @@ def _outward_signs(surface: _Surface, sign: np.ndarray, component: np.ndarray, o
         scale = comp_area * extent
     ambiguous = np.abs(m) <= 1e-8 * scale
     if np.any(ambiguous):
-        return None, (
+        raise ContactInputError(
             f"cannot tell the outward side of {int(ambiguous.sum())} membrane component(s) "
             "(flat, or symmetric about the outward point): give `outward` (a point the normal "
             "points away from) or `direction`"
         )
-    return sign * np.where(m > 0.0, 1.0, -1.0)[component], None
+    return sign * np.where(m > 0.0, 1.0, -1.0)[component]
 
 
 def cell_orientation(
@@ -284,12 +299,13 @@ def cell_orientation(
     parts = comm.gather((keys, senses, integrals), root=0)
     signs, message = None, None
     if comm.rank == 0:
-        surface = _Surface(*(np.concatenate([p[i] for p in parts]) for i in range(3)))
-        sign, component, message = _signs_within_components(surface.keys, surface.senses)
-        if message is None:
-            sign, message = _outward_signs(surface, sign, component, outward, direction)
-        if message is None:
+        try:
+            sign = _orient(
+                _Surface(*(np.concatenate(p) for p in zip(*parts, strict=True))), outward, direction
+            )
             signs = np.split(sign, np.cumsum([len(p[1]) for p in parts])[:-1])
+        except ContactInputError as error:
+            message = str(error)
     message = comm.bcast(message, root=0)
     collective_check(comm, message is None, message or "")
     local = comm.scatter(signs, root=0)
