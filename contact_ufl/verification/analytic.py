@@ -200,3 +200,89 @@ class CattaneoMindlin2D:
         a, c, p0 = self.hertz.a, self.c, self.hertz.p0
         stick = self.mu * (c / a) * p0 * np.sqrt(np.clip(1.0 - (x / c) ** 2, 0.0, None))
         return self.mu * self.hertz.pressure(x) - np.where(np.abs(x) < c, stick, 0.0)
+
+
+# -- Free inflation of membranes under a follower pressure -------------------------------------
+#
+# A pressure p (per unit current area) inflates a membrane of reference radius R and
+# thickness t0 homogeneously: every point moves radially, the stretch l = r / R is uniform.
+# With W(l) the membrane energy per unit reference area, the virtual work balance of a
+# sphere, 4 pi R^2 W'(l) = p dV/dl with V = 4/3 pi R^3 l^3, gives p = W'(l) / (R l^2); of a
+# long tube at axial stretch 1 (per unit length, or a plane-strain string ring per unit
+# depth), 2 pi R W'(l) = p dV/dl with V = pi R^2 l^2, gives p = W'(l) / (R l).
+
+
+def sphere_inflation_neo_hookean(mu: float, t0: float, R: float, stretch):
+    """Pressure of an incompressible Neo-Hookean spherical membrane at the stretch ``l``.
+
+    Equi-biaxial stretches ``l, l`` and the thickness stretch ``1/l^2``: ``W = t0 mu/2 (2 l^2
+    + l^-4 - 3)``, ``W' = 2 t0 mu (l - l^-5)`` and ``p = 2 mu t0 / R (1/l - 1/l^7)``; its
+    maximum is at ``l = 7^(1/6)``.
+    """
+    l = np.asarray(stretch, dtype=float)
+    return 2.0 * mu * t0 / R * (1.0 / l - l**-7)
+
+
+def sphere_inflation_svk(E: float, nu: float, t0: float, R: float, stretch):
+    """Pressure of a Saint Venant-Kirchhoff spherical membrane (plane stress) at the stretch ``l``.
+
+    ``E_s = e I`` with ``e = (l^2 - 1)/2``: ``W = t0 E / (2 (1 - nu^2)) ((1 - nu) 2 e^2 + nu (2
+    e)^2) = t0 E e^2 / (1 - nu)``, ``W' = 2 t0 E e l / (1 - nu)`` and ``p = t0 E (l^2 - 1) /
+    ((1 - nu) R l)``.
+    """
+    l = np.asarray(stretch, dtype=float)
+    return t0 * E * (l**2 - 1.0) / ((1.0 - nu) * R * l)
+
+
+def tube_inflation_neo_hookean(mu: float, t0: float, R: float, stretch):
+    """Pressure of an incompressible Neo-Hookean tube at axial stretch 1 (hoop stretch ``l``).
+
+    Stretches ``l, 1`` and the thickness stretch ``1/l``: ``W = t0 mu/2 (l^2 + l^-2 - 2)``,
+    ``W' = t0 mu (l - l^-3)`` and ``p = mu t0 / R (1 - l^-4)`` (bounded by ``mu t0 / R``).
+    """
+    l = np.asarray(stretch, dtype=float)
+    return mu * t0 / R * (1.0 - l**-4)
+
+
+def tube_inflation_svk(E: float, nu: float, t0: float, R: float, stretch):
+    """Pressure of a Saint Venant-Kirchhoff tube (plane stress) at axial stretch 1.
+
+    ``E_s = diag(e, 0)`` with ``e = (l^2 - 1)/2``: ``W = t0 E e^2 / (2 (1 - nu^2))``, ``W' = t0 E
+    e l / (1 - nu^2)`` and ``p = t0 E (l^2 - 1) / (2 (1 - nu^2) R)``.
+    """
+    l = np.asarray(stretch, dtype=float)
+    return t0 * E * (l**2 - 1.0) / (2.0 * (1.0 - nu**2) * R)
+
+
+def _condensed_neo_hookean(E: float, nu: float, area_stretch_sq):
+    """Lame parameters and ``J^2`` of the compressible Neo-Hookean membrane in plane stress
+    (:class:`~contact_ufl.membranes.MembraneCompressibleNeoHookean`): ``l3^2 = (2 mu +
+    lambda) / (2 mu + lambda J_s^2)``, ``J^2 = J_s^2 l3^2``."""
+    mu = E / (2.0 * (1.0 + nu))
+    lmbda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    J_sq = area_stretch_sq * (2.0 * mu + lmbda) / (2.0 * mu + lmbda * area_stretch_sq)
+    return mu, lmbda, J_sq
+
+
+def sphere_inflation_compressible_neo_hookean(E: float, nu: float, t0: float, R: float, stretch):
+    """Pressure of a compressible Neo-Hookean spherical membrane (plane stress) at ``l``.
+
+    ``psi = mu/2 (I1 - 3 - 2 ln J) + lambda/4 (J^2 - 1 - 2 ln J)`` with ``I1 = 2 l^2 + l3^2``,
+    ``J = l^2 l3`` and ``l3`` condensed (``d psi / d l3 = 0``); by that condition ``W' = t0
+    d psi / d l`` at fixed ``l3`` ``= t0 (2 mu (l - 1/l) + lambda (J^2 - 1) / l)``, and ``p = W'
+    / (R l^2)``.
+    """
+    l = np.asarray(stretch, dtype=float)
+    mu, lmbda, J_sq = _condensed_neo_hookean(E, nu, l**4)
+    return t0 * (2.0 * mu * (l - 1.0 / l) + lmbda * (J_sq - 1.0) / l) / (R * l**2)
+
+
+def tube_inflation_compressible_neo_hookean(E: float, nu: float, t0: float, R: float, stretch):
+    """Pressure of a compressible Neo-Hookean tube (plane stress) at axial stretch 1.
+
+    ``I1 = l^2 + 1 + l3^2``, ``J = l l3``, ``l3`` condensed: ``W' = t0 (mu (l - 1/l) + lambda
+    (J^2 - 1) / (2 l))`` and ``p = W' / (R l)``.
+    """
+    l = np.asarray(stretch, dtype=float)
+    mu, lmbda, J_sq = _condensed_neo_hookean(E, nu, l**2)
+    return t0 * (mu * (l - 1.0 / l) + lmbda * (J_sq - 1.0) / (2.0 * l)) / (R * l)
