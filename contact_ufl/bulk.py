@@ -3,8 +3,11 @@
 A :class:`Bulk` holds, for one :class:`~contact_ufl.scene.Domain` (a mesh and its bodies,
 supports and loads), the displacement ``u``, the measures, the virtual work of the bodies'
 stresses and of the loads in UFL, the plastic histories of elastoplastic bodies, and the
-prescribed-displacement dofs. The problem (:mod:`contact_ufl.problem`) composes one bulk per
-mesh with the contact interfaces between them.
+prescribed-displacement dofs. On a membrane (string) mesh the bodies' work is the
+derivative of the membrane energy (:mod:`contact_ufl.membranes`) and a follower pressure
+acts on the membrane cells along the oriented reference normal ``n0``. The problem
+(:mod:`contact_ufl.problem`) composes one bulk per mesh with the contact interfaces between
+them.
 """
 
 from __future__ import annotations
@@ -14,7 +17,14 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from contact_ufl.loads import BodyForce, deformation_gradient, evaluate, load_constant
+from contact_ufl import membranes
+from contact_ufl.loads import (
+    BodyForce,
+    FollowerPressure,
+    deformation_gradient,
+    evaluate,
+    load_constant,
+)
 from contact_ufl.plasticity import J2Plasticity, PlasticHistory
 from contact_ufl.scene import Body, Domain
 
@@ -30,7 +40,7 @@ class Bulk:
         Polynomial degree of the displacement.
     quadrature_degree
         Quadrature degree of the bulk integrals (default: exact for P1 simplices, ``2 p``
-        otherwise).
+        otherwise; ``2 p`` on a membrane).
 
     Attributes
     ----------
@@ -44,6 +54,11 @@ class Bulk:
         cell tag.
     dirichlet_dofs
         Local (owned) indices of the prescribed displacement dofs (unrolled).
+    membrane
+        Whether the mesh is a membrane (string): topological dimension ``gdim - 1``.
+    n0
+        (membrane) The oriented unit reference normal (UFL), from :attr:`orientation`, the
+        sign per cell of :func:`contact_ufl.membranes.cell_orientation`.
     """
 
     def __init__(self, domain: Domain, degree: int = 1, quadrature_degree: int | None = None):
@@ -58,7 +73,16 @@ class Bulk:
             dolfinx.mesh.CellType.triangle,
             dolfinx.mesh.CellType.tetrahedron,
         )
-        qdeg = quadrature_degree or (2 * degree - 1 if simplex else 2 * degree)
+        self.membrane = mesh.topology.dim < gdim
+        self.orientation, self.n0 = None, None
+        if self.membrane:
+            membranes.check_manifold(mesh)
+            self.orientation = membranes.cell_orientation(
+                mesh, outward=domain.outward, direction=domain.direction
+            )
+            self.n0 = membranes.reference_normal(mesh, orientation=self.orientation)
+        exact = 2 * degree - 1 if simplex and not self.membrane else 2 * degree
+        qdeg = quadrature_degree or exact
         self.dx = ufl.Measure(
             "dx", domain=mesh, subdomain_data=domain.cell_tags, metadata={"quadrature_degree": qdeg}
         )
@@ -86,15 +110,42 @@ class Bulk:
         return body.material.first_piola(deformation_gradient(self.u))
 
     def residual(self, v: ufl.Argument) -> ufl.Form:
-        """``int P : Grad v dV - (external virtual work)``: the bulk residual of this mesh."""
-        F = sum(ufl.inner(self.first_piola(b), ufl.grad(v)) * self.dx(b.tag) for b in self.bodies)
+        """``int P : Grad v dV - (external virtual work)``: the bulk residual of this mesh (a
+        membrane's: the derivative of its energy)."""
+        if self.membrane:
+            F = ufl.derivative(self.energy(), self.u, v)
+        else:
+            F = sum(
+                ufl.inner(self.first_piola(b), ufl.grad(v)) * self.dx(b.tag) for b in self.bodies
+            )
         for load, c in self.load_constants:
-            F -= load.virtual_work(self.u, v, self.measure(load), c)
+            F -= self.virtual_work(load, v, c)
         return F
 
+    def energy(self) -> ufl.Form:
+        """The stored energy ``sum_b int psi_b dV`` (per unit reference area on a
+        membrane) of the hyperelastic bodies."""
+        if self.membrane:
+            return sum(
+                b.material.strain_energy(self.u, self.n0) * self.dx(b.tag) for b in self.bodies
+            )
+        F = deformation_gradient(self.u)
+        return sum(b.material.strain_energy(F) * self.dx(b.tag) for b in self.bodies)
+
+    def virtual_work(self, load, v, constant: dolfinx.fem.Constant) -> ufl.Form:
+        """External virtual work of ``load`` (its value in ``constant``) on ``v``."""
+        if self.membrane and isinstance(load, FollowerPressure):
+            work = membranes.pressure_virtual_work(self.u, v, self.n0, constant)
+            return work * self.dx(load.tag)
+        return load.virtual_work(self.u, v, self.measure(load), constant)
+
     def measure(self, load) -> ufl.Measure:
-        """The measure a load acts on (cells for a body force, facets otherwise)."""
-        return self.dx if isinstance(load, BodyForce) else self.ds
+        """The measure a load acts on: cells for a body force and for a pressure on a
+        membrane, facets otherwise."""
+        on_cells = isinstance(load, BodyForce) or (
+            self.membrane and isinstance(load, FollowerPressure)
+        )
+        return self.dx if on_cells else self.ds
 
     def set_time(self, t: float) -> None:
         """Set the load constants to their values at pseudo-time ``t``."""
@@ -143,10 +194,7 @@ class Bulk:
             self._load_resultant_forms = []
             for i in range(gdim):
                 e_i = dolfinx.fem.Constant(mesh, np.eye(gdim)[i])
-                work = sum(
-                    load.virtual_work(self.u, e_i, self.measure(load), c)
-                    for load, c in self.load_constants
-                )
+                work = sum(self.virtual_work(load, e_i, c) for load, c in self.load_constants)
                 self._load_resultant_forms.append(dolfinx.fem.form(work) if work else None)
         local = [
             dolfinx.fem.assemble_scalar(f) if f is not None else 0.0
@@ -157,7 +205,5 @@ class Bulk:
     def stored_energy(self) -> float:
         """Elastic energy ``sum_b int psi_b(F) dV`` of the (hyperelastic) bodies."""
         if self._energy_form is None:
-            F = deformation_gradient(self.u)
-            energy = sum(b.material.strain_energy(F) * self.dx(b.tag) for b in self.bodies)
-            self._energy_form = dolfinx.fem.form(energy)
+            self._energy_form = dolfinx.fem.form(self.energy())
         return self.comm.allreduce(dolfinx.fem.assemble_scalar(self._energy_form))

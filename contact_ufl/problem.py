@@ -25,7 +25,7 @@ from contact_ufl.bulk import Bulk
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.layout import StackedLayout
-from contact_ufl.mpi import global_bounds
+from contact_ufl.mpi import global_bounds, global_diameter
 from contact_ufl.scene import Domain, Scene
 
 if TYPE_CHECKING:
@@ -35,8 +35,9 @@ if TYPE_CHECKING:
 
 def softer_modulus(parts: list[Domain], pair: ContactPair) -> float:
     """The smallest Young's modulus of the bodies whose cells hold the facets of ``pair``
-    (the slave body alone when the master is a rigid obstacle); ``parts`` are the scene's
-    domains, indexed by the pair's ``slave_domain`` and ``master_domain``."""
+    (the slave body alone when the master is a rigid obstacle; a membrane's is ``E t0 / L``
+    with ``L`` its mesh's diameter); ``parts`` are the scene's domains, indexed by the
+    pair's ``slave_domain`` and ``master_domain``."""
     sides = [(pair.slave_domain, pair.slave)]
     if not pair.on_obstacle:
         sides.append((pair.master_domain, pair.master))
@@ -52,7 +53,8 @@ def softer_modulus(parts: list[Domain], pair: ContactPair) -> float:
         cell_tag = np.full(imap.size_local + imap.num_ghosts, -1, dtype=np.int64)
         cell_tag[domain.cell_tags.indices] = domain.cell_tags.values
         found = mesh.comm.allreduce(set(cell_tag[cells].tolist()), MPI.BOR)
-        moduli += [b.material.E for b in domain.bodies if b.tag in found]
+        size = global_diameter(mesh.comm, mesh.geometry.x)
+        moduli += [b.modulus(size) for b in domain.bodies if b.tag in found]
     return min(moduli) if moduli else float("nan")
 
 
@@ -263,11 +265,12 @@ class ContactProblem:
         return np.concatenate([b.prescribed(t) for b in self.bulks])
 
     def scales(self) -> tuple[float, float]:
-        """The scene's diameter L and largest Young's modulus E (collective)."""
+        """The scene's diameter L and largest modulus E of its bodies (collective; a
+        membrane's is ``E t0 / L``: :meth:`Body.modulus <contact_ufl.scene.Body.modulus>`)."""
         x = np.vstack([b.V.mesh.geometry.x for b in self.bulks])
         lo, hi = global_bounds(self.comm, x)
-        E = max(body.material.E for b in self.bulks for body in b.bodies)
-        return float(np.linalg.norm(hi - lo)), E
+        size = float(np.linalg.norm(hi - lo))
+        return size, max(body.modulus(size) for b in self.bulks for body in b.bodies)
 
     # -- pseudo-time and the step protocol ----------------------------------------------
     def set_time(self, t: float) -> None:

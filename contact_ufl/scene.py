@@ -33,6 +33,7 @@ from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.errors import ContactInputError, collective_check
 from contact_ufl.loads import BodyForce, FollowerForce, FollowerPressure, Load, evaluate
 from contact_ufl.materials import Hyperelastic
+from contact_ufl.membranes import MembraneLaw, check_manifold
 from contact_ufl.plasticity import J2Plasticity
 
 if TYPE_CHECKING:
@@ -49,8 +50,21 @@ class Body:
     material."""
 
     tag: int | str
-    material: Hyperelastic | J2Plasticity
+    material: Hyperelastic | J2Plasticity | MembraneLaw
     name: str = ""
+
+    @property
+    def membrane(self) -> bool:
+        """Whether the body is a membrane (string): its material a membrane law."""
+        return isinstance(self.material, MembraneLaw)
+
+    def modulus(self, size: float) -> float:
+        """The stiffness scale of the body in a scene of size ``size``: Young's modulus of a
+        solid, ``E t0 / size`` of a membrane (the modulus of a solid of that size with the
+        membrane's stiffness per unit area). It scales eps_N, the supports' equations and
+        the Newton tolerance."""
+        E = self.material.E
+        return E * self.material.thickness / size if self.membrane else E
 
 
 @dataclass
@@ -77,6 +91,12 @@ class Domain:
         whose tags hold each value) when not given.
     name
         A name for messages and output files (default: ``mesh <index>``).
+    outward, direction
+        (membranes) The side the oriented reference normal ``n0`` of a membrane (string)
+        mesh points to: away from the point ``outward``, or along ``direction``; by default
+        away from the centroid of each connected piece of the surface (right for tubes,
+        spheres and their symmetry sectors; a flat membrane needs one of the two). A follower
+        pressure on a membrane pushes along ``n0`` (inflates it when ``n0`` points out).
 
     Notes
     -----
@@ -95,6 +115,8 @@ class Domain:
     tags: dict[str, int] = field(default_factory=dict)
     groups: dict[str, tuple[int, int]] = field(default_factory=dict)
     name: str = ""
+    outward: Sequence[float] | None = None
+    direction: Sequence[float] | None = None
 
     def __post_init__(self) -> None:
         if self.tags and not self.groups:
@@ -147,6 +169,11 @@ class Domain:
             name=name,
         )
 
+    @property
+    def membrane(self) -> bool:
+        """Whether the mesh is a membrane (string): topological dimension ``gdim - 1``."""
+        return self.mesh.topology.dim < self.mesh.geometry.dim
+
     def cell_tag(self, key: Tag) -> int:
         """The integer cell tag of ``key`` (an integer, or a cell group's name)."""
         return self._lookup(key, self.mesh.topology.dim, f"cell tag {key!r}")
@@ -154,6 +181,11 @@ class Domain:
     def facet_tag(self, key: Tag) -> int:
         """The integer facet tag of ``key`` (an integer, or a facet group's name)."""
         return self._lookup(key, self.mesh.topology.dim - 1, f"facet tag {key!r}")
+
+    def on_cells(self, load: Load) -> bool:
+        """Whether ``load`` acts on cells (a body force, a pressure on a membrane) rather
+        than on facets."""
+        return isinstance(load, BodyForce) or (self.membrane and isinstance(load, FollowerPressure))
 
     def group_names(self) -> dict[str, list[str]]:
         """The names of the cell and of the facet groups (``"cell"``, ``"facet"``)."""
@@ -215,7 +247,7 @@ class Domain:
             resolve(
                 ld,
                 "tag",
-                tdim if isinstance(ld, BodyForce) else tdim - 1,
+                tdim if self.on_cells(ld) else tdim - 1,
                 f"{type(ld).__name__} {ld.tag!r}",
             )
             for ld in self.loads
@@ -229,12 +261,7 @@ class Domain:
         comm = self.mesh.comm
         gdim, tdim = self.mesh.geometry.dim, self.mesh.topology.dim
         where = f"{self.name}: " if self.name else ""
-        collective_check(
-            comm,
-            gdim == tdim and gdim in (2, 3),
-            f"{where}solid bodies need a 2D (plane strain) or 3D mesh of full dimension; "
-            f"got topological dimension {tdim} in {gdim}D",
-        )
+        self._check_dimensions(where)
         collective_check(
             comm,
             self.cell_tags.dim == tdim,
@@ -254,7 +281,8 @@ class Domain:
                 f"{where}body {body.name or body.tag}: cell tag {body.tag} has no cells",
             )
         facet_values = comm.allreduce(set(np.unique(self.facet_tags.values).tolist()), MPI.BOR)
-        surface_loads = [ld for ld in self.loads if not isinstance(ld, BodyForce)]
+        cell_values = comm.allreduce(set(np.unique(self.cell_tags.values).tolist()), MPI.BOR)
+        surface_loads = [ld for ld in self.loads if not self.on_cells(ld)]
         for item in [*self.dirichlet, *surface_loads]:
             collective_check(
                 comm,
@@ -263,7 +291,51 @@ class Domain:
                 f"(facet tags: {sorted(facet_values)})",
             )
         for load in self.loads:
+            if self.on_cells(load):
+                collective_check(
+                    comm,
+                    load.tag in cell_values,
+                    f"{where}{type(load).__name__}: cell tag {load.tag} does not exist "
+                    f"(cell tags: {sorted(cell_values)})",
+                )
             _validate_load(comm, load, gdim, where)
+
+    def _check_dimensions(self, where: str) -> None:
+        """Solids on a mesh of full dimension, membranes (strings) on a surface (curve)
+        mesh: a clear error on every rank for a mismatch."""
+        comm = self.mesh.comm
+        gdim, tdim = self.mesh.geometry.dim, self.mesh.topology.dim
+        kinds = {b.membrane for b in self.bodies}
+        collective_check(
+            comm,
+            len(kinds) <= 1,
+            f"{where}a mesh holds solids or membranes, not both: bodies "
+            f"{[b.name or b.tag for b in self.bodies if b.membrane]} are membranes, "
+            f"{[b.name or b.tag for b in self.bodies if not b.membrane]} solids (give the "
+            "membranes a mesh of their own: a Domain)",
+        )
+        if self.membrane:
+            check_manifold(self.mesh)
+            collective_check(
+                comm,
+                kinds <= {True},
+                f"{where}solid bodies need a 2D (plane strain) or 3D mesh of full dimension; "
+                f"got topological dimension {tdim} in {gdim}D (a membrane mesh: give its "
+                "bodies a membrane law, e.g. MembraneNeoHookean)",
+            )
+        else:
+            collective_check(
+                comm,
+                gdim in (2, 3),
+                f"{where}solid bodies need a 2D (plane strain) or 3D mesh, got {gdim}D",
+            )
+            collective_check(
+                comm,
+                kinds <= {False},
+                f"{where}membrane bodies need a membrane mesh (triangles or quadrilaterals in "
+                f"3D, intervals in 2D), got a mesh of topological dimension {tdim} in {gdim}D "
+                "(a solid mesh: give its bodies a solid material)",
+            )
 
 
 @dataclass

@@ -113,3 +113,36 @@ def flat_square(comm: MPI.Comm, n: int = 4):
     i, j = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), indexing="ij")
     x = np.stack([i.ravel(), j.ravel(), np.zeros(i.size)], 1)
     return _create(comm, "triangle", _triangulated_grid(n, n), x, False)
+
+
+def with_tags(
+    mesh: dolfinx.mesh.Mesh, planes: dict[str, tuple[int, float]], name: str = "membrane"
+):
+    """The mesh with its groups: all cells ``name`` (tag 1), and the boundary facets (edges
+    of a membrane, vertices of a string) on each plane ``x[axis] = value`` of ``planes``
+    (name -> (axis, value); tags 1, 2, ... in order).
+
+    Returns a :class:`~contact_ufl.gmshio.MeshData`.
+    """
+    from contact_ufl.gmshio import MeshData
+
+    tdim = mesh.topology.dim
+    num_cells = mesh.topology.index_map(tdim).size_local + mesh.topology.index_map(tdim).num_ghosts
+    cells = np.arange(num_cells, dtype=np.int32)
+    cell_tags = dolfinx.mesh.meshtags(mesh, tdim, cells, np.ones_like(cells))
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    scale = np.abs(mesh.geometry.x).max(initial=1.0)
+    found, values = [], []
+    groups = {name: (tdim, 1)}
+    for tag, (plane, (axis, value)) in enumerate(planes.items(), start=1):
+        facets = dolfinx.mesh.locate_entities_boundary(
+            mesh, tdim - 1, lambda x, a=axis, v=value: np.isclose(x[a], v, atol=1e-9 * scale)
+        )
+        found.append(facets)
+        values.append(np.full(len(facets), tag, dtype=np.int32))
+        groups[plane] = (tdim - 1, tag)
+    facets = np.concatenate(found) if found else np.zeros(0, np.int32)
+    order = np.argsort(facets, kind="stable")
+    facet_values = np.concatenate(values) if values else np.zeros(0, np.int32)
+    facet_tags = dolfinx.mesh.meshtags(mesh, tdim - 1, facets[order], facet_values[order])
+    return MeshData(mesh, cell_tags, facet_tags, groups)

@@ -637,3 +637,36 @@ def on_meshes_of_their_own(scene: Scene) -> Scene:
         for p in scene.contacts
     ]
     return Scene(domains=domains, contacts=contacts)
+
+
+def inflated_sphere(
+    n: int = 32,
+    law=None,
+    pressure: float = 1.0,
+    R: float = 1.0,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """Free inflation of a spherical membrane: the octant ``x, y, z >= 0`` of the sphere of
+    radius ``R`` (``n`` triangles along each quarter arc), held normally on its three
+    symmetry planes, under a follower pressure ``pressure * t``.
+
+    The default law is :class:`~contact_ufl.membranes.MembraneNeoHookean` with ``mu = 1``,
+    ``t0 = 0.01``: its pressure maximum is ``2 mu t0 / R (7^(-1/6) - 7^(-7/6))`` at the
+    stretch ``7^(1/6)`` (:func:`~contact_ufl.verification.analytic.sphere_inflation_neo_hookean`).
+    """
+    from contact_ufl.loads import FollowerPressure
+    from contact_ufl.membranes import MembraneNeoHookean
+    from contact_ufl.verification import membrane_meshes
+
+    law = law or MembraneNeoHookean(1.0, 0.01)
+    mesh = membrane_meshes.sphere_octant(comm, R, n)
+    planes = {"x0": (0, 0.0), "y0": (1, 0.0), "z0": (2, 0.0)}
+    data = membrane_meshes.with_tags(mesh, planes)
+    domain = Domain.from_mesh_data(
+        data,
+        bodies=[Body("membrane", law)],
+        dirichlet=[Dirichlet(name, 0.0, component=axis) for name, (axis, _) in planes.items()],
+        loads=[FollowerPressure("membrane", lambda t: pressure * t)],
+        name="sphere",
+    )
+    return Scene(domains=[domain])

@@ -1,0 +1,90 @@
+"""Membranes in scenes: a membrane mesh as a Domain, solved by ContactProblem.
+
+The membrane mechanics of :mod:`contact_ufl.membranes` are verified on their own in
+``tests/test_membranes.py``; here the same closed forms check that the problem wires them in
+(energy, follower pressure along the oriented normal, supports on membrane edges), and that
+a wrong mesh for a body is refused.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import contact_ufl as cu
+from contact_ufl.membranes import MembraneNeoHookean
+from contact_ufl.results import equilibrium_error
+from contact_ufl.verification import analytic, scenes
+
+COMM = MPI.COMM_WORLD
+MU, T0, R = 1.0, 0.01, 1.0
+P_MAX = analytic.sphere_inflation_neo_hookean(MU, T0, R, 7.0 ** (1.0 / 6.0))
+
+
+def mean_stretch(bulk) -> float:
+    """Mean current distance of the nodes from the origin, over R (all ranks)."""
+    owned = bulk.V.dofmap.index_map.size_local
+    X = bulk.V.tabulate_dof_coordinates()[:owned]
+    x = X + bulk.u.x.array.reshape(-1, 3)[:owned]
+    return COMM.allreduce(np.linalg.norm(x, axis=1).sum()) / COMM.allreduce(owned) / R
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    """The Neo-Hookean sphere octant inflated to 95% of its pressure maximum."""
+    scene = scenes.inflated_sphere(n=32, law=MembraneNeoHookean(MU, T0), pressure=0.95 * P_MAX)
+    problem = cu.ContactProblem(scene, verbose=False)
+    stretches = []
+    problem.solve(num_steps=5, callback=lambda p, r: stretches.append(mean_stretch(p.bulks[0])))
+    return problem, np.array(stretches)
+
+
+def test_sphere_inflation_through_the_problem(sphere):
+    """Pressure against stretch within 0.5% of ``2 mu t0/R (1/l - 1/l^7)`` at every step."""
+    problem, stretches = sphere
+    assert problem.bulks[0].membrane
+    assert len(problem.history.steps) == 5 and not problem.history.cutbacks
+    pressures = 0.95 * P_MAX * np.linspace(0.2, 1.0, 5)
+    exact = analytic.sphere_inflation_neo_hookean(MU, T0, R, stretches)
+    assert np.all(stretches > 1.0) and stretches[-1] > 1.15
+    assert np.abs(pressures / exact - 1.0).max() < 5e-3
+
+
+def test_sphere_equilibrium(sphere):
+    """The supports on the three symmetry edges balance the follower pressure."""
+    problem, _ = sphere
+    load = problem.load_resultant()
+    # the pressure on an octant pushes out along +x, +y, +z alike
+    assert np.allclose(load, load[0], rtol=1e-2) and load[0] > 0.0
+    assert equilibrium_error(problem, ["x0", "y0", "z0"]) < 1e-8
+
+
+def test_membrane_law_on_a_solid_mesh_is_refused():
+    scene = scenes.patch()
+    law = MembraneNeoHookean(1.0, 0.01)
+    bodies = [dataclasses.replace(b, material=law) for b in scene.bodies]
+    with pytest.raises(cu.ContactInputError, match="membrane bodies need a membrane mesh"):
+        cu.ContactProblem(dataclasses.replace(scene, bodies=bodies), verbose=False)
+    mixed = [bodies[0], scene.bodies[1]]
+    with pytest.raises(cu.ContactInputError, match="solids or membranes, not both"):
+        cu.ContactProblem(dataclasses.replace(scene, bodies=mixed), verbose=False)
+
+
+def test_solid_material_on_a_membrane_mesh_is_refused():
+    scene = scenes.inflated_sphere(n=4)
+    (domain,) = scene.domains
+    bodies = [dataclasses.replace(domain.bodies[0], material=cu.NeoHookean(1.0, 0.3))]
+    bad = cu.Scene(domains=[dataclasses.replace(domain, bodies=bodies)])
+    with pytest.raises(cu.ContactInputError, match="solid bodies need"):
+        cu.ContactProblem(bad, verbose=False)
+
+
+def test_pressure_on_membrane_edges_is_refused():
+    """A pressure on a membrane acts on its cells: an edge group is the wrong dimension."""
+    scene = scenes.inflated_sphere(n=4)
+    (domain,) = scene.domains
+    with pytest.raises(cu.ContactInputError, match="has dimension 1"):
+        dataclasses.replace(domain, loads=[cu.FollowerPressure("x0", 1.0)])
