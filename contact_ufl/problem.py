@@ -46,9 +46,11 @@ def softer_modulus(parts: list[Domain], pair: ContactPair) -> float:
         domain = parts[k or 0]
         mesh = domain.mesh
         tdim = mesh.topology.dim
-        mesh.topology.create_connectivity(tdim - 1, tdim)
-        f2c = mesh.topology.connectivity(tdim - 1, tdim)
-        cells = f2c.array[f2c.offsets[domain.facet_tags.find(tag)]]
+        cells = domain.surface_tags.find(tag)
+        if not domain.membrane:  # the cells of the facets
+            mesh.topology.create_connectivity(tdim - 1, tdim)
+            f2c = mesh.topology.connectivity(tdim - 1, tdim)
+            cells = f2c.array[f2c.offsets[cells]]
         imap = mesh.topology.index_map(tdim)
         cell_tag = np.full(imap.size_local + imap.num_ghosts, -1, dtype=np.int64)
         cell_tag[domain.cell_tags.indices] = domain.cell_tags.values
@@ -153,12 +155,13 @@ class ContactProblem:
         master = self.bulks[pair.master_domain] if not pair.on_obstacle else slave
         return ContactInterface(
             slave.u,
-            slave.domain.facet_tags,
+            slave.domain.surface_tags,
             pair,
             softer_modulus(parts, pair),
             master_u=master.u,
-            master_facet_tags=master.domain.facet_tags,
+            master_facet_tags=master.domain.surface_tags,
             master_block=self.bulks.index(master),
+            master_orientation=master.orientation,
         )
 
     # -- one mesh: the attributes of a one-mesh problem ----------------------------------

@@ -187,13 +187,31 @@ class Domain:
         than on facets."""
         return isinstance(load, BodyForce) or (self.membrane and isinstance(load, FollowerPressure))
 
-    def group_names(self) -> dict[str, list[str]]:
-        """The names of the cell and of the facet groups (``"cell"``, ``"facet"``)."""
+    @property
+    def surface_dim(self) -> int:
+        """The dimension of the contact surfaces of this mesh: its facets, or the cells of
+        a membrane (string)."""
         tdim = self.mesh.topology.dim
+        return tdim if self.membrane else tdim - 1
+
+    @property
+    def surface_tags(self) -> dolfinx.mesh.MeshTags:
+        """The tags of the contact surfaces: the facet tags, or a membrane's cell tags."""
+        return self.cell_tags if self.membrane else self.facet_tags
+
+    def group_names(self) -> dict[str, list[str]]:
+        """The names of the cell, facet and contact-surface groups (``"cell"``,
+        ``"facet"``, ``"surface"``)."""
         return {
-            kind: sorted(n for n, (d, _) in self.groups.items() if d in (k, -1))
-            for kind, k in (("cell", tdim), ("facet", tdim - 1))
+            kind: sorted(n for n, (d, _) in self.groups.items() if d in (self.dimension(kind), -1))
+            for kind in ("cell", "facet", "surface")
         }
+
+    def dimension(self, kind: str) -> int:
+        """The dimension of the entities of ``kind``: ``"cell"``, ``"facet"`` or
+        ``"surface"`` (a contact surface: :attr:`surface_dim`)."""
+        tdim = self.mesh.topology.dim
+        return {"cell": tdim, "facet": tdim - 1, "surface": self.surface_dim}[kind]
 
     def _groups_from_tags(self) -> dict[str, tuple[int, int]]:
         """Name -> (dimension, tag) from :attr:`tags`: the dimension whose tags hold the
@@ -488,7 +506,8 @@ class Scene:
         key
             An integer tag, or the name of a physical group.
         kind
-            ``"facet"`` or ``"cell"``.
+            ``"facet"``, ``"cell"`` or ``"surface"`` (a contact surface: facets of a solid
+            mesh, cells of a membrane).
         domain
             The domain (index or name) that holds ``key``; default: the one whose groups
             have the name ``key``, or the only domain.
@@ -522,8 +541,7 @@ class Scene:
                 f"{what}: an integer tag in a scene of {len(parts)} meshes needs its domain "
                 "(give the group's name, or the domain)"
             )
-        tdim = parts[k].mesh.topology.dim
-        return k, parts[k]._lookup(key, tdim - 1 if kind == "facet" else tdim, what)
+        return k, parts[k]._lookup(key, parts[k].dimension(kind), what)
 
     def _domain_index(self, domain: int | str, parts: list[Domain]) -> int:
         names = [d.name for d in parts]
@@ -548,7 +566,7 @@ class Scene:
                 if not isinstance(key, RigidObstacle):
                     domain = getattr(pair, f"{side}_domain")
                     what = f"contact pair {k}, {side} surface"
-                    d, tag = self.locate(key, "facet", domain, what)
+                    d, tag = self.locate(key, "surface", domain, what)
                     changes[side], changes[f"{side}_domain"] = tag, d
             contacts.append(dataclasses.replace(pair, **changes))
         self.contacts = contacts

@@ -51,17 +51,21 @@ class ContactInterface:
     u
         The displacement of the slave's mesh.
     facet_tags
-        Facet tags of that mesh.
+        The tags of the contact surfaces of that mesh: its facet tags, or the cell tags of a
+        membrane (string) mesh, whose cells are its contact surface.
     pair
         The contact pair (integer tags).
     modulus
         Young's modulus of the softer of the two bodies: the scale of the default ``eps_N``
         (needed only when ``pair.eps_N`` is ``None``).
     master_u, master_facet_tags
-        The displacement and facet tags of the master's mesh (default: those of the slave:
-        both surfaces on one mesh).
+        The displacement and contact-surface tags of the master's mesh (default: those of
+        the slave: both surfaces on one mesh).
     master_block
         The block of ``master_u`` in the unknowns of the problem (one block per mesh).
+    master_orientation
+        (membrane master) The sign per cell of the membrane's oriented normal
+        (:func:`contact_ufl.membranes.cell_orientation`).
 
     Attributes
     ----------
@@ -85,6 +89,7 @@ class ContactInterface:
         master_u: dolfinx.fem.Function | None = None,
         master_facet_tags: dolfinx.mesh.MeshTags | None = None,
         master_block: int = 0,
+        master_orientation: dolfinx.fem.Function | None = None,
     ):
         V = u.function_space
         mesh = V.mesh
@@ -111,7 +116,9 @@ class ContactInterface:
         else:
             master_u = u if master_u is None else master_u
             master_tags = facet_tags if master_facet_tags is None else master_facet_tags
-            self.kinematics = self._mesh_side(master_u, master_tags, master_block, pair)
+            self.kinematics = self._mesh_side(
+                master_u, master_tags, master_block, master_orientation, pair
+            )
         eps_N = pair.eps_N if pair.eps_N is not None else default_eps(self.slave, modulus)
         self.normal = NormalLaw(self.slave, eps_N, self.touching)
         self.t_N = self.normal.traction(self.kinematics.gap, self.kinematics.mask)
@@ -128,6 +135,7 @@ class ContactInterface:
         master_u: dolfinx.fem.Function,
         facet_tags: dolfinx.mesh.MeshTags,
         block: int,
+        orientation: dolfinx.fem.Function | None,
         pair: ContactPair,
     ) -> MeshKinematics:
         """The kinematics of a meshed master surface (with its search)."""
@@ -138,7 +146,7 @@ class ContactInterface:
             not smoothed or gdim == 2,
             "master_normal='smoothed' is implemented for 2D (segment) master surfaces only",
         )
-        self.master = MeshMaster(master_u, facet_tags, pair.master, smoothed, block)
+        self.master = MeshMaster(master_u, facet_tags, pair.master, smoothed, block, orientation)
         size = global_diameter(
             comm,
             np.vstack([self.slave.X.reshape(-1, gdim), self.master.X_nodes.reshape(-1, gdim)]),

@@ -144,6 +144,11 @@ class MeshKinematics:
         self.mask = dolfinx.fem.Function(space(()))
         #: (smoothed normal) whether the neighbour before / after the facet exists
         self.neighbour_flags = dolfinx.fem.Function(space((2,))) if master.smoothed else None
+        #: (two-sided master, a membrane) the side of the master each slave point is on:
+        #: +1 in front of the master's oriented normal, -1 behind it (the normal acting on the
+        #: point is ``side`` times the master's); 0 before a point was first paired
+        self.side = dolfinx.fem.Function(space(())) if master.two_sided else None
+        self._side = np.zeros(slave.num_cells * slave.num_points)
         #: Freeze the projected point inside a Newton iteration (drop its variation from the
         #: tangent, as many codes do): Newton then converges only linearly. For comparisons.
         self.frozen_projection = False
@@ -185,6 +190,8 @@ class MeshKinematics:
         else:
             tangents = [interpolate([dN[a][al] for a in range(nn)], xh, gdim) for al in range(fdim)]
             self.nu = facet_normal(tangents, self.mask)
+        if self.side is not None:
+            self.nu = self.side * self.nu
         self.gap = -ufl.dot(self.nu, x - self.y)
 
     def master_point(self, xi, nodes) -> ufl.core.expr.Expr:
@@ -234,6 +241,31 @@ class MeshKinematics:
         slave.set_at_points(self.mask, paired.astype(float))
         if self.neighbour_flags is not None:
             slave.set_at_points(self.neighbour_flags, pairing.flags)
+        if self.side is not None:
+            self._face(pairing)
+            slave.set_at_points(self.side, self._side)
+
+    def _face(self, pairing: Pairing) -> None:
+        """The side of a two-sided master that acts on each paired point (in place: the
+        projection's normal and gap become those of that side).
+
+        A solid slave faces the master with its outward normal: the side whose normal
+        opposes the slave's current normal acts. A membrane slave has two sides too: a
+        point keeps the side it was on when it was first paired (its projection's side
+        then), so that it stays on it when it presses on the master.
+        """
+        proj, paired = pairing.projection, pairing.paired
+        if self.slave.membrane:
+            first = paired & (self._side == 0.0)
+            d = pairing.points[first] - proj.y[first]
+            self._side[first] = np.where(np.einsum("pd,pd->p", d, proj.normal[first]) < 0, -1, 1)
+        else:
+            n_slave = self.slave.current_normals(self.u)
+            facing = np.einsum("pd,pd->p", n_slave, proj.normal) > 0.0
+            self._side = np.where(paired, np.where(facing, -1.0, 1.0), self._side)
+        sign = np.where(paired, self._side, 1.0)
+        proj.normal *= sign[:, None]
+        proj.gap = np.where(paired, proj.gap * sign, proj.gap)
 
     @property
     def search_time(self) -> float:

@@ -45,6 +45,10 @@ class MeshMaster:
         Whether the normal is smoothed (2D): the neighbours of every segment are gathered.
     block
         The block of ``u`` in the unknowns of the problem (one block per mesh).
+    orientation
+        (membrane) The sign per cell of the membrane's oriented normal: ``facet_tags`` are
+        then the membrane's cell tags, its cells are the master facets, and the master is
+        two-sided (:attr:`two_sided`).
 
     Attributes
     ----------
@@ -69,10 +73,16 @@ class MeshMaster:
         tag: int,
         smoothed: bool,
         block: int = 0,
+        orientation: dolfinx.fem.Function | None = None,
     ):
         self.u, self.V = u, u.function_space
         self.facet_tags, self.tag, self.smoothed, self.block = facet_tags, tag, smoothed, block
-        self._build()
+        #: whether either side of the surface may be the one in contact (a membrane)
+        self.two_sided = facet_tags.dim == self.V.mesh.topology.dim
+        if self.two_sided:
+            self._build_membrane(orientation)
+        else:
+            self._build()
         #: nodes of a facet (the largest over the ranks: a rank may have no facet)
         self.nn = int(self.V.mesh.comm.allreduce(self.nodes.shape[1], MPI.MAX))
         #: nodes carried to a slave point: the facet's, and (smoothed) its two neighbours
@@ -122,7 +132,16 @@ class MeshMaster:
         flip = np.einsum("fd,fd->f", facet_normals(X), X.mean(axis=1) - cell_centre) < 0.0
         swap = (0, 1) if nv == 2 else (1, 2)
         nodes[flip, swap[0]], nodes[flip, swap[1]] = nodes[flip, swap[1]], nodes[flip, swap[0]]
+        geometry_nodes = np.take_along_axis(
+            mesh.geometry.dofmaps[0][cells], np.array(reference_facets)[local], axis=1
+        )
+        self._finish(nodes, geometry_nodes, flip, swap)
+
+    def _finish(self, nodes, geometry_nodes, flip, swap) -> None:
+        """Positions, global numbers, keys and boundary edges of the oriented facets of
+        ``nodes`` (geometry nodes of their vertices before the orientation swap)."""
         self.nodes = nodes
+        coords = self.V.tabulate_dof_coordinates()[:, : self.V.mesh.geometry.dim]
         self.X_nodes = coords[nodes]
         imap = self.V.dofmap.index_map
         self.global_nodes = imap.local_to_global(nodes.ravel().astype(np.int32)).reshape(
@@ -130,12 +149,24 @@ class MeshMaster:
         )
         # a key of each facet independent of the partition and of rigid motions: the sorted
         # input (file) indices of its vertices, to break ties between equidistant facets
-        geometry_nodes = np.take_along_axis(
-            mesh.geometry.dofmaps[0][cells], np.array(reference_facets)[local], axis=1
-        )
-        node_keys = mesh.geometry.input_global_indices[geometry_nodes]
+        node_keys = self.V.mesh.geometry.input_global_indices[geometry_nodes]
         self.keys = np.sort(node_keys, axis=1)
         self.boundary_edges = _boundary_edges(self.V.mesh.comm, node_keys, nodes, flip, swap)
+
+    def _build_membrane(self, orientation: dolfinx.fem.Function) -> None:
+        """The master facets of a membrane (string): its tagged cells, ordered so that the
+        normal of :mod:`.projection` is the membrane's oriented normal ``n0``."""
+        mesh = self.V.mesh
+        tdim = mesh.topology.dim
+        cells = tagged_facets(self.facet_tags, self.tag, "master")
+        cells = cells[cells < mesh.topology.index_map(tdim).size_local]
+        nv = len(basix.topology(basix_cell(mesh, tdim))[0])
+        nodes = self.V.dofmap.list[cells][:, :nv].copy()  # P1: the vertex dofs, in cell order
+        sign = orientation.x.array[orientation.function_space.dofmap.list[cells, 0]]
+        flip = sign < 0.0
+        swap = (0, 1) if nv == 2 else (1, 2)
+        nodes[flip, swap[0]], nodes[flip, swap[1]] = nodes[flip, swap[1]], nodes[flip, swap[0]]
+        self._finish(nodes, mesh.geometry.dofmaps[0][cells][:, :nv], flip, swap)
 
     @property
     def num_facets(self) -> int:

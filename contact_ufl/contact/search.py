@@ -118,6 +118,10 @@ class ClosestPointSearch:
         normals = np.repeat(self.slave.normals, self.slave.num_points, axis=0)
         outside = np.einsum("pd,pd->p", proj.normal, x - proj.y) >= -1e-8 * (1 + proj.distance)
         opposed = np.einsum("pd,pd->p", proj.normal, normals) < 0.0
+        if self.master.two_sided:  # a membrane master: either side may face the point
+            outside = opposed = True
+        elif self.slave.membrane:  # a membrane slave: either of its sides may face
+            opposed = True
         facing = np.count_nonzero((proj.facet >= 0) & outside & opposed)
         total = self.comm.allreduce(facing, MPI.SUM)
         collective_check(

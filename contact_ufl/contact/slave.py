@@ -31,6 +31,7 @@ from contact_ufl.contact.facets import (
     basix_cell,
     coordinate_element,
     exterior_facet_cells,
+    facet_normals,
     outward_normals,
     scalar_element,
     tagged_facets,
@@ -80,24 +81,34 @@ class SlaveSurface:
 
     def __post_init__(self) -> None:
         mesh = self.V.mesh
-        tdim, fdim = mesh.topology.dim, mesh.topology.dim - 1
-        facets = tagged_facets(self.facet_tags, self.tag, "slave")
-        cells, local = exterior_facet_cells(mesh, facets, "slave")
-        self.submesh, self.entity_map = dolfinx.mesh.create_submesh(mesh, fdim, facets)[:2]
-        num_owned = self.submesh.topology.index_map(fdim).size_local
+        tdim = mesh.topology.dim
+        #: whether the surface is a membrane's (string's) cells rather than facets of a solid
+        self.membrane = self.facet_tags.dim == tdim
+        sdim = self.facet_tags.dim
+        entities = tagged_facets(self.facet_tags, self.tag, "slave")
+        self.submesh, self.entity_map = dolfinx.mesh.create_submesh(mesh, sdim, entities)[:2]
+        num_owned = self.submesh.topology.index_map(sdim).size_local
         sub_cells = np.arange(num_owned, dtype=np.int32)
         parent = self.entity_map.sub_topology_to_topology(sub_cells, inverse=False)
-        order = np.argsort(facets)
-        pos = order[np.searchsorted(facets, parent, sorter=order)]
-        self.parent_cells = cells[pos]
-        parent_local = local[pos]
+        parent_cell = basix_cell(mesh, tdim)
+        if self.membrane:
+            self.parent_cells = parent
+            nv = len(basix.topology(parent_cell)[0])
+            local_vertices = np.tile(np.arange(nv), (len(parent), 1))
+        else:
+            cells, local = exterior_facet_cells(mesh, entities, "slave")
+            order = np.argsort(entities)
+            pos = order[np.searchsorted(entities, parent, sorter=order)]
+            self.parent_cells = cells[pos]
+            facet_vertices = np.array(basix.topology(parent_cell)[tdim - 1])
+            local_vertices = facet_vertices[local[pos]]
 
-        sub_cell = basix_cell(self.submesh, fdim)
+        sub_cell = basix_cell(self.submesh, sdim)
         self.points_ref, self.weights_ref = composite_quadrature(
             sub_cell, self.quadrature_degree, self.subdivisions, self.rule
         )
         self.num_points = len(self.weights_ref)
-        ref = self._parent_reference_points(sub_cell, parent_local, tdim)
+        ref = self._parent_reference_points(sub_cell, local_vertices, tdim)
         self._ref = ref
         nc, nq = len(self.parent_cells), self.num_points
         flat = ref.reshape(-1, tdim)
@@ -110,7 +121,11 @@ class SlaveSurface:
         vertices = self.submesh.geometry.x[
             self.submesh.geometry.dofmaps[0][:nc, :nv], : mesh.geometry.dim
         ]
-        self.normals = outward_normals(vertices, xg.mean(axis=1))
+        if self.membrane:  # the normals of the vertex order: a membrane has two sides
+            n = facet_normals(vertices)
+            self.normals = n / np.linalg.norm(n, axis=1, keepdims=True)
+        else:
+            self.normals = outward_normals(vertices, xg.mean(axis=1))
         tab_u = scalar_element(self.V).tabulate(1, flat)[..., 0]  # (1 + tdim, npts, ndofs)
         self._phi_u = tab_u[0].reshape(nc, nq, tab_u.shape[-1])
         # reference gradients of the displacement basis: Grad phi = J^-T grad_xi phi
@@ -118,11 +133,14 @@ class SlaveSurface:
         dgeom = dgeom.reshape(tdim, nc, nq, dgeom.shape[-1])
         jac = np.einsum("kcqn,cnd->cqdk", dgeom, xg)  # dX/dxi, (nc, nq, gdim, tdim)
         dphi = tab_u[1:].reshape(tdim, nc, nq, tab_u.shape[-1])
-        self._grad_phi_u = np.einsum("cqkd,kcqn->cqnd", np.linalg.inv(jac), dphi)
+        # (a membrane: the pseudo-inverse, the tangential gradient as UFL's on a manifold)
+        inverse = np.linalg.pinv(jac) if self.membrane else np.linalg.inv(jac)
+        self._grad_phi_u = np.einsum("cqkd,kcqn->cqnd", inverse, dphi)
         self._cell_dofs = self.V.dofmap.list[self.parent_cells]
-        #: the contact measure: the parent ``ds`` over the slave facets, with the rule's degree
+        #: the contact measure: the parent ``ds`` over the slave facets (``dx`` over the
+        #: cells of a membrane), with the rule's degree
         self.ds = ufl.Measure(
-            "ds",
+            "dx" if self.membrane else "ds",
             domain=mesh,
             subdomain_data=self.facet_tags,
             subdomain_id=self.tag,
@@ -133,21 +151,21 @@ class SlaveSurface:
         p1 = self.P1.ufl_element().basix_element
         self._phi_p1 = p1.tabulate(0, self.points_ref)[0, :, :, 0]  # (nq, nv)
 
-    def _parent_reference_points(self, sub_cell, parent_local, tdim) -> np.ndarray:
+    def _parent_reference_points(self, sub_cell, local_vertices, tdim) -> np.ndarray:
         """Map the submesh quadrature points into the parent reference cells.
 
-        The submesh cell's vertices are a permutation of its parent facet's vertices; matching
-        them by position gives an affine map between the two reference facets.
+        The submesh cell's vertices are a permutation of its parent facet's (cell's, for a
+        membrane) vertices ``local_vertices`` ``(nc, nv)`` (local vertex numbers in the parent
+        cell); matching them by position gives an affine map between the two reference
+        entities.
         """
         mesh = self.V.mesh
-        gdim, fdim = mesh.geometry.dim, tdim - 1
+        gdim = mesh.geometry.dim
         parent_cell = basix_cell(mesh, tdim)
         ref_vertices = basix.geometry(parent_cell)
-        facet_vertices = np.array(basix.topology(parent_cell)[fdim])  # (nfacets, nv)
-        nv = facet_vertices.shape[1]
+        nv = local_vertices.shape[1]
         # vertex positions of the parent facets (geometry nodes = first nodes are vertices)
         cell_nodes = mesh.geometry.dofmaps[0][self.parent_cells]
-        local_vertices = facet_vertices[parent_local]  # (nc, nv)
         xpar = mesh.geometry.x[np.take_along_axis(cell_nodes, local_vertices, axis=1), :gdim]
         sub_nodes = self.submesh.geometry.dofmaps[0][: len(self.parent_cells), :nv]
         xsub = self.submesh.geometry.x[sub_nodes, :gdim]
@@ -182,6 +200,15 @@ class SlaveSurface:
         N = np.broadcast_to(self.normals[:, None, :], F.shape[:-1])
         FinvT_N = np.linalg.solve(np.swapaxes(F, -1, -2), N[..., None])[..., 0]
         return np.linalg.det(F) * np.linalg.norm(FinvT_N, axis=-1)
+
+    def current_normals(self, u: dolfinx.fem.Function) -> np.ndarray:
+        """Current unit normals ``F^-T N / |F^-T N|`` at the points, ``(npoints, gdim)``
+        (of a membrane: on the side of its vertex-order normal)."""
+        F = self.deformation_gradient(u)
+        N = np.broadcast_to(self.normals[:, None, :], F.shape[:-1])
+        n = np.linalg.solve(np.swapaxes(F, -1, -2), N[..., None])[..., 0]
+        n /= np.linalg.norm(n, axis=-1, keepdims=True)
+        return n.reshape(-1, F.shape[-1])
 
     def positions(self, u: dolfinx.fem.Function) -> np.ndarray:
         """Current positions x = X + u of the quadrature points, ``(ncells, nq, gdim)``."""

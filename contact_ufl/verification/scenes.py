@@ -670,3 +670,81 @@ def inflated_sphere(
         name="sphere",
     )
     return Scene(domains=[domain])
+
+
+def surface_as_membrane(
+    scene: Scene, facet_tag: int, body_tag: int, law, direction, name: str = "membrane"
+) -> Domain:
+    """A membrane (string) on a mesh of its own made of the facets ``facet_tag`` of the
+    one-mesh ``scene`` (a surface of a solid taken alone), its cells tagged ``body_tag``
+    (also its contact surface) and its boundary (edges; the end points of a string) tagged 1
+    (group ``"<name>_boundary"``), with the material ``law`` and its normal along
+    ``direction`` (:class:`~contact_ufl.scene.Domain`)."""
+    mesh = scene.mesh
+    tdim = mesh.topology.dim
+    facets = scene.facet_tags.find(facet_tag)
+    sub = dolfinx.mesh.create_submesh(mesh, tdim - 1, facets)[0]
+    imap = sub.topology.index_map(tdim - 1)
+    cells = np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32)
+    cell_tags = dolfinx.mesh.meshtags(sub, tdim - 1, cells, np.full_like(cells, body_tag))
+    sub.topology.create_entities(tdim - 2)
+    sub.topology.create_connectivity(tdim - 2, tdim - 1)
+    boundary = dolfinx.mesh.exterior_facet_indices(sub.topology)
+    facet_tags = dolfinx.mesh.meshtags(sub, tdim - 2, boundary, np.ones_like(boundary))
+    return Domain(
+        sub,
+        cell_tags,
+        facet_tags,
+        [Body(body_tag, law, name)],
+        groups={name: (tdim - 1, body_tag), f"{name}_boundary": (tdim - 2, 1)},
+        name=name,
+        direction=direction,
+    )
+
+
+def with_membrane(scene: Scene, side: str, law, direction) -> Scene:
+    """The two-body one-mesh ``scene`` (one contact pair) with one body replaced by a
+    membrane made of its contact surface (:func:`surface_as_membrane`): ``side`` is
+    ``"master"`` or ``"slave"``; the other body keeps a mesh of its own."""
+    split = on_meshes_of_their_own(scene)
+    (pair,) = split.contacts
+    k = getattr(pair, f"{side}_domain")
+    body_tag = split.domains[k].bodies[0].tag
+    membrane = surface_as_membrane(scene, getattr(pair, side), body_tag, law, direction)
+    domains = list(split.domains)
+    domains[k] = membrane
+    return Scene(domains=domains, contacts=[dataclasses.replace(pair, **{side: body_tag})])
+
+
+def membrane_sandwich(dim: int = 2, pressure: float = 0.01, law=None) -> Scene:
+    """A membrane (string) between the two blocks of the contact patch test (:func:`patch`):
+    the upper block presses on the membrane (a master, two-sided), the membrane on the lower
+    block (a slave), under the uniform pressure on top. The blocks are held normally on all
+    their sides (confined compression: no lateral displacement) and the membrane's boundary
+    in its plane. Exact solution: homogeneous, with the multipliers of both pairs equal to
+    ``pressure`` (the membrane stays flat, unstretched, and carries no tension).
+    """
+    from contact_ufl.membranes import MembraneNeoHookean
+
+    law = law or MembraneNeoHookean(1.0, 0.01)
+    scene = patch(dim, pressure, quadrature_degree=3, subdivisions=8 if dim == 2 else 2)
+    split = on_meshes_of_their_own(scene)
+    far = {0: "right"} if dim == 2 else {0: "x1", 1: "y1"}
+    upper, lower = (
+        dataclasses.replace(
+            d,
+            dirichlet=[
+                *d.dirichlet,
+                *(Dirichlet(f"{d.name}_{face}", 0.0, component=k) for k, face in far.items()),
+            ],
+        )
+        for d in split.domains
+    )
+    (pair,) = split.contacts
+    up = np.eye(dim)[dim - 1]
+    membrane = surface_as_membrane(scene, pair.master, 100, law, up)
+    in_plane = [Dirichlet("membrane_boundary", 0.0, component=k) for k in range(dim - 1)]
+    membrane = dataclasses.replace(membrane, dirichlet=in_plane)
+    on_membrane = dataclasses.replace(pair, master=100, master_domain=2)
+    membrane_on_lower = dataclasses.replace(pair, slave=100, slave_domain=2, master_domain=1)
+    return Scene(domains=[upper, lower, membrane], contacts=[on_membrane, membrane_on_lower])

@@ -16,8 +16,9 @@ import numpy as np
 from petsc4py import PETSc
 
 from contact_ufl.contact.obstacles import RigidCylinder, RigidObstacle, RigidSphere
+from contact_ufl.membranes import MembraneNeoHookean
 from contact_ufl.problem import ContactProblem
-from contact_ufl.verification.scenes import curved_pair, on_meshes_of_their_own
+from contact_ufl.verification.scenes import curved_pair, on_meshes_of_their_own, with_membrane
 
 __all__ = [
     "CURVED_STATES",
@@ -113,6 +114,8 @@ def curved_case(
     mu: float = 0.0,
     master_normal: str = "facet",
     own_meshes: bool = False,
+    membrane: str | None = None,
+    direction: float = 1.0,
 ):
     """The Taylor test case on curved surfaces: problem at its state, direction, steps.
 
@@ -121,12 +124,18 @@ def curved_case(
     puts the contact points in slip, a large one in stick). Over the steps no slave point
     changes master facet, contact status or stick/slip status. ``master_normal`` is that
     of :class:`~contact_ufl.contact.ContactPair`. With ``own_meshes`` each body is on a
-    mesh of its own (:func:`~contact_ufl.verification.scenes.on_meshes_of_their_own`).
+    mesh of its own (:func:`~contact_ufl.verification.scenes.on_meshes_of_their_own`). With
+    ``membrane="master"`` (``"slave"``) the lower (upper) body is replaced by a Neo-Hookean
+    membrane made of its contact surface (:func:`~contact_ufl.verification.scenes.with_membrane`),
+    its normal up (``direction = 1``) or down (``-1``).
     """
     scene = curved_pair(dim)
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu, master_normal=master_normal)
     if own_meshes:
         scene = on_meshes_of_their_own(scene)
+    if membrane:
+        up = direction * np.eye(dim)[dim - 1]
+        scene = with_membrane(scene, membrane, MembraneNeoHookean(1.0, 0.05), up)
     problem = ContactProblem(scene, verbose=False)
     solver = problem.solver  # made at the reference state, the converged state of step 0
     state = CURVED_STATES[dim]
