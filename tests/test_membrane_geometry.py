@@ -1,0 +1,274 @@
+"""Verification material for contact with membranes: meshes with named groups, the closed
+form of an inflated tube pressed between two plates, and the pre-tensioned drumhead.
+
+The meshes' groups are counted over all ranks (owned entities only). The plates-and-tube
+closed form is checked against its own statement (``w = 0`` at the free radius, ``F = p w``,
+the rigid limit) and independently against the potential energy of the stadium-shaped tube
+minimised numerically. The drumhead runs through ``ContactProblem`` (no contact): its edge
+supports keep the equi-biaxial pre-stretch exactly, and under a small pressure its
+deflection is the Fourier series of ``T Laplace w = -p``.
+"""
+
+from __future__ import annotations
+
+import contact_ufl  # noqa: F401  (loads MPI and PETSc first)
+
+# isort: split
+import dolfinx
+import numpy as np
+import pytest
+from mpi4py import MPI
+from scipy.optimize import minimize_scalar
+
+import contact_ufl as cu
+from contact_ufl.results import equilibrium_error
+from contact_ufl.verification import analytic, scenes
+from contact_ufl.verification import membrane_meshes as meshes
+
+COMM = MPI.COMM_WORLD
+MU, T0, R0 = 1.0, 0.01, 1.0
+P = 0.5 * MU * T0 / R0
+
+
+def owned_count(data, name: str) -> int:
+    """Number of entities of the group ``name`` over all ranks (each counted once)."""
+    dim, tag = data.groups[name]
+    tags = data.cell_tags if dim == data.mesh.topology.dim else data.facet_tags
+    owned = data.mesh.topology.index_map(dim).size_local
+    return COMM.allreduce(int(np.sum(tags.indices[tags.values == tag] < owned)), MPI.SUM)
+
+
+def group_coordinates(data, name: str) -> np.ndarray:
+    """The coordinates of the vertices of the entities of the facet group ``name`` (local)."""
+    dim, tag = data.groups[name]
+    entities = data.facet_tags.find(tag)
+    mesh = data.mesh
+    mesh.topology.create_connectivity(dim, 0)
+    nodes = dolfinx.mesh.entities_to_geometry(mesh, dim, entities)
+    return mesh.geometry.x[nodes.ravel()]
+
+
+# -- meshes with named groups ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("quarters", "x0", "y0"), [(1, 1, 1), (2, 1, 2), (4, 2, 2)], ids=["quarter", "half", "ring"]
+)
+def test_string_ring_groups(quarters, x0, y0):
+    n = 6
+    data = meshes.string_ring(COMM, R0, n, quarters)
+    assert data.groups == {"tube": (1, 1), "x0": (0, 1), "y0": (0, 2)}
+    assert owned_count(data, "tube") == quarters * n
+    assert (owned_count(data, "x0"), owned_count(data, "y0")) == (x0, y0)
+    for name, axis in (("x0", 0), ("y0", 1)):
+        x = group_coordinates(data, name)
+        assert np.allclose(x[:, axis], 0.0, atol=1e-12)
+        assert np.allclose(np.linalg.norm(x, axis=1), R0)
+
+
+@pytest.mark.parametrize("cell", ["quadrilateral", "triangle"])
+def test_tube_quarter_groups(cell):
+    n, n_axial, length = 8, 3, 0.3
+    data = meshes.tube_quarter(COMM, R0, n, length, n_axial, cell=cell)
+    assert data.groups == {
+        "tube": (2, 1),
+        "x0": (1, 1),
+        "y0": (1, 2),
+        "z0": (1, 3),
+        "z1": (1, 4),
+    }
+    per_quad = 1 if cell == "quadrilateral" else 2
+    assert owned_count(data, "tube") == per_quad * n * n_axial
+    counts = [owned_count(data, name) for name in ("x0", "y0", "z0", "z1")]
+    assert counts == [n_axial, n_axial, n, n]
+    for name, axis, value in (("x0", 0, 0.0), ("y0", 1, 0.0), ("z0", 2, 0.0), ("z1", 2, length)):
+        assert np.allclose(group_coordinates(data, name)[:, axis], value, atol=1e-12)
+
+
+@pytest.mark.parametrize("quarter", [False, True], ids=["whole", "quarter"])
+def test_drumhead_groups(quarter):
+    n, a = 4, 0.5
+    data = meshes.drumhead(COMM, a, n, quarter)
+    names = ("x0", "y0", "xmax", "ymax") if quarter else ("xmin", "xmax", "ymin", "ymax")
+    assert list(data.groups) == ["membrane", *names]
+    side = n if quarter else 2 * n
+    assert owned_count(data, "membrane") == 2 * side**2
+    assert [owned_count(data, name) for name in names] == [side] * 4
+    x = group_coordinates(data, "xmax")
+    assert np.allclose(x[:, 0], a) and np.allclose(x[:, 2], 0.0)
+
+
+def test_drumhead_is_symmetric():
+    """The diagonals point to the centre: the mesh maps onto itself under x -> -x."""
+    data = meshes.drumhead(MPI.COMM_SELF, 0.5, 3)
+    mesh = data.mesh
+    tdim = mesh.topology.dim
+    cells = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
+    centroids = dolfinx.mesh.compute_midpoints(mesh, tdim, cells)
+    key = np.round(centroids[:, :2], 9)
+    mirrored = key * np.array([-1.0, 1.0])
+    assert {tuple(k) for k in key} == {tuple(k) for k in mirrored}
+
+
+# -- the plates-and-tube closed form -----------------------------------------------------------
+
+
+def test_tube_touches_plates_at_the_free_radius():
+    r_free = analytic.tube_free_radius(MU, T0, R0, P)
+    assert np.isclose(analytic.tube_inflation_neo_hookean(MU, T0, R0, r_free / R0), P)
+    result = analytic.tube_between_plates(MU, T0, R0, P, r_free)
+    assert abs(result["width"]) < 1e-12 and np.isclose(result["stretch"], r_free / R0)
+
+
+def test_tube_between_plates_relations():
+    r_free = analytic.tube_free_radius(MU, T0, R0, P)
+    r = np.linspace(0.3, 1.0, 8) * r_free
+    result = analytic.tube_between_plates(MU, T0, R0, P, r)
+    l, w = result["stretch"], result["width"]
+    assert l.shape == w.shape == r.shape
+    assert np.allclose(result["force"], P * w) and np.allclose(result["contact_pressure"], P)
+    assert np.allclose(analytic.tube_hoop_tension_neo_hookean(MU, T0, l), P * r, rtol=1e-13)
+    assert np.allclose(2.0 * np.pi * r + 2.0 * w, 2.0 * np.pi * R0 * l)
+    assert np.all(np.diff(w) < 0.0) and np.all(np.diff(l) > 0.0)  # closing widens the contact
+
+
+def test_tube_between_plates_rigid_limit():
+    r = np.array([0.5, 0.8, 0.99]) * R0
+    result = analytic.tube_between_plates(1e9, T0, R0, P, r)
+    assert np.allclose(result["width"], np.pi * (R0 - r), rtol=1e-6)
+    assert np.allclose(result["stretch"], 1.0, atol=1e-8)
+
+
+def stadium_potential(l: float, r: float) -> float:
+    """Energy of the stadium of half height ``r`` at the hoop stretch ``l`` (per unit length):
+    stored energy ``2 pi R0 W(l)`` minus ``p`` times the enclosed area ``pi r^2 + 2 r w``."""
+    W = 0.5 * MU * T0 * (l**2 + l**-2 - 2.0)
+    w = np.pi * (R0 * l - r)
+    return 2.0 * np.pi * R0 * W - P * (np.pi * r**2 + 2.0 * r * w)
+
+
+def minimised_potential(r: float) -> tuple[float, float]:
+    """The stretch minimising :func:`stadium_potential` at ``r``, and the minimum."""
+    best = minimize_scalar(
+        stadium_potential,
+        bounds=(r / R0, 3.0),
+        args=(r,),
+        method="bounded",
+        options={"xatol": 1e-12},
+    )
+    return best.x, best.fun
+
+
+def test_tube_between_plates_minimises_the_potential():
+    """Independent of the derivation: the stretch minimises the energy at fixed plates, and
+    the plate force is the virtual work of the plates, ``2 F = -d(min energy)/dr``."""
+    r, h = 0.9 * R0, 1e-4
+    result = analytic.tube_between_plates(MU, T0, R0, P, r)
+    l_min, _ = minimised_potential(r)
+    assert np.isclose(l_min, result["stretch"], rtol=1e-7)
+    force = -(minimised_potential(r + h)[1] - minimised_potential(r - h)[1]) / (4.0 * h)
+    assert np.isclose(force, result["force"], rtol=1e-5)
+
+
+def test_tube_between_plates_bad_input():
+    r_free = analytic.tube_free_radius(MU, T0, R0, P)
+    with pytest.raises(ValueError, match="not in \\(0, r_free\\]"):
+        analytic.tube_between_plates(MU, T0, R0, P, [0.9, 1.01 * r_free])
+    with pytest.raises(ValueError, match="limit mu t0 / R0"):
+        analytic.tube_free_radius(MU, T0, R0, MU * T0 / R0)
+    with pytest.raises(ValueError, match="mu must be positive"):
+        analytic.tube_between_plates(-1.0, T0, R0, P, 0.9)
+
+
+def test_plates_schedule():
+    r_free = analytic.tube_free_radius(MU, T0, R0, P)
+    schedule = scenes.PlatesSchedule(P, 1.05 * r_free, 0.9 * r_free, t_inflate=0.2)
+    assert schedule.p(0.1) == pytest.approx(0.5 * P) and schedule.p(0.7) == P
+    assert schedule.half_separation(0.2) == pytest.approx(1.05 * r_free)
+    assert schedule.half_separation(1.0) == pytest.approx(0.9 * r_free)
+    plate = schedule.plate(3, side=-1.0)
+    assert plate.normal == (0.0, 1.0, 0.0) and plate.point == (0.0, -1.05 * r_free, 0.0)
+    assert np.allclose(plate.motion(1.0), (0.0, 0.15 * r_free, 0.0))
+    with pytest.raises(ValueError, match="r_end < r_start"):
+        scenes.PlatesSchedule(P, 0.9, 1.0)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_tube_for_plates_inflates_to_the_free_radius(dim):
+    """Through ContactProblem (no contact yet): the inflation phase ends at ``r_free``."""
+    r_free = analytic.tube_free_radius(MU, T0, R0, P)
+    schedule = scenes.PlatesSchedule(P, 1.05 * r_free, 0.9 * r_free)
+    domain = scenes.tube_for_plates(schedule, dim=dim, n=24)
+    problem = cu.ContactProblem(cu.Scene(domains=[domain]), verbose=False)
+    problem.solve(num_steps=4, t_end=schedule.t_inflate)
+    bulk = problem.bulks[0]
+    owned = bulk.V.dofmap.index_map.size_local
+    X = bulk.V.tabulate_dof_coordinates()[:, :dim]
+    x = (X + bulk.u.x.array.reshape(-1, dim))[:owned, :2]
+    radius = np.linalg.norm(x, axis=1)
+    r_min, r_max = COMM.allreduce(radius.min(), MPI.MIN), COMM.allreduce(radius.max(), MPI.MAX)
+    assert r_max - r_min < 1e-9  # symmetric: the nodes stay on one circle
+    assert 0.0 < 1.0 - r_max / r_free < 5e-4  # the P1 polygon is stiffer: O(h^2) below
+    assert equilibrium_error(problem, ["x0", "y0"]) < 1e-8
+
+
+# -- the pre-tensioned drumhead ----------------------------------------------------------------
+
+STRETCH, A = 1.05, 0.5
+
+
+def solve_drumhead(n: int, pressure: float, quarter: bool = False):
+    domain = scenes.pretensioned_drumhead(n, A, STRETCH, pressure, quarter=quarter)
+    problem = cu.ContactProblem(cu.Scene(domains=[domain]), verbose=False)
+    scenes.pretension(problem, STRETCH)
+    problem.solve(num_steps=1)
+    bulk = problem.bulks[0]
+    owned = bulk.V.dofmap.index_map.size_local
+    x = (bulk.V.tabulate_dof_coordinates() + bulk.u.x.array.reshape(-1, 3))[:owned]
+    return problem, x
+
+
+def test_drumhead_pretension_is_exact():
+    """No pressure: the pre-stretch is the solution; each edge carries the nominal tension
+    ``mu t0 (s - s^-5)`` over its reference length ``2 a``."""
+    problem, x = solve_drumhead(4, 0.0)
+    assert problem.history.steps[0].newton_iterations <= 1
+    X = problem.bulks[0].V.tabulate_dof_coordinates()[: len(x)]
+    assert np.allclose(x[:, :2], STRETCH * X[:, :2], atol=1e-12) and np.allclose(x[:, 2], 0.0)
+    reaction = problem.reaction("xmax")
+    nominal = MU * T0 * (STRETCH - STRETCH**-5)
+    assert np.isclose(reaction[0], nominal * 2.0 * A, rtol=1e-10)
+    assert abs(reaction[1]) < 1e-12 and abs(reaction[2]) < 1e-12
+
+
+def drumhead_pressure() -> tuple[float, float, float]:
+    """Tension, current side and a pressure deflecting the centre by about 0.5% of the side."""
+    T = analytic.equibiaxial_tension_neo_hookean(MU, T0, STRETCH)
+    L = 2.0 * A * STRETCH
+    return T, L, 0.005 * T / (0.0737 * L)
+
+
+def test_drumhead_deflection_under_pressure():
+    """Within 1% of the series (P1 error, falling fourfold per halving of h), in equilibrium,
+    and a quarter model with symmetry supports gives the whole square's deflection."""
+    T, L, p = drumhead_pressure()
+    errors = []
+    for n in (8, 16):
+        problem, x = solve_drumhead(n, p)
+        exact = analytic.pretensioned_square_membrane(T, p, L, x[:, 0] + L / 2, x[:, 1] + L / 2)
+        w_max = COMM.allreduce(x[:, 2].max(), MPI.MAX)
+        errors.append(COMM.allreduce(np.abs(x[:, 2] - exact).max(), MPI.MAX) / w_max)
+        assert equilibrium_error(problem, ["xmin", "xmax", "ymin", "ymax"]) < 1e-8
+    assert errors[0] < 1e-2 and errors[1] < 0.3 * errors[0]
+    centre = analytic.pretensioned_square_membrane(T, p, L, L / 2, L / 2)
+    assert abs(w_max / centre - 1.0) < 3e-3
+    _, xq = solve_drumhead(8, p, quarter=True)
+    w_quarter = COMM.allreduce(xq[:, 2].max(), MPI.MAX)
+    _, x8 = solve_drumhead(8, p)
+    assert np.isclose(w_quarter, COMM.allreduce(x8[:, 2].max(), MPI.MAX), rtol=1e-8)
+
+
+def test_pretension_after_the_first_solve_is_refused():
+    problem, _ = solve_drumhead(2, 0.0)
+    with pytest.raises(ValueError, match="before the first solve"):
+        scenes.pretension(problem, STRETCH)
