@@ -22,7 +22,7 @@ from scipy.optimize import minimize_scalar
 
 import contact_ufl as cu
 from contact_ufl.results import equilibrium_error
-from contact_ufl.verification import analytic, scenes
+from contact_ufl.verification import analytic, geometries, scenes
 from contact_ufl.verification import membrane_meshes as meshes
 
 COMM = MPI.COMM_WORLD
@@ -217,14 +217,15 @@ def test_tube_for_plates_inflates_to_the_free_radius(dim):
 STRETCH, A = 1.05, 0.5
 
 
-def solve_drumhead(n: int, pressure: float, quarter: bool = False):
-    domain = scenes.pretensioned_drumhead(n, A, STRETCH, pressure, quarter=quarter)
+def solve_drumhead(n: int, pressure: float, quarter: bool = False, dim: int = 3, steps: int = 1):
+    domain = scenes.pretensioned_drumhead(n, A, STRETCH, pressure, quarter=quarter, dim=dim)
     problem = cu.ContactProblem(cu.Scene(domains=[domain]), verbose=False)
     scenes.pretension(problem, STRETCH)
-    problem.solve(num_steps=1)
+    problem.solve(num_steps=steps)
     bulk = problem.bulks[0]
     owned = bulk.V.dofmap.index_map.size_local
-    x = (bulk.V.tabulate_dof_coordinates() + bulk.u.x.array.reshape(-1, 3))[:owned]
+    X = bulk.V.tabulate_dof_coordinates()[:, :dim]
+    x = (X + bulk.u.x.array.reshape(-1, dim))[:owned]
     return problem, x
 
 
@@ -272,3 +273,58 @@ def test_pretension_after_the_first_solve_is_refused():
     problem, _ = solve_drumhead(2, 0.0)
     with pytest.raises(ValueError, match="before the first solve"):
         scenes.pretension(problem, STRETCH)
+
+
+def test_string_drumhead_pretension_is_exact():
+    """The plane-strain string: its ends carry ``mu t0 (s - s^-3)`` (out-of-plane stretch 1)."""
+    problem, x = solve_drumhead(4, 0.0, dim=2)
+    X = problem.bulks[0].V.tabulate_dof_coordinates()[: len(x), :2]
+    assert np.allclose(x[:, 0], STRETCH * X[:, 0], atol=1e-12) and np.allclose(x[:, 1], 0.0)
+    tension = analytic.tube_hoop_tension_neo_hookean(MU, T0, STRETCH)
+    assert np.allclose(problem.reaction("xmax"), [tension, 0.0], rtol=1e-10, atol=1e-14)
+
+
+@pytest.mark.parametrize("quarter", [False, True], ids=["whole", "half"])
+def test_string_drumhead_is_a_circular_arc(quarter):
+    """Under a follower pressure the stretched string is an arc of radius ``T / p``: the
+    nodes lie on the closed form's circle and its sag converges as ``h^2``."""
+    T = analytic.tube_hoop_tension_neo_hookean(MU, T0, STRETCH)
+    chord = STRETCH * A
+    p = 0.4 * T / chord  # sag about a tenth of the chord
+    exact = analytic.pressurised_string(MU, T0, A, chord, p)
+    centre = np.array([0.0, -exact["radius"] * np.cos(exact["half_angle"])])
+    errors = []
+    for n in (8, 16):
+        problem, x = solve_drumhead(n, p, quarter=quarter, dim=2, steps=2)
+        on_circle = np.abs(np.linalg.norm(x - centre, axis=1) / exact["radius"] - 1.0)
+        assert COMM.allreduce(on_circle.max(initial=0.0), MPI.MAX) < 5e-5
+        sag = COMM.allreduce(x[:, 1].max(initial=0.0), MPI.MAX)
+        errors.append(abs(sag / exact["sag"] - 1.0))
+        supports = ["x0", "xmax"] if quarter else ["xmin", "xmax"]
+        assert equilibrium_error(problem, supports) < 1e-8
+    assert errors[0] < 1e-3 and errors[1] < 0.3 * errors[0]
+
+
+def test_pressurised_string_limits():
+    """Small pressure: the parabola's sag ``p c^2 / (2 T)``; bad input refused."""
+    chord = STRETCH * A
+    T = analytic.tube_hoop_tension_neo_hookean(MU, T0, STRETCH)
+    p = 1e-4 * T / chord
+    assert np.isclose(
+        analytic.pressurised_string(MU, T0, A, chord, p)["sag"], p * chord**2 / (2 * T), rtol=1e-4
+    )
+    with pytest.raises(ValueError, match="slack"):
+        analytic.pressurised_string(MU, T0, A, 0.9 * A, p)
+
+
+@pytest.mark.parametrize("quarter", [False, True], ids=["whole", "quarter"])
+def test_hemisphere_indenter_groups(quarter):
+    data = geometries.hemisphere_3d(radius=0.25, gap=0.01, quarter=quarter)
+    names = ["indenter_contact", "indenter_top"]
+    names += ["indenter_x0", "indenter_y0"] if quarter else []
+    assert data.groups == {"indenter": (3, 1)} | {k: (2, 11 + i) for i, k in enumerate(names)}
+    assert all(owned_count(data, name) > 0 for name in names)
+    x = group_coordinates(data, "indenter_contact")
+    assert np.allclose(np.linalg.norm(x - [0.0, 0.0, 0.26], axis=1), 0.25, atol=1e-9)
+    lowest = COMM.allreduce(x[:, 2].min(initial=1.0), MPI.MIN)
+    assert np.isclose(lowest, 0.01)

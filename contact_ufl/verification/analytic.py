@@ -472,3 +472,53 @@ def equibiaxial_tension_neo_hookean(mu: float, t0: float, stretch: float) -> flo
     l2 = s``, ``T = mu t0 (1 - s^-6)``.
     """
     return mu * t0 * (1.0 - stretch**-6)
+
+
+def pressurised_string(mu: float, t0: float, a: float, chord: float, p: float) -> dict[str, float]:
+    """A Neo-Hookean string of reference length ``2 a`` whose ends are held on a chord of
+    length ``2 chord`` (e.g. the pre-stretched string drumhead: ``chord = stretch * a``),
+    under a uniform follower pressure ``p`` (plane strain, per unit depth).
+
+    No load is tangential, so the tension ``T`` and the stretch ``l`` are uniform and the
+    string is a circular arc of radius ``rho = T / p`` (``T kappa = p``), of half angle
+    ``theta`` with ``rho sin(theta) = chord`` and length ``2 rho theta = 2 a l``; with ``T =
+    mu t0 (l - l^-3)`` (:func:`tube_hoop_tension_neo_hookean`), one equation in ``theta in (0,
+    pi/2]``: ``T(rho theta / a) = p rho``, ``rho = chord / sin(theta)``, solved by bisection
+    (``brentq``). The sag (the arc's height over the chord) is ``rho (1 - cos theta)``; the
+    small-deflection limit is the parabola ``p (chord^2 - x^2) / (2 T)``.
+
+    Returns
+    -------
+    dict
+        ``radius`` ``rho``, ``half_angle`` ``theta``, ``stretch`` ``l``, ``tension`` ``T``,
+        ``sag``.
+
+    Raises
+    ------
+    ValueError
+        Non-positive parameters, a chord shorter than ``2 a`` (a slack string), or a pressure
+        that would blow the string beyond a half circle.
+    """
+    from scipy.optimize import brentq
+
+    for name, value in (("mu", mu), ("t0", t0), ("a", a), ("chord", chord), ("p", p)):
+        if not 0.0 < value < np.inf:
+            raise ValueError(f"{name} must be positive and finite, got {name} = {value}")
+    if not chord > a:
+        raise ValueError(f"the chord {chord} must exceed the half length {a}: the string is slack")
+
+    def residual(theta: float) -> float:
+        rho = chord / np.sin(theta)
+        return float(tube_hoop_tension_neo_hookean(mu, t0, rho * theta / a)) - p * rho
+
+    if residual(0.5 * np.pi) <= 0.0:
+        raise ValueError(f"the pressure p = {p} blows the string beyond a half circle")
+    theta = brentq(residual, 1e-12, 0.5 * np.pi, xtol=1e-15, rtol=1e-15)
+    rho = chord / np.sin(theta)
+    return {
+        "radius": rho,
+        "half_angle": theta,
+        "stretch": rho * theta / a,
+        "tension": p * rho,
+        "sag": rho * (1.0 - np.cos(theta)),
+    }

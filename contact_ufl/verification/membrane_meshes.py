@@ -18,7 +18,8 @@ like the gmsh scenes), for scenes of membranes in contact:
   with the vertices on the symmetry planes;
 * :func:`tube_quarter`: a quarter of a tube with layers along its axis, with the edges on the
   symmetry planes and at its ends;
-* :func:`drumhead`: a flat square membrane (or its quarter) in ``z = 0``, with its edges.
+* :func:`drumhead`: a flat square membrane (or its quarter) in ``z = 0``, with its edges; or
+  a straight string in 2D.
 """
 
 from __future__ import annotations
@@ -296,20 +297,24 @@ def drumhead(
     a: float,
     n: int,
     quarter: bool = False,
+    dim: int = 3,
     ghost_mode: dolfinx.mesh.GhostMode = SHARED_FACET,
 ):
     """A flat square membrane in the plane ``z = 0`` of 3D (triangles): ``[-a, a]^2``, or its
     quarter ``[0, a]^2``; ``n`` cells along ``a`` (``2 n`` along a side of the whole square).
+    With ``dim`` 2, its plane-strain counterpart: the straight string ``[-a, a]`` (or its half
+    ``[0, a]``) on the line ``y = 0`` of 2D (intervals).
 
     The squares of the grid are cut along the diagonal pointing to the centre, so the whole
     mesh is symmetric about both axes (and a quarter is one quarter of it).
 
-    Groups: cells ``"membrane"`` (dimension 2, tag 1); edges ``"xmin"``, ``"xmax"``,
-    ``"ymin"``, ``"ymax"`` (the edges ``x = -a``, ``x = a``, ``y = -a``, ``y = a``; tags 1 to
-    4) of the whole square; ``"x0"``, ``"y0"`` (the symmetry edges ``x = 0`` and ``y = 0``),
-    ``"xmax"``, ``"ymax"`` (tags 1 to 4) of the quarter. The edges held by the frame:
-    :data:`DRUMHEAD_EDGES`. Flat: its domain needs ``direction`` (e.g. ``(0, 0, 1)``: ``n0 =
-    +z``, a positive follower pressure pushes it up). See
+    Groups: cells ``"membrane"`` (dimension ``dim - 1``, tag 1); edges ``"xmin"``,
+    ``"xmax"``, ``"ymin"``, ``"ymax"`` (the edges ``x = -a``, ``x = a``, ``y = -a``, ``y = a``;
+    tags 1 to 4) of the whole square; ``"x0"``, ``"y0"`` (the symmetry edges ``x = 0`` and ``y
+    = 0``), ``"xmax"``, ``"ymax"`` (tags 1 to 4) of the quarter. A string has the end points
+    ``"xmin"``, ``"xmax"`` (tags 1, 2), or ``"x0"``, ``"xmax"`` for its half. The edges held
+    by the frame: :data:`DRUMHEAD_EDGES`. Flat: its domain needs ``direction`` (e.g. ``(0, 0,
+    1)``: ``n0 = +z``, a positive follower pressure pushes it up). See
     :func:`contact_ufl.verification.scenes.pretensioned_drumhead`.
 
     Returns
@@ -317,7 +322,15 @@ def drumhead(
     MeshData
     """
     _check_size(a=a, n=n)
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim}")
     xs = np.linspace(0.0 if quarter else -a, a, (1 if quarter else 2) * n + 1)
+    if dim == 2:
+        x = np.stack([xs, np.zeros_like(xs)], 1)
+        cells = np.stack([np.arange(len(xs) - 1), np.arange(1, len(xs))], 1)
+        mesh = _create(comm, "interval", cells, x, False, ghost_mode)
+        planes = {"x0": (0, 0.0)} if quarter else {"xmin": (0, -a)}
+        return with_tags(mesh, {**planes, "xmax": (0, a)}, name="membrane")
     X, Y = np.meshgrid(xs, xs, indexing="ij")
     x = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], 1)
     mesh = _create(comm, "triangle", _union_jack(xs, xs), x, False, ghost_mode)

@@ -773,30 +773,34 @@ def tube_for_plates(
     )
 
 
-def drumhead_supports(a: float, stretch: float, quarter: bool = False) -> list[Dirichlet]:
+def drumhead_supports(
+    a: float, stretch: float, quarter: bool = False, dim: int = 3
+) -> list[Dirichlet]:
     """Supports of the pre-tensioned drumhead of
-    :func:`~contact_ufl.verification.membrane_meshes.drumhead`.
+    :func:`~contact_ufl.verification.membrane_meshes.drumhead` (``dim`` 2: the string).
 
     Each framed edge moves out by ``(stretch - 1) a`` normal to itself, in its plane, and is
-    held at ``z = 0``; its tangential motion is free (a roller), so the equi-biaxial stretch
-    ``u = (stretch - 1) (x, y, 0)`` is the exact state under no other load. A quarter is held
-    normally on its symmetry edges ``"x0"``, ``"y0"``.
+    held at ``z = 0`` (a string's ends at ``y = 0``); its tangential motion is free (a
+    roller), so the equi-biaxial stretch ``u = (stretch - 1) (x, y, 0)`` (the string's ``u =
+    (stretch - 1) (x, 0)``) is the exact state under no other load. A quarter (half string)
+    is held normally on its symmetry edges ``"x0"`` (and ``"y0"``).
     """
     from contact_ufl.verification.membrane_meshes import DRUMHEAD_EDGES
 
     if not stretch > 0.0:
         raise ValueError(f"stretch must be positive, got {stretch}")
     shift = (stretch - 1.0) * a
-    names = ("xmax", "ymax") if quarter else tuple(DRUMHEAD_EDGES)
+    edges = {k: v for k, v in DRUMHEAD_EDGES.items() if v[0] < dim - 1}
+    names = [k for k in edges if k.endswith("max")] if quarter else list(edges)
     supports = []
     for name in names:
-        axis, sign = DRUMHEAD_EDGES[name]
+        axis, sign = edges[name]
         supports += [
             Dirichlet(name, sign * shift, component=axis),
-            Dirichlet(name, 0.0, component=2),
+            Dirichlet(name, 0.0, component=dim - 1),
         ]
     if quarter:
-        supports += [Dirichlet("x0", 0.0, component=0), Dirichlet("y0", 0.0, component=1)]
+        supports += [Dirichlet(k, 0.0, component=i) for i, k in enumerate(["x0", "y0"][: dim - 1])]
     return supports
 
 
@@ -807,45 +811,50 @@ def pretensioned_drumhead(
     pressure: float = 0.0,
     law=None,
     quarter: bool = False,
+    dim: int = 3,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> Domain:
-    """A flat square membrane ``[-a, a]^2`` in ``z = 0`` (or its quarter), its edges
-    stretched by ``stretch`` (:func:`drumhead_supports`), under the follower pressure
-    ``pressure * t`` along ``n0 = +z`` (``direction=(0, 0, 1)``).
+    """A flat square membrane ``[-a, a]^2`` in ``z = 0`` (or its quarter; ``dim`` 2: the
+    string ``[-a, a]`` on ``y = 0``, or its half), its edges stretched by ``stretch``
+    (:func:`drumhead_supports`), under the follower pressure ``pressure * t`` along ``n0 =
+    +z`` (``direction=(0, 0, 1)``; a string's ``+y``).
 
     A flat membrane has no stiffness normal to itself at ``u = 0``, nor anywhere Newton's
     first iterate leaves the interior unstretched: start the solve from the tensioned state
-    with :func:`pretension` (before the first solve), which the edge supports then hold. The
-    Cauchy tension is ``mu t0 (1 - stretch^-6)`` for the default
-    :class:`~contact_ufl.membranes.MembraneNeoHookean` (``mu = 1``, ``t0 = 0.01``;
-    :func:`~contact_ufl.verification.analytic.equibiaxial_tension_neo_hookean`). The cells
-    are ``"membrane"``: a solid pressed into it from above contacts them (``n0`` points up, to
-    the indenter).
+    with :func:`pretension` (before the first solve), which the edge supports then hold. For
+    the default :class:`~contact_ufl.membranes.MembraneNeoHookean` (``mu = 1``, ``t0 = 0.01``)
+    the Cauchy tension is ``mu t0 (1 - stretch^-6)``
+    (:func:`~contact_ufl.verification.analytic.equibiaxial_tension_neo_hookean`), a string's
+    ``mu t0 (stretch - stretch^-3)``
+    (:func:`~contact_ufl.verification.analytic.tube_hoop_tension_neo_hookean`). The cells are
+    ``"membrane"``: a solid pressed into it from above contacts them (``n0`` points up, to the
+    indenter).
     """
     from contact_ufl.loads import FollowerPressure
     from contact_ufl.membranes import MembraneNeoHookean
     from contact_ufl.verification import membrane_meshes
 
     law = law or MembraneNeoHookean(1.0, 0.01)
-    data = membrane_meshes.drumhead(comm, a, n, quarter)
+    data = membrane_meshes.drumhead(comm, a, n, quarter, dim)
     loads = [FollowerPressure("membrane", lambda t: pressure * t)] if pressure else []
     return Domain(
         data.mesh,
         data.cell_tags,
         data.facet_tags,
         [Body("membrane", law)],
-        drumhead_supports(a, stretch, quarter),
+        drumhead_supports(a, stretch, quarter, dim),
         loads,
         groups=dict(data.groups),
         name="drumhead",
-        direction=(0.0, 0.0, 1.0),
+        direction=tuple(np.eye(dim)[dim - 1]),
     )
 
 
 def pretension(problem, stretch: float, domain: int = 0) -> None:
     """Start ``problem`` from the flat membrane of ``problem.bulks[domain]`` (in a plane
-    ``z = const`` about the origin, e.g. :func:`pretensioned_drumhead`) stretched
-    equi-biaxially: ``u = (stretch - 1) (x, y, 0)``.
+    ``z = const`` about the origin, e.g. :func:`pretensioned_drumhead`; a string on a line
+    ``y = const``) stretched equi-biaxially: ``u = (stretch - 1) (x, y, 0)`` (a string's
+    ``(stretch - 1) (x, 0)``).
 
     The solver starts from the problem's fields as they are when it is made (its first use):
     call this before the first solve. Newton's first iterate is then a tensioned membrane,
@@ -854,9 +863,10 @@ def pretension(problem, stretch: float, domain: int = 0) -> None:
     if problem._solver is not None:
         raise ValueError("pretension must be set before the first solve (the solver exists)")
     bulk = problem.bulks[domain]
-    if not bulk.membrane or bulk.V.mesh.geometry.dim != 3:
-        raise ValueError(f"domain {domain} is not a membrane in 3D")
-    X = bulk.V.tabulate_dof_coordinates()
+    if not bulk.membrane:
+        raise ValueError(f"domain {domain} is not a membrane")
+    gdim = bulk.V.mesh.geometry.dim
+    X = bulk.V.tabulate_dof_coordinates()[:, :gdim]
     u = np.zeros_like(X)
-    u[:, :2] = (stretch - 1.0) * X[:, :2]
+    u[:, : gdim - 1] = (stretch - 1.0) * X[:, : gdim - 1]
     bulk.u.x.array[:] = u.ravel()
