@@ -819,9 +819,13 @@ def pretensioned_drumhead(
     (:func:`drumhead_supports`), under the follower pressure ``pressure * t`` along ``n0 =
     +z`` (``direction=(0, 0, 1)``; a string's ``+y``).
 
-    A flat membrane has no stiffness normal to itself at ``u = 0``, nor anywhere Newton's
-    first iterate leaves the interior unstretched: start the solve from the tensioned state
-    with :func:`pretension` (before the first solve), which the edge supports then hold. For
+    A flat membrane has no stiffness normal to itself where it is unstretched: start the
+    solve from the tensioned state with :func:`pretension` (before the first solve), which
+    the edge supports then hold. Without it, the first Newton iterate has the stretched edges
+    around an unstretched interior: with no pressure (a solid pressed into the drumhead) its
+    tangent is singular (measured: ``DIVERGED_LINEAR_SOLVE`` at every cut-back); a follower
+    pressure couples the transverse to the in-plane motion and Newton converges, but in 11-12
+    iterations where the pre-tensioned start takes 3. For
     the default :class:`~contact_ufl.membranes.MembraneNeoHookean` (``mu = 1``, ``t0 = 0.01``)
     the Cauchy tension is ``mu t0 (1 - stretch^-6)``
     (:func:`~contact_ufl.verification.analytic.equibiaxial_tension_neo_hookean`), a string's
