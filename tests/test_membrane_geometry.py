@@ -15,12 +15,16 @@ import contact_ufl  # noqa: F401  (loads MPI and PETSc first)
 
 # isort: split
 import dolfinx
+import dolfinx.fem.petsc
 import numpy as np
 import pytest
+import ufl
 from mpi4py import MPI
 from scipy.optimize import minimize_scalar
 
 import contact_ufl as cu
+from contact_ufl import membranes
+from contact_ufl.membranes import MembraneNeoHookean
 from contact_ufl.results import equilibrium_error
 from contact_ufl.verification import analytic, geometries, scenes
 from contact_ufl.verification import membrane_meshes as meshes
@@ -168,6 +172,86 @@ def test_tube_between_plates_minimises_the_potential():
     assert np.isclose(l_min, result["stretch"], rtol=1e-7)
     force = -(minimised_potential(r + h)[1] - minimised_potential(r - h)[1]) / (4.0 * h)
     assert np.isclose(force, result["force"], rtol=1e-5)
+
+
+def penalty_plates(n: int, k: float, radii: list[float]) -> list[tuple[float, float, float]]:
+    """The quarter string ring inflated to ``P`` (four steps), then pressed by a penalty plate
+    ``y = r`` (energy ``k/2 int <y - r>_+^2 dX``) through ``radii``: a plain SNES harness
+    independent of the package's contact. Returns, per radius, the plate force on the
+    quarter, the largest distance of the free nodes from their arc over ``r`` (relative), and
+    the mean stretch ``int J_s dX / (pi R0 / 2)``."""
+    law = MembraneNeoHookean(MU, T0)
+    data = meshes.string_ring(COMM, R0, n, 1)
+    mesh = data.mesh
+    n0 = membranes.reference_normal(mesh)
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,)))
+    u, v = dolfinx.fem.Function(V), ufl.TestFunction(V)
+    p, r = dolfinx.fem.Constant(mesh, 0.0), dolfinx.fem.Constant(mesh, 10.0)
+    dx = ufl.Measure("dx", mesh, metadata={"quadrature_degree": 4})
+    g = (ufl.SpatialCoordinate(mesh) + u)[1] - r
+    g_plus = 0.5 * (g + abs(g))
+    energy = law.strain_energy(u, n0) * dx + 0.5 * k * g_plus**2 * dx
+    residual = ufl.derivative(energy, u, v) - membranes.pressure_virtual_work(u, v, n0, p) * dx
+    bcs = []
+    for name, axis in (("x0", 0), ("y0", 1)):
+        vertices = data.facet_tags.find(data.groups[name][1])
+        dofs = dolfinx.fem.locate_dofs_topological(V.sub(axis), 0, vertices)
+        bcs.append(dolfinx.fem.dirichletbc(np.float64(0.0), dofs, V.sub(axis)))
+    options = {"snes_rtol": 1e-10, "snes_atol": 1e-14, "snes_max_it": 50, "ksp_type": "preonly"}
+    options |= {"pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+    problem = dolfinx.fem.petsc.NonlinearProblem(
+        residual,
+        u,
+        bcs=bcs,
+        J=ufl.derivative(residual, u, ufl.TrialFunction(V)),
+        petsc_options_prefix="penalty_plates_",
+        petsc_options=options,
+    )
+
+    def solve() -> None:
+        problem.solve()
+        assert problem.solver.getConvergedReason() > 0
+
+    for fraction in (0.25, 0.5, 0.75, 1.0):
+        p.value = fraction * P
+        solve()
+    force = dolfinx.fem.form(k * g_plus * dx)
+    length = dolfinx.fem.form(membranes.area_stretch(u, n0) * dx)
+    owned = V.dofmap.index_map.size_local
+    X = V.tabulate_dof_coordinates()[:owned, :2]
+    out = []
+    for value in radii:
+        r.value = value
+        solve()
+        width = analytic.tube_between_plates(MU, T0, R0, P, value)["width"]
+        x = X + u.x.array.reshape(-1, 2)[:owned]
+        free = x[:, 1] < value * (1.0 - 1e-3)
+        off_arc = np.abs(np.hypot(x[free, 0] - 0.5 * width, x[free, 1]) / value - 1.0)
+        out.append(
+            (
+                COMM.allreduce(dolfinx.fem.assemble_scalar(force), MPI.SUM),
+                COMM.allreduce(off_arc.max(initial=0.0), MPI.MAX),
+                COMM.allreduce(dolfinx.fem.assemble_scalar(length), MPI.SUM) / (0.5 * np.pi * R0),
+            )
+        )
+    return out
+
+
+def test_tube_between_plates_against_a_penalty_solution():
+    """A finite-element check of the closed form (no package contact): with a stiff penalty
+    plate (penetration ``p / k ~ 5e-5``), the plate force on the quarter is ``p w / 2``, the
+    free arcs are circles of radius ``r`` about ``(w/2, 0)``, and the stretch is the closed
+    form's."""
+    r_free = analytic.tube_free_radius(MU, T0, R0, P)
+    radii = list(r_free * np.linspace(1.0, 0.8, 9)[1:])
+    for value, (force, off_arc, stretch) in zip(
+        radii, penalty_plates(32, 100.0, radii), strict=True
+    ):
+        exact = analytic.tube_between_plates(MU, T0, R0, P, value)
+        if value <= 0.9 * r_free:  # the width is several elements
+            assert abs(force / (0.5 * exact["force"]) - 1.0) < 5e-3
+        assert off_arc < 5e-4
+        assert abs(stretch / exact["stretch"] - 1.0) < 3e-4
 
 
 def test_tube_between_plates_bad_input():
