@@ -286,3 +286,239 @@ def tube_inflation_compressible_neo_hookean(E: float, nu: float, t0: float, R: f
     l = np.asarray(stretch, dtype=float)
     mu, lmbda, J_sq = _condensed_neo_hookean(E, nu, l**2)
     return t0 * (mu * (l - 1.0 / l) + lmbda * (J_sq - 1.0) / (2.0 * l)) / (R * l)
+
+
+# -- An inflated tube pressed between two rigid plates -----------------------------------------
+#
+# A Neo-Hookean tube of reference radius R0 and thickness t0 (a long tube at axial stretch 1,
+# per unit length; or a string ring in 2D, plane strain, per unit depth: the same law with the
+# out-of-plane stretch 1) is inflated to the pressure p and then pressed between two
+# frictionless rigid flat plates at y = +-r. See :func:`tube_between_plates`.
+
+
+def tube_hoop_tension_neo_hookean(mu: float, t0: float, stretch):
+    """Hoop tension (force per unit length of the tube, or per unit depth of a string) of the
+    incompressible Neo-Hookean tube at axial stretch 1 and hoop stretch ``l``.
+
+    :class:`~contact_ufl.membranes.MembraneNeoHookean` stores ``W = t0 mu/2 (I1 + J_s^-2 - 3)``
+    per unit reference area with ``I1 = l^2 + 1`` and ``J_s = l`` (the string: its
+    out-of-plane stretch 1 in ``I1``): ``W = t0 mu/2 (l^2 + l^-2 - 2)``. The tension is the
+    work conjugate of the stretch, ``T = dW/dl = mu t0 (l - l^-3)`` (per unit reference
+    axial length, which is the current one at axial stretch 1; a string's tension is a force,
+    the same per unit reference or current length). It grows monotonically with ``l``.
+    """
+    l = np.asarray(stretch, dtype=float)
+    return mu * t0 * (l - l**-3)
+
+
+def _check_tube(mu: float, t0: float, R0: float, p: float) -> None:
+    for name, value in (("mu", mu), ("t0", t0), ("R0", R0), ("p", p)):
+        if not 0.0 < value < np.inf:
+            raise ValueError(f"{name} must be positive and finite, got {name} = {value}")
+    if not p * R0 < mu * t0:
+        raise ValueError(
+            f"the pressure p = {p} reaches the tube's limit mu t0 / R0 = {mu * t0 / R0}: "
+            "no free equilibrium (the Neo-Hookean tube inflates without bound)"
+        )
+
+
+def tube_free_radius(mu: float, t0: float, R0: float, p: float) -> float:
+    """Radius ``r_free`` of the Neo-Hookean tube freely inflated to the pressure ``p``.
+
+    Equilibrium of the circular tube, ``T = p r`` with ``r = l R0`` and ``T = mu t0 (l -
+    l^-3)`` (:func:`tube_hoop_tension_neo_hookean`), gives ``p = mu t0 / R0 (1 - l^-4)``
+    (:func:`tube_inflation_neo_hookean`), whence ``r_free = R0 (1 - p R0 / (mu t0))^(-1/4)``.
+    Needs ``0 < p < mu t0 / R0`` (``ValueError`` otherwise).
+    """
+    _check_tube(mu, t0, R0, p)
+    return R0 * (1.0 - p * R0 / (mu * t0)) ** -0.25
+
+
+def _hoop_stretch(q: np.ndarray) -> np.ndarray:
+    """The root ``l >= 1`` of ``l - l^-3 = q`` (``q >= 0``), by Newton's method from ``l = 1``.
+
+    ``f(l) = l - l^-3 - q`` is increasing and concave for ``l > 0``: its tangents lie above
+    it, so the iterates from ``f(1) = -q <= 0`` stay left of the root and increase to it.
+    """
+    l = np.ones_like(q)
+    for _ in range(100):
+        f = l - l**-3 - q
+        if np.all(np.abs(f) <= 1e-15 * (1.0 + q)):
+            break
+        l = l - f / (1.0 + 3.0 * l**-4)
+    return l
+
+
+def tube_between_plates(mu: float, t0: float, R0: float, p: float, r) -> dict[str, np.ndarray]:
+    """The inflated Neo-Hookean tube pressed between two frictionless rigid flat plates.
+
+    The tube (reference radius ``R0``, thickness ``t0``, shear modulus ``mu``; a long tube
+    at axial stretch 1 per unit length, or a string ring in 2D per unit depth) holds the
+    pressure ``p`` (per unit current area, constant) and lies between the plates ``y = -r``
+    and ``y = r``, ``r <= r_free`` (:func:`tube_free_radius`).
+
+    Derivation. The plates are frictionless and the pressure normal to the tube, so no load
+    is tangential: the tangential equilibrium of the tube, ``dT/ds = 0``, makes the tension
+    ``T`` uniform, hence (``T(l)`` increasing) the hoop stretch ``l`` uniform. Normal
+    equilibrium of the free parts, ``T kappa = p``, makes them arcs of one curvature; each
+    joins the two plates tangentially (a membrane has no bending stiffness, but a kink would
+    carry a concentrated force, which the plates cannot give outside the contact zones and
+    the pressure cannot give at all), so each is a half circle of diameter ``2r``: ``T = p
+    r``. In a flat contact zone ``kappa = 0``, so the contact pressure equals ``p``. The
+    cross-section is a stadium: two flat zones of width ``w`` (one on each plate, ``|x| <=
+    w/2``) and two half circles of radius ``r`` centred at ``(+-w/2, 0)``; its current length
+    is the reference length stretched, ``2 pi r + 2 w = 2 pi R0 l``. Hence
+
+    * ``mu t0 (l - l^-3) = p r`` (:func:`tube_hoop_tension_neo_hookean`): ``l``, one root
+      ``l >= 1`` found by Newton's method;
+    * ``w = pi (R0 l - r)``: the contact width on each plate;
+    * the plate force ``F = p w`` (per unit length; in 2D per unit depth): the contact
+      pressure ``p`` over the width ``w``; the same from the vertical balance of the upper
+      half, cut at ``y = 0``: the pressure lifts it by ``p (w + 2 r)``, the tension at the
+      two cuts pulls it down by ``2 T = 2 p r``, so the plate pushes down by ``F = p w``.
+
+    At ``r = r_free``, ``w = 0``; as ``mu -> inf`` (a rigid tube) ``l -> 1`` and ``w -> pi
+    (R0 - r)``. Frictionless contact makes the state path independent: a test may inflate
+    the tube freely to ``p`` first (the plates away) and then close the plates from
+    ``r_free`` to ``r`` at constant ``p`` (the pressure is the control; solved
+    quasi-statically, the end state is this one).
+
+    Parameters
+    ----------
+    mu, t0, R0
+        Shear modulus, reference thickness (a string: cross-section area per unit depth) and
+        reference radius.
+    p
+        Inflation pressure, ``0 < p < mu t0 / R0``.
+    r
+        Half the separation of the plates (scalar or array), ``0 < r <= r_free``.
+
+    Returns
+    -------
+    dict
+        ``stretch`` (the uniform hoop stretch ``l``), ``width`` (the contact width ``w`` on
+        each plate), ``force`` (``p w``, per plate), ``tension`` (``T = p r``) and
+        ``contact_pressure`` (``p``), as arrays of the shape of ``r``.
+
+    Raises
+    ------
+    ValueError
+        A non-positive parameter, ``p >= mu t0 / R0``, or ``r`` not in ``(0, r_free]`` (the
+        plates do not touch the tube).
+    """
+    r_free = tube_free_radius(mu, t0, R0, p)
+    r = np.asarray(r, dtype=float)
+    beyond = ~((r > 0.0) & (r <= r_free * (1.0 + 1e-12)))
+    if np.any(beyond):
+        raise ValueError(
+            f"half plate separation r = {r[beyond].ravel()[0]} is not in (0, r_free], "
+            f"r_free = {r_free} (the free radius at p = {p}): the plates would not touch the "
+            "tube"
+        )
+    l = _hoop_stretch(p * r / (mu * t0))
+    width = np.maximum(np.pi * (R0 * l - r), 0.0)
+    return {
+        "stretch": l,
+        "width": width,
+        "force": p * width,
+        "tension": p * r,
+        "contact_pressure": np.full_like(r, p),
+    }
+
+
+# -- A pre-tensioned square membrane under a small uniform pressure ----------------------------
+
+
+def pretensioned_square_membrane(T: float, p: float, L: float, x, y, terms: int = 201):
+    """Small deflection ``w(x, y)`` of a square membrane ``[0, L]^2`` under the uniform
+    tension ``T`` (force per unit length) and a uniform pressure ``p``, clamped on its edges.
+
+    Linearised about the flat tensioned state, the transverse equilibrium is ``T Laplace w =
+    -p`` with ``w = 0`` on the edges (Prandtl's torsion problem). With ``p = sum_{m, n odd}
+    16 p / (pi^2 m n) sin(m pi x / L) sin(n pi y / L)``,
+
+    ``w = 16 p L^2 / (pi^4 T) sum_{m, n odd} sin(m pi x / L) sin(n pi y / L) / (m n (m^2 +
+    n^2))``;
+
+    at the centre ``w = 0.0736713... p L^2 / T``. Valid while the added strain ``~ (w / L)^2``
+    is small beside the pre-strain (the tension stays ``T``). The series runs over odd ``m, n
+    < terms``; its terms fall like ``1 / (m n (m^2 + n^2))``.
+
+    Parameters
+    ----------
+    T, p, L
+        Tension, pressure and side (in the current configuration).
+    x, y
+        Points (arrays of one shape) in ``[0, L]^2``.
+    terms
+        Upper bound of the odd indices of the series.
+    """
+    k = np.arange(1, terms, 2, dtype=float)
+    m, n = np.meshgrid(k, k, indexing="ij")
+    coefficient = 1.0 / (m * n * (m**2 + n**2))
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    sx = np.sin(np.pi * np.multiply.outer(x, k) / L)
+    sy = np.sin(np.pi * np.multiply.outer(y, k) / L)
+    series = np.einsum("...m,mn,...n->...", sx, coefficient, sy)
+    return 16.0 * p * L**2 / (np.pi**4 * T) * series
+
+
+def equibiaxial_tension_neo_hookean(mu: float, t0: float, stretch: float) -> float:
+    """Cauchy tension (force per unit *current* length) of the incompressible Neo-Hookean
+    membrane stretched equi-biaxially by ``s``.
+
+    ``W = t0 mu/2 (l1^2 + l2^2 + (l1 l2)^-2 - 3)``: the nominal tension ``dW/dl1 = mu t0 (l1 -
+    l1^-3 l2^-2)`` per unit reference length, over ``l2`` per unit current length; at ``l1 =
+    l2 = s``, ``T = mu t0 (1 - s^-6)``.
+    """
+    return mu * t0 * (1.0 - stretch**-6)
+
+
+def pressurised_string(mu: float, t0: float, a: float, chord: float, p: float) -> dict[str, float]:
+    """A Neo-Hookean string of reference length ``2 a`` whose ends are held on a chord of
+    length ``2 chord`` (e.g. the pre-stretched string drumhead: ``chord = stretch * a``),
+    under a uniform follower pressure ``p`` (plane strain, per unit depth).
+
+    No load is tangential, so the tension ``T`` and the stretch ``l`` are uniform and the
+    string is a circular arc of radius ``rho = T / p`` (``T kappa = p``), of half angle
+    ``theta`` with ``rho sin(theta) = chord`` and length ``2 rho theta = 2 a l``; with ``T =
+    mu t0 (l - l^-3)`` (:func:`tube_hoop_tension_neo_hookean`), one equation in ``theta in (0,
+    pi/2]``: ``T(rho theta / a) = p rho``, ``rho = chord / sin(theta)``, solved by bisection
+    (``brentq``). The sag (the arc's height over the chord) is ``rho (1 - cos theta)``; the
+    small-deflection limit is the parabola ``p (chord^2 - x^2) / (2 T)``.
+
+    Returns
+    -------
+    dict
+        ``radius`` ``rho``, ``half_angle`` ``theta``, ``stretch`` ``l``, ``tension`` ``T``,
+        ``sag``.
+
+    Raises
+    ------
+    ValueError
+        Non-positive parameters, a chord shorter than ``2 a`` (a slack string), or a pressure
+        that would blow the string beyond a half circle.
+    """
+    from scipy.optimize import brentq
+
+    for name, value in (("mu", mu), ("t0", t0), ("a", a), ("chord", chord), ("p", p)):
+        if not 0.0 < value < np.inf:
+            raise ValueError(f"{name} must be positive and finite, got {name} = {value}")
+    if not chord > a:
+        raise ValueError(f"the chord {chord} must exceed the half length {a}: the string is slack")
+
+    def residual(theta: float) -> float:
+        rho = chord / np.sin(theta)
+        return float(tube_hoop_tension_neo_hookean(mu, t0, rho * theta / a)) - p * rho
+
+    if residual(0.5 * np.pi) <= 0.0:
+        raise ValueError(f"the pressure p = {p} blows the string beyond a half circle")
+    theta = brentq(residual, 1e-12, 0.5 * np.pi, xtol=1e-15, rtol=1e-15)
+    rho = chord / np.sin(theta)
+    return {
+        "radius": rho,
+        "half_angle": theta,
+        "stretch": rho * theta / a,
+        "tension": p * rho,
+        "sag": rho * (1.0 - np.cos(theta)),
+    }

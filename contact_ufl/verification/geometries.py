@@ -12,6 +12,8 @@ Generators
 * :func:`patch_2d`: two stacked rectangles (contact patch test), triangles or quadrilaterals.
 * :func:`patch_3d`: two stacked boxes, tetrahedra or hexahedra.
 * :func:`cylinders_3d`: half cylinder on a block with a cylindrical top of crossed axis.
+* :func:`hemisphere_3d`: a hemispherical indenter (one body; for a solid pressed into a
+  membrane).
 * :func:`beams_3d`: two cantilever beams, clamped on the same side or at opposite ends,
   overlapping in plan.
 
@@ -41,6 +43,7 @@ __all__ = [
     "patch_2d",
     "patch_3d",
     "cylinders_3d",
+    "hemisphere_3d",
     "ironing_2d",
     "BeamPair",
     "beams_3d",
@@ -762,6 +765,83 @@ def cylinders_3d(
             gmsh.model.mesh.setOrder(order)
 
     return generate_mesh(comm, "cylinders_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
+
+
+def hemisphere_3d(
+    radius: float = 0.25,
+    gap: float = 0.0,
+    h_contact: float | None = None,
+    h_far: float | None = None,
+    refine_radius: float = 0.3,
+    quarter: bool = False,
+    order: int = 1,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> MeshData:
+    """A hemispherical indenter (one body): the lower half of the ball of radius R centred
+    at ``(0, 0, R + gap)``, its lowest point ``(0, 0, gap)``; or its quarter ``x, y >= 0``.
+    Tetrahedra of size ``h_contact`` within ``refine_radius * R`` of the lowest point, growing
+    to ``h_far`` over a further R. For a solid pressed into a flat membrane (the drumhead of
+    :func:`contact_ufl.verification.membrane_meshes.drumhead`, its centre under the
+    indenter): move ``"indenter_top"`` down.
+
+    Parameters
+    ----------
+    radius
+        Radius R.
+    gap
+        Height of the lowest point (>= 0).
+    h_contact, h_far
+        Element sizes near the lowest point and far from it (defaults ``0.1 R``, ``0.3 R``).
+    refine_radius, order, comm, msh_file, ghost_mode
+        As in :func:`hertz_2d`.
+    quarter
+        The quarter ``x, y >= 0`` (symmetry faces ``x = 0`` and ``y = 0``).
+
+    Returns
+    -------
+    MeshData
+        Cell group ``"indenter"`` (1); facet groups ``"indenter_contact"`` (the spherical
+        face, 11), ``"indenter_top"`` (the flat face ``z = R + gap``, 12), and for a quarter
+        ``"indenter_x0"``, ``"indenter_y0"`` (the symmetry faces, 13, 14).
+    """
+    R = radius
+    h_contact = 0.1 * R if h_contact is None else h_contact
+    h_far = 0.3 * R if h_far is None else h_far
+    _check_positive(radius=R, h_contact=h_contact, h_far=h_far, refine_radius=refine_radius)
+    _check_common(gap, order)
+    tol = 1e-5 * R
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        zc = R + gap
+        ball = occ.addSphere(0.0, 0.0, zc, R)
+        lo = 0.0 if quarter else -2.0 * R
+        box = occ.addBox(lo, lo, zc - 2.0 * R, 2.0 * R - lo, 2.0 * R - lo, 2.0 * R)
+        (body_dt,), _ = occ.intersect([(3, ball)], [(3, box)])
+        occ.synchronize()
+        body = body_dt[1]
+        names: dict[str, list[int]] = {"indenter_contact": [], "indenter_top": []}
+        if quarter:
+            names.update({"indenter_x0": [], "indenter_y0": []})
+        for face in _boundary(3, [body], 2):
+            flat = _flat(face, tol)
+            if flat is None:
+                names["indenter_contact"].append(face)
+            else:
+                names[("indenter_x0", "indenter_y0", "indenter_top")[flat[0]]].append(face)
+        _add_groups([("indenter", 3, [body])] + [(k, 2, v) for k, v in names.items()], tdim=3)
+        distance = _distance_to((0.0, 0.0, gap))
+        d_min = refine_radius * R
+        _set_background([_threshold(distance, h_contact, h_far, d_min, d_min + R)])
+        gmsh.model.mesh.generate(3)
+        if order > 1:
+            gmsh.model.mesh.setOrder(order)
+
+    return generate_mesh(
+        comm, "hemisphere_3d", build, 3, _mesh_options(order), msh_file, ghost_mode
+    )
 
 
 def tag_single_body(

@@ -748,3 +748,207 @@ def membrane_sandwich(dim: int = 2, pressure: float = 0.01, law=None) -> Scene:
     on_membrane = dataclasses.replace(pair, master=100, master_domain=2)
     membrane_on_lower = dataclasses.replace(pair, slave=100, slave_domain=2, master_domain=1)
     return Scene(domains=[upper, lower, membrane], contacts=[on_membrane, membrane_on_lower])
+
+
+# -- membranes for contact: the plates-and-tube problem and the drumhead ------------------------
+
+
+@dataclass(frozen=True)
+class PlatesSchedule:
+    """Pseudo-time schedule of the plates-and-tube problem: inflate, then close the plates.
+
+    For ``0 <= t <= t_inflate`` the follower pressure grows linearly to ``pressure`` with the
+    plates at ``y = +-r_start`` (above the free radius: no contact); for ``t_inflate <= t <=
+    1`` the pressure is held and the plates move linearly to ``y = +-r_end``. The pressure is
+    the control (not the enclosed volume); frictionless contact makes the end state that of
+    :func:`~contact_ufl.verification.analytic.tube_between_plates` at ``r_end``, whatever the
+    path, and so every converged step after first contact (at ``r = r_free``).
+
+    Attributes
+    ----------
+    pressure, r_start, r_end, t_inflate
+        As above (``r_end < r_start``, ``0 < t_inflate < 1``).
+    """
+
+    pressure: float
+    r_start: float
+    r_end: float
+    t_inflate: float = 0.25
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.t_inflate < 1.0:
+            raise ValueError(f"t_inflate must lie in (0, 1), got {self.t_inflate}")
+        if not 0.0 < self.r_end < self.r_start:
+            raise ValueError(f"need 0 < r_end < r_start, got {self.r_end}, {self.r_start}")
+
+    def p(self, t: float) -> float:
+        """The pressure at pseudo-time ``t``."""
+        return self.pressure * min(t / self.t_inflate, 1.0)
+
+    def half_separation(self, t: float) -> float:
+        """The plates' distance ``r`` from the axis at pseudo-time ``t``."""
+        s = min(max((t - self.t_inflate) / (1.0 - self.t_inflate), 0.0), 1.0)
+        return self.r_start + s * (self.r_end - self.r_start)
+
+    def plate(self, dim: int, side: float = 1.0) -> RigidPlane:
+        """The plate ``y = side * r(t)`` (``side`` +1 upper, -1 lower) in ``dim`` dimensions,
+        its normal towards the tube."""
+        e_y = np.eye(dim)[1]
+        r0 = self.r_start
+
+        def motion(t: float) -> tuple[float, ...]:
+            return tuple(side * (self.half_separation(t) - r0) * e_y)
+
+        return RigidPlane(tuple(side * r0 * e_y), tuple(-side * e_y), motion)
+
+
+def tube_for_plates(
+    schedule: PlatesSchedule,
+    dim: int = 2,
+    n: int = 32,
+    law=None,
+    R0: float = 1.0,
+    quarters: int = 1,
+    length: float = 0.1,
+    n_axial: int = 1,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Domain:
+    """The tube of the plates-and-tube problem as a membrane domain (no contact pair yet).
+
+    ``dim`` 2: the string ring of :func:`~contact_ufl.verification.membrane_meshes.string_ring`
+    (``quarters`` 1, 2 or 4, ``n`` intervals per quarter); ``dim`` 3: the quarter tube of
+    :func:`~contact_ufl.verification.membrane_meshes.tube_quarter` (``n`` cells around,
+    ``n_axial`` along ``length``, quadrilaterals), held at axial stretch 1 (``u_z = 0`` on its
+    ends ``"z0"``, ``"z1"``). Supports ``u_x = 0`` on ``"x0"`` and ``u_y = 0`` on ``"y0"``
+    (symmetry; see ``string_ring``); the follower pressure ``schedule.p(t)`` on the cells
+    ``"tube"``, along the default outward ``n0``. The default law is
+    :class:`~contact_ufl.membranes.MembraneNeoHookean` with ``mu = 1``, ``t0 = 0.01``.
+
+    The upper plate is ``schedule.plate(dim)`` (and the lower ``schedule.plate(dim, -1)`` for
+    a whole ring); the contact surface is the cells ``"tube"``. On a quarter the plate force
+    is half the closed form's ``p w`` (the contact zone ``0 <= x <= w/2``), in 3D times
+    ``length``.
+    """
+    from contact_ufl.loads import FollowerPressure
+    from contact_ufl.membranes import MembraneNeoHookean
+    from contact_ufl.verification import membrane_meshes
+
+    law = law or MembraneNeoHookean(1.0, 0.01)
+    dirichlet = [Dirichlet("x0", 0.0, component=0), Dirichlet("y0", 0.0, component=1)]
+    if dim == 2:
+        data = membrane_meshes.string_ring(comm, R0, n, quarters)
+    elif dim == 3:
+        data = membrane_meshes.tube_quarter(comm, R0, n, length, n_axial)
+        dirichlet += [Dirichlet(end, 0.0, component=2) for end in ("z0", "z1")]
+    else:
+        raise ValueError(f"dim must be 2 or 3, got {dim}")
+    return Domain.from_mesh_data(
+        data,
+        bodies=[Body("tube", law)],
+        dirichlet=dirichlet,
+        loads=[FollowerPressure("tube", schedule.p)],
+        name="tube",
+    )
+
+
+def drumhead_supports(
+    a: float, stretch: float, quarter: bool = False, dim: int = 3
+) -> list[Dirichlet]:
+    """Supports of the pre-tensioned drumhead of
+    :func:`~contact_ufl.verification.membrane_meshes.drumhead` (``dim`` 2: the string).
+
+    Each framed edge moves out by ``(stretch - 1) a`` normal to itself, in its plane, and is
+    held at ``z = 0`` (a string's ends at ``y = 0``); its tangential motion is free (a
+    roller), so the equi-biaxial stretch ``u = (stretch - 1) (x, y, 0)`` (the string's ``u =
+    (stretch - 1) (x, 0)``) is the exact state under no other load. A quarter (half string)
+    is held normally on its symmetry edges ``"x0"`` (and ``"y0"``).
+    """
+    from contact_ufl.verification.membrane_meshes import DRUMHEAD_EDGES
+
+    if not stretch > 0.0:
+        raise ValueError(f"stretch must be positive, got {stretch}")
+    shift = (stretch - 1.0) * a
+    edges = {k: v for k, v in DRUMHEAD_EDGES.items() if v[0] < dim - 1}
+    names = [k for k in edges if k.endswith("max")] if quarter else list(edges)
+    supports = []
+    for name in names:
+        axis, sign = edges[name]
+        supports += [
+            Dirichlet(name, sign * shift, component=axis),
+            Dirichlet(name, 0.0, component=dim - 1),
+        ]
+    if quarter:
+        supports += [Dirichlet(k, 0.0, component=i) for i, k in enumerate(["x0", "y0"][: dim - 1])]
+    return supports
+
+
+def pretensioned_drumhead(
+    n: int = 8,
+    a: float = 0.5,
+    stretch: float = 1.05,
+    pressure: float = 0.0,
+    law=None,
+    quarter: bool = False,
+    dim: int = 3,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Domain:
+    """A flat square membrane ``[-a, a]^2`` in ``z = 0`` (or its quarter; ``dim`` 2: the
+    string ``[-a, a]`` on ``y = 0``, or its half), its edges stretched by ``stretch``
+    (:func:`drumhead_supports`), under the follower pressure ``pressure * t`` along ``n0 =
+    +z`` (``direction=(0, 0, 1)``; a string's ``+y``).
+
+    A flat membrane has no stiffness normal to itself where it is unstretched: start the
+    solve from the tensioned state with :func:`pretension` (before the first solve), which
+    the edge supports then hold. Without it, the first Newton iterate has the stretched edges
+    around an unstretched interior: with no pressure (a solid pressed into the drumhead) its
+    tangent is singular (measured: ``DIVERGED_LINEAR_SOLVE`` at every cut-back); a follower
+    pressure couples the transverse to the in-plane motion and Newton converges, but in 11-12
+    iterations where the pre-tensioned start takes 3. For
+    the default :class:`~contact_ufl.membranes.MembraneNeoHookean` (``mu = 1``, ``t0 = 0.01``)
+    the Cauchy tension is ``mu t0 (1 - stretch^-6)``
+    (:func:`~contact_ufl.verification.analytic.equibiaxial_tension_neo_hookean`), a string's
+    ``mu t0 (stretch - stretch^-3)``
+    (:func:`~contact_ufl.verification.analytic.tube_hoop_tension_neo_hookean`). The cells are
+    ``"membrane"``: a solid pressed into it from above contacts them (``n0`` points up, to the
+    indenter).
+    """
+    from contact_ufl.loads import FollowerPressure
+    from contact_ufl.membranes import MembraneNeoHookean
+    from contact_ufl.verification import membrane_meshes
+
+    law = law or MembraneNeoHookean(1.0, 0.01)
+    data = membrane_meshes.drumhead(comm, a, n, quarter, dim)
+    loads = [FollowerPressure("membrane", lambda t: pressure * t)] if pressure else []
+    return Domain(
+        data.mesh,
+        data.cell_tags,
+        data.facet_tags,
+        [Body("membrane", law)],
+        drumhead_supports(a, stretch, quarter, dim),
+        loads,
+        groups=dict(data.groups),
+        name="drumhead",
+        direction=tuple(np.eye(dim)[dim - 1]),
+    )
+
+
+def pretension(problem, stretch: float, domain: int = 0) -> None:
+    """Start ``problem`` from the flat membrane of ``problem.bulks[domain]`` (in a plane
+    ``z = const`` about the origin, e.g. :func:`pretensioned_drumhead`; a string on a line
+    ``y = const``) stretched equi-biaxially: ``u = (stretch - 1) (x, y, 0)`` (a string's
+    ``(stretch - 1) (x, 0)``).
+
+    The solver starts from the problem's fields as they are when it is made (its first use):
+    call this before the first solve. Newton's first iterate is then a tensioned membrane,
+    whose transverse stiffness ``T Laplace`` is regular.
+    """
+    if problem._solver is not None:
+        raise ValueError("pretension must be set before the first solve (the solver exists)")
+    bulk = problem.bulks[domain]
+    if not bulk.membrane:
+        raise ValueError(f"domain {domain} is not a membrane")
+    gdim = bulk.V.mesh.geometry.dim
+    X = bulk.V.tabulate_dof_coordinates()[:, :gdim]
+    u = np.zeros_like(X)
+    u[:, : gdim - 1] = (stretch - 1.0) * X[:, : gdim - 1]
+    bulk.u.x.array[:] = u.ravel()
