@@ -16,7 +16,7 @@ from mpi4py import MPI
 import contact_ufl as cu
 from contact_ufl.results import body_resultants, equilibrium_error
 from contact_ufl.taylor import taylor_test
-from contact_ufl.verification import scenes
+from contact_ufl.verification import analytic, scenes
 from contact_ufl.verification.taylor_cases import curved_case
 
 COMM = MPI.COMM_WORLD
@@ -86,3 +86,65 @@ def test_membrane_sandwich_patch(dim, tolerance):
     supports = [f"{b}_{n}" for b in ("upper", "lower") for n in names]
     supports += ["lower_bottom", "membrane_boundary"]
     assert equilibrium_error(problem, supports) < 1e-10
+
+
+MU, T0, R0 = 1.0, 0.01, 1.0
+
+
+def _tube_between_plates(dim: int, n: int):
+    """The quarter tube (string ring in 2D) inflated to half its limit pressure, then pressed
+    by a rigid plate from 1.02 to 0.8 times its free radius (10 steps); the closed form."""
+    p = 0.5 * MU * T0 / R0
+    free = analytic.tube_free_radius(MU, T0, R0, p)
+    schedule = scenes.PlatesSchedule(p, 1.02 * free, 0.8 * free)
+    plate = schedule.plate(dim)
+    tube = scenes.tube_for_plates(schedule, dim=dim, n=n)
+    scene = cu.Scene(domains=[tube], contacts=[cu.ContactPair("tube", plate)])
+    problem = cu.ContactProblem(scene, verbose=False)
+    problem.solve(num_steps=10)
+    exact = analytic.tube_between_plates(MU, T0, R0, p, schedule.r_end)
+    return problem, schedule, plate, exact
+
+
+def _pressure_error(problem, schedule, exact) -> float:
+    """Largest deviation of the current contact pressure ``lambda_N / (da/dA)`` from the
+    inflation pressure over the points in contact within 3/4 of the flat zone's half width
+    (away from where the free arc leaves the plate), relative."""
+    (c,) = problem.contacts
+    active = c.active()
+    x = c.slave.positions(c.u).reshape(-1, problem.gdim)[:, 0]
+    pressure = c.multiplier_at_points() / c.slave.area_ratio(c.u).ravel()
+    inner = active & (x < 0.75 * exact["width"] / 2)
+    error = np.abs(pressure[inner] / schedule.pressure - 1.0).max(initial=0.0)
+    assert COMM.allreduce(int(inner.sum())) > 4
+    return COMM.allreduce(error, MPI.MAX)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_tube_between_plates(dim):
+    """An inflated tube pressed between rigid plates (quarter model; a membrane slave on a
+    rigid obstacle): the plate force is the inflation pressure times the contact width, the
+    contact pressure in the flat zone is the inflation pressure, the free arcs stay circular
+    (:func:`contact_ufl.verification.analytic.tube_between_plates`)."""
+    problem, schedule, plate, exact = _tube_between_plates(dim, 128)
+    assert not problem.history.cutbacks
+    depth = 0.1 if dim == 3 else 1.0  # the 3D tube's length (per unit depth in 2D)
+    force = problem.obstacle_reaction(plate)
+    assert abs(-force[1] / (0.5 * exact["force"] * depth) - 1.0) < 1e-3
+    assert _pressure_error(problem, schedule, exact) < 1e-2
+    bulk = problem.bulks[0]
+    owned = bulk.V.dofmap.index_map.size_local
+    x = bulk.V.tabulate_dof_coordinates()[:owned, :dim]
+    x = x + bulk.u.x.array.reshape(-1, dim)[:owned]
+    free = x[:, 0] > exact["width"] / 2 + 1e-9
+    radius = np.linalg.norm(x[free, :2] - [exact["width"] / 2, 0.0], axis=1)
+    error = np.abs(radius / schedule.r_end - 1.0).max(initial=0.0)
+    assert COMM.allreduce(error, MPI.MAX) < 1e-3
+
+
+def test_tube_contact_pressure_converges():
+    """The contact pressure's error in the flat zone falls under refinement (2D)."""
+    coarse, fine = (_tube_between_plates(2, n) for n in (64, 128))
+    e_coarse = _pressure_error(coarse[0], coarse[1], coarse[3])
+    e_fine = _pressure_error(fine[0], fine[1], fine[3])
+    assert e_fine < 0.25 * e_coarse, (e_coarse, e_fine)

@@ -66,7 +66,7 @@ def exterior_facet_cells(
         "(a contact surface must be on the boundary of its body)",
     )
     cells = f2c.array[offsets[facets]]
-    nfc = c2f.offsets[1] - c2f.offsets[0]
+    nfc = len(basix.topology(basix_cell(mesh, tdim))[tdim - 1])  # (a rank may have no cell)
     cell_facets = c2f.array.reshape(-1, nfc)[cells]
     local = np.argmax(cell_facets == facets[:, None], axis=1).astype(np.int32)
     return cells.astype(np.int32), local

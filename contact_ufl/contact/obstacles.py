@@ -393,6 +393,8 @@ class ObstacleKinematics:
         normals = np.repeat(self.slave.normals, self.slave.num_points, axis=0)
         outside = gap <= 1e-8 * (1.0 + np.abs(gap))
         opposed = np.einsum("pd,pd->p", nu, normals) < 0.0
+        if self.slave.membrane:  # either side of a membrane may face the obstacle
+            opposed = True
         total = self.slave.V.mesh.comm.allreduce(int(np.count_nonzero(valid & outside & opposed)))
         collective_check(
             self.slave.V.mesh.comm,
