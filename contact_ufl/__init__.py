@@ -25,7 +25,8 @@ Bodies on meshes of their own are :class:`Domain` s of one scene
 
 The parts, as modules: :mod:`.scene` (bodies, domains, supports, loads, pairs),
 :mod:`.gmshio` (meshes from gmsh), :mod:`.materials`, :mod:`.plasticity`, :mod:`.loads`,
-:mod:`.contact` (the contact pair as composed parts), :mod:`.bulk` (the displacement and bulk
+:mod:`.membranes` (membranes and strings), :mod:`.contact` (the contact pair as composed
+parts), :mod:`.bulk` (the displacement and bulk
 weak form of one mesh), :mod:`.problem` (fields and forms), :mod:`.newton`
 (the SNES solver), :mod:`.stepping` (load stepping), :mod:`.results`, :mod:`.output`,
 :mod:`.taylor`. Verification scenes and references live in :mod:`.verification`, which the
@@ -41,6 +42,11 @@ from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSph
 from contact_ufl.errors import ContactInputError, ConvergenceError
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerForce, FollowerPressure
 from contact_ufl.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff
+from contact_ufl.membranes import (
+    MembraneCompressibleNeoHookean,
+    MembraneNeoHookean,
+    MembraneSVK,
+)
 from contact_ufl.newton import NewtonSolver, NewtonTimings
 from contact_ufl.output import ResultWriter
 from contact_ufl.plasticity import J2Plasticity
@@ -67,6 +73,9 @@ __all__ = [
     "J2Plasticity",
     "LinearElastic",
     "LoadStepper",
+    "MembraneCompressibleNeoHookean",
+    "MembraneNeoHookean",
+    "MembraneSVK",
     "MeshData",
     "NeoHookean",
     "NewtonSolver",

@@ -17,7 +17,9 @@ from mpi4py import MPI
 import contact_ufl as cu
 from contact_ufl.membranes import MembraneNeoHookean
 from contact_ufl.results import equilibrium_error
+from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import analytic, scenes
+from contact_ufl.verification.taylor_cases import membrane_pressure_case
 
 COMM = MPI.COMM_WORLD
 MU, T0, R = 1.0, 0.01, 1.0
@@ -88,3 +90,12 @@ def test_pressure_on_membrane_edges_is_refused():
     (domain,) = scene.domains
     with pytest.raises(cu.ContactInputError, match="has dimension 1"):
         dataclasses.replace(domain, loads=[cu.FollowerPressure("x0", 1.0)])
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_taylor_membrane_under_follower_pressure(dim):
+    """The tangent of the membrane energy and of the follower pressure's load stiffness
+    (``ufl.derivative`` through the oriented normal), in the problem: Taylor slope 2."""
+    problem, dz, steps = membrane_pressure_case(dim)
+    result = taylor_test(problem, dz, steps)
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes

@@ -217,3 +217,31 @@ def obstacle_case(dim: int, num_steps: int = 4, mu: float = 0.0, shape: str = "c
     contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
     direction = sliding_direction(problem, tag, np.array(state["slide"]))
     return problem, direction, [state["h0"] * 2.0**-k for k in range(num_steps)]
+
+
+def membrane_pressure_case(dim: int, num_steps: int = 4):
+    """The Taylor test case of a membrane under a follower pressure (no contact): the sphere
+    octant of :func:`~contact_ufl.verification.scenes.inflated_sphere` (3D) or the quarter
+    string ring of :func:`~contact_ufl.verification.scenes.tube_for_plates` (2D), deformed by
+    a smooth field, at its full pressure; the direction another smooth field. Returns the
+    problem at its state, the direction and the steps, as :func:`curved_case`."""
+    from contact_ufl.scene import Scene
+    from contact_ufl.verification.scenes import PlatesSchedule, inflated_sphere, tube_for_plates
+
+    if dim == 3:
+        scene = inflated_sphere(n=8, pressure=0.01)
+    else:
+        schedule = PlatesSchedule(0.005, 2.0, 1.5)
+        scene = Scene(domains=[tube_for_plates(schedule, dim=2, n=16)])
+    problem = ContactProblem(scene, verbose=False)
+    solver = problem.solver
+    problem.set_time(1.0)
+    (bulk,) = problem.bulks
+    bulk.u.interpolate(lambda x: smooth_field(x, 0.05, dim))
+    du = dolfinx.fem.Function(bulk.V)
+    du.interpolate(lambda x: smooth_field(x, 0.05, dim, phase=0.7))
+    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
+    solver.forget_state()
+    direction = solver.x.duplicate()
+    dolfinx.fem.petsc.assign([du], direction)
+    return problem, direction, [1e-2 * 2.0**-k for k in range(num_steps)]
