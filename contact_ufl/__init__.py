@@ -39,6 +39,7 @@ from contact_ufl import (
     results,
 )
 from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSphere
+from contact_ufl.control import VolumeControl
 from contact_ufl.errors import ContactInputError, ConvergenceError
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerForce, FollowerPressure
 from contact_ufl.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff
@@ -87,6 +88,7 @@ __all__ = [
     "SaintVenantKirchhoff",
     "Scene",
     "StepRecord",
+    "VolumeControl",
     "output",
     "read_gmsh",
     "results",

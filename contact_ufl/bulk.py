@@ -18,6 +18,7 @@ import ufl
 from mpi4py import MPI
 
 from contact_ufl import membranes
+from contact_ufl.control import VolumeControl
 from contact_ufl.loads import (
     BodyForce,
     FollowerPressure,
@@ -92,7 +93,11 @@ class Bulk:
             for b in domain.bodies
             if isinstance(b.material, J2Plasticity)
         }
-        self.load_constants = [(load, load_constant(mesh, load)) for load in domain.loads]
+        self.load_constants = [
+            (load, load_constant(mesh, load))
+            for load in domain.loads
+            if not isinstance(load, VolumeControl)  # (its pressure is an unknown)
+        ]
         self._energy_form = None
         self._load_resultant_forms = None
         self._locate_dirichlet()

@@ -233,7 +233,8 @@ class NewtonSolver:
         """Search, refresh the contact data and (if the pairing changed) the operator T."""
         start = time.perf_counter()
         contacts = self.problem.contacts
-        gathers = [c.update(self.problem.layout) for c in contacts]
+        parts = [*contacts, *self.problem.controls]  # (controls gather their load factor)
+        gathers = [c.update(self.problem.layout) for c in parts]
         pattern = [cols for g in gathers for _, cols in g]
         pattern = np.concatenate(pattern) if pattern else np.zeros(0, np.int64)
         changed = self._pattern is None or not np.array_equal(pattern, self._pattern)

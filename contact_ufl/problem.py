@@ -24,6 +24,7 @@ from petsc4py import PETSc
 from contact_ufl.bulk import Bulk
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
+from contact_ufl.control import VolumeConstraint, VolumeControl
 from contact_ufl.layout import StackedLayout
 from contact_ufl.mpi import global_bounds, global_diameter
 from contact_ufl.scene import Domain, Scene
@@ -144,6 +145,15 @@ class ContactProblem:
         #: :attr:`Scene.parts <contact_ufl.scene.Scene.parts>`
         self.bulks = [Bulk(d, degree, quadrature_degree) for d in parts]
         self.contacts = [self._interface(p, parts) for p in scene.contacts]
+        size, E = self.scales()
+        #: the path-following controls (:mod:`contact_ufl.control`): unknown load factors
+        #: with their equations, e.g. a membrane's pressure set by its enclosed volume
+        self.controls = [
+            VolumeConstraint(load, b, E / size)
+            for b in self.bulks
+            for load in b.domain.loads
+            if isinstance(load, VolumeControl)
+        ]
         self._build_forms()
         self._build_dirichlet()
         self._solver: NewtonSolver | None = None
@@ -218,6 +228,9 @@ class ContactProblem:
         contact_residuals: list = [0] * len(self.bulks)
         fields = [b.u for b in self.bulks]
         unknowns = list(fields)
+        for control in self.controls:
+            k = self.bulks.index(control.bulk)
+            residuals[k] = residuals[k] - control.bulk_residual(tests[k])
         for c in self.contacts:
             k = c.pair.slave_domain
             Fu_c, F_fields = c.residuals(tests[k])
@@ -227,6 +240,13 @@ class ContactProblem:
             contact_residuals += F_fields
             fields += c.fields
             unknowns += c.unknowns
+        for control in self.controls:
+            residuals += control.residuals()
+            q, mesh = ufl.TestFunction(control.P), control.P.mesh
+            contact_residuals += [dolfinx.fem.Constant(mesh, 0.0) * q * control.bulk.dx]
+            fields += control.fields
+            unknowns += control.unknowns
+            control.block = len(unknowns) - 1
         self.fields, self.unknowns = fields, unknowns
         jacobian = [
             [_nonempty(ufl.derivative(Fi, f, ufl.TrialFunction(f.function_space))) for f in fields]
@@ -282,6 +302,8 @@ class ContactProblem:
         self.t = t
         for b in self.bulks:
             b.set_time(t)
+        for control in self.controls:
+            control.set_time(t)
         for c in self.contacts:
             c.set_time(t)
 
@@ -392,7 +414,9 @@ class ContactProblem:
 
     def load_resultant(self) -> np.ndarray:
         """Resultant of all applied loads (dead and follower) at the current state."""
-        return sum((b.load_resultant() for b in self.bulks), np.zeros(self.gdim))
+        loads = [b.load_resultant() for b in self.bulks]
+        loads += [control.load_resultant() for control in self.controls]
+        return sum(loads, np.zeros(self.gdim))
 
     def contact_residual(self) -> PETSc.Vec:
         """The contact terms alone of the residual at the current state, as a vector of the

@@ -30,6 +30,7 @@ from mpi4py import MPI
 
 from contact_ufl.contact import ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
+from contact_ufl.control import VolumeControl
 from contact_ufl.errors import ContactInputError, collective_check
 from contact_ufl.loads import BodyForce, FollowerForce, FollowerPressure, Load, evaluate
 from contact_ufl.materials import Hyperelastic
@@ -185,7 +186,9 @@ class Domain:
     def on_cells(self, load: Load) -> bool:
         """Whether ``load`` acts on cells (a body force, a pressure on a membrane) rather
         than on facets."""
-        return isinstance(load, BodyForce) or (self.membrane and isinstance(load, FollowerPressure))
+        return isinstance(load, BodyForce) or (
+            self.membrane and isinstance(load, FollowerPressure | VolumeControl)
+        )
 
     @property
     def surface_dim(self) -> int:
@@ -309,6 +312,12 @@ class Domain:
                 f"(facet tags: {sorted(facet_values)})",
             )
         for load in self.loads:
+            collective_check(
+                comm,
+                self.membrane or not isinstance(load, VolumeControl),
+                f"{where}a VolumeControl (cell tag {load.tag}) needs a membrane: the pressure "
+                "whose enclosed volume it controls acts on membrane cells",
+            )
             if self.on_cells(load):
                 collective_check(
                     comm,

@@ -1,0 +1,104 @@
+"""Past a limit point: the inflation of a Neo-Hookean balloon controlled by its volume.
+
+Under a prescribed pressure an incompressible Neo-Hookean spherical membrane has a pressure
+maximum, ``p = 2 mu t0 / R (1/l - 1/l^7)`` is largest at the stretch ``l = 7^(1/6)``:
+load control cannot pass it. Controlled by its enclosed volume (the pressure an unknown,
+:class:`contact_ufl.control.VolumeControl`) the inflation goes through it, and the pressure
+follows the closed form on both sides.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import contact_ufl as cu
+from contact_ufl.control import VolumeControl
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification import analytic, scenes
+
+COMM = MPI.COMM_WORLD
+MU, T0, R = 1.0, 0.01, 1.0
+STRETCH_END = 1.6  # beyond the maximum at 7^(1/6) = 1.383
+P_MAX = analytic.sphere_inflation_neo_hookean(MU, T0, R, 7.0 ** (1.0 / 6.0))
+
+
+def balloon(control) -> cu.Scene:
+    """The sphere octant of :func:`~contact_ufl.verification.scenes.inflated_sphere` with
+    the pressure load replaced by ``control`` (or a pressure, for load control)."""
+    (domain,) = scenes.inflated_sphere(n=32, law=cu.MembraneNeoHookean(MU, T0)).domains
+    return cu.Scene(domains=[dataclasses.replace(domain, loads=[control])])
+
+
+@pytest.fixture(scope="module")
+def inflated():
+    ratio = STRETCH_END**3 - 1.0
+    problem = cu.ContactProblem(
+        balloon(VolumeControl("membrane", lambda t: 1.0 + ratio * t)), verbose=False
+    )
+    (control,) = problem.controls
+    path = []
+
+    def record(problem, step):
+        stretch = (control.volume() / control.reference_volume) ** (1.0 / 3.0)
+        path.append((stretch, control.pressure))
+
+    problem.solve(num_steps=12, callback=record)
+    return problem, np.array(path)
+
+
+def test_volume_control_passes_the_pressure_maximum(inflated):
+    """Every step converges; the pressure rises to its maximum and falls past it, and
+    follows the closed form within 0.1% (the faceted sphere) on both sides."""
+    problem, path = inflated
+    assert len(problem.history.steps) == 12 and not problem.history.cutbacks
+    stretch, pressure = path.T
+    assert np.isclose(stretch[-1], STRETCH_END, rtol=1e-9)
+    peak = np.argmax(pressure)
+    assert 0 < peak < len(pressure) - 1  # a maximum inside the path
+    assert np.all(np.diff(pressure[peak:]) < 0.0) and np.all(np.diff(pressure[: peak + 1]) > 0)
+    exact = analytic.sphere_inflation_neo_hookean(MU, T0, R, stretch)
+    assert np.abs(pressure / exact - 1.0).max() < 1e-3
+    assert abs(pressure.max() / P_MAX - 1.0) < 2e-3
+
+
+def test_volume_control_equilibrium(inflated):
+    """The unknown pressure's resultant balances the symmetry supports."""
+    problem, _ = inflated
+    from contact_ufl.results import equilibrium_error
+
+    assert equilibrium_error(problem, ["x0", "y0", "z0"]) < 1e-8
+
+
+def test_load_control_stops_at_the_maximum():
+    """The same balloon under a prescribed pressure 2% above the maximum: no step beyond
+    the maximum converges."""
+    pressure = cu.FollowerPressure("membrane", lambda t: 1.02 * P_MAX * t)
+    problem = cu.ContactProblem(balloon(pressure), verbose=False)
+    with pytest.raises(cu.ConvergenceError):
+        problem.solve(num_steps=4, max_cutbacks=3)
+    reached = problem.history.steps[-1].t if problem.history.steps else 0.0
+    assert reached * 1.02 < 1.0  # stopped below the maximum
+
+
+def test_taylor_with_the_pressure_unknown(inflated):
+    """The bordered tangent (load vector column, volume row): Taylor slope 2 along a
+    direction that changes the displacement and the pressure."""
+    problem, _ = inflated
+    solver = problem.solver
+    dz = solver.x.duplicate()
+    rng = np.random.default_rng(COMM.rank)
+    dz.array[:] = 1e-2 * rng.standard_normal(len(dz.array))
+    dz.array[problem.dirichlet_rows] = 0.0
+    result = taylor_test(problem, dz, [1e-2 * 2.0**-k for k in range(4)])
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
+
+
+def test_volume_control_needs_a_membrane():
+    scene = scenes.patch()
+    bad = dataclasses.replace(scene, loads=[VolumeControl("upper_top", 2.0)])
+    with pytest.raises(cu.ContactInputError, match="needs a membrane"):
+        cu.ContactProblem(bad, verbose=False)
