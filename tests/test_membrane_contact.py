@@ -33,11 +33,14 @@ TIGHT = {"snes_rtol": 1e-12, "snes_atol": 1e-15}
         (2, "slave", 0.05, -1.0),
         (3, "master", 0.0, -1.0),
         (3, "slave", 0.05, 1.0),
+        (2, "both", 0.05, -1.0),
+        (3, "both", 0.0, 1.0),
     ],
 )
 def test_taylor_membrane(dim, side, mu, direction):
     """Taylor slope 2 with a membrane master (either orientation: the acting side follows
-    the slave) or a membrane slave, frictionless and in slip."""
+    the slave), a membrane slave, or both (membrane on membrane), frictionless and in
+    slip."""
     problem, dz, steps = curved_case(dim, mu=mu, membrane=side, direction=direction)
     assert any(b.membrane for b in problem.bulks) and problem.active_points() > 10
     kinematics = problem.contacts[0].kinematics

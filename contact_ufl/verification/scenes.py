@@ -705,15 +705,16 @@ def surface_as_membrane(
 def with_membrane(scene: Scene, side: str, law, direction) -> Scene:
     """The two-body one-mesh ``scene`` (one contact pair) with one body replaced by a
     membrane made of its contact surface (:func:`surface_as_membrane`): ``side`` is
-    ``"master"`` or ``"slave"``; the other body keeps a mesh of its own."""
+    ``"master"`` or ``"slave"`` (the other body keeps a mesh of its own), or ``"both"``."""
     split = on_meshes_of_their_own(scene)
     (pair,) = split.contacts
-    k = getattr(pair, f"{side}_domain")
-    body_tag = split.domains[k].bodies[0].tag
-    membrane = surface_as_membrane(scene, getattr(pair, side), body_tag, law, direction)
-    domains = list(split.domains)
-    domains[k] = membrane
-    return Scene(domains=domains, contacts=[dataclasses.replace(pair, **{side: body_tag})])
+    domains, changes = list(split.domains), {}
+    for role in ("slave", "master") if side == "both" else (side,):
+        k = getattr(pair, f"{role}_domain")
+        body_tag = split.domains[k].bodies[0].tag
+        domains[k] = surface_as_membrane(scene, getattr(pair, role), body_tag, law, direction)
+        changes[role] = body_tag
+    return Scene(domains=domains, contacts=[dataclasses.replace(pair, **changes)])
 
 
 def membrane_sandwich(dim: int = 2, pressure: float = 0.01, law=None) -> Scene:
