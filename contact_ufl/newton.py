@@ -187,6 +187,10 @@ class NewtonSolver:
         self._J = self._assemble_jacobian_matrix(first=True)
         self.snes = self._create_snes(petsc_options or {}, petsc_options_prefix)
         self.fallback_linesearch: str | None = "bt"
+        #: per Newton iteration of the last solve: residual norm and the contact state (a
+        #: signature of the pairing and status of this rank's points), for :meth:`diagnose`
+        self.iterates: list[tuple[float, int]] = []
+        self._not_finite = None
         #: try a closing iterate where a pair has no point in contact (:meth:`solve_step`)
         self.close_gaps = True
         problem._solver = self  # the solver of the problem's results that need T
@@ -205,6 +209,7 @@ class NewtonSolver:
         # and communicators) alive through a reference cycle that Python's collector cannot see
         snes.setFunction(_weakly(self._residual), self._R)
         snes.setJacobian(_weakly(self._jacobian), self._J)
+        snes.setMonitor(_weakly(self._monitor))
         snes.setFromOptions()
         snes.getKSP().setFromOptions()
         return snes
@@ -302,6 +307,10 @@ class NewtonSolver:
         if len(rows):
             u = x.array_r[rows]
             F.array[rows] = problem.dirichlet_scale * (u - problem.prescribed(problem.t))
+        if self._in_snes and not np.isfinite(F.norm()):  # where did the iterate go wrong?
+            from contact_ufl.results import inverted_cell_centres
+
+            self._not_finite = inverted_cell_centres(problem)
         end = time.perf_counter()
         self.timings.residual_assembly += end - assembly
         self.timings.residuals += 1
@@ -447,9 +456,52 @@ class NewtonSolver:
                 c.normal.closing.value = c.normal.touching
             self._state = None
 
+    def _monitor(self, snes, its: int, norm: float) -> None:
+        """Record the residual norm and the contact state of each Newton iterate."""
+        state = [
+            np.concatenate([c.projection.facet, c.active().astype(np.int64)])
+            for c in self.problem.contacts
+            if c.projection is not None
+        ]
+        signature = hash(np.concatenate(state).tobytes()) if state else 0
+        self.iterates.append((float(norm), signature))
+
+    def diagnose(self) -> str:
+        """Why the last Newton solve failed, at its last iterate (collective): inverted
+        elements (and where), contact pairing or status that cycles between iterates, or a
+        residual that stalls with neither (a limit point, or a singular tangent)."""
+        from contact_ufl.results import inverted_cell_centres
+
+        centres = inverted_cell_centres(self.problem)
+        if not len(centres) and self._not_finite is not None:
+            centres = self._not_finite  # the trial iterate the line search rejected
+        if len(centres):
+            where = ", ".join("(" + ", ".join(f"{v:.3g}" for v in c) + ")" for c in centres[:3])
+            return f"inverted elements in {len(centres)} cells, e.g. at {where}"
+        signatures = [s for _, s in self.iterates]
+        revisits = any(
+            signatures[k] in signatures[: k - 1] and signatures[k] != signatures[k - 1]
+            for k in range(2, len(signatures))
+        )
+        if self.comm.allreduce(revisits, MPI.LOR):
+            return (
+                "the contact pairing or status cycles: an iterate returns to the contact state "
+                "of an earlier one (active-set cycling)"
+            )
+        changes = sum(a != b for a, b in zip(signatures, signatures[1:], strict=False))
+        if self.comm.allreduce(changes, MPI.SUM) == 0 and len(signatures) > 2:
+            return (
+                "the residual stalls with no inverted element and no change of contact state: "
+                "a limit point or a singular tangent (a load beyond a maximum, a body free "
+                "to move)"
+            )
+        return "the residual does not converge (no inverted element, no contact cycling)"
+
     def _newton(self) -> tuple[int, int]:
         """One SNES solve from :attr:`x`: converged reason and iterations."""
         self._state = None
+        self.iterates = []
+        self._not_finite = None  # inverted cells of an iterate whose residual is NaN/inf
         start = time.perf_counter()
         self._in_snes = True
         try:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -58,6 +58,26 @@ class StepRecord:
     reason: str = ""
 
 
+class Cutback(NamedTuple):
+    """A failed load step, cut back.
+
+    Attributes
+    ----------
+    t
+        The pseudo-time the step tried to reach.
+    reason
+        SNES's converged reason of its last try (a ``DIVERGED_*`` name).
+    why
+        What went wrong at its last iterate (:meth:`NewtonSolver.diagnose
+        <contact_ufl.newton.NewtonSolver.diagnose>`): inverted elements and where, contact
+        cycling, or a stalled residual (a limit point).
+    """
+
+    t: float
+    reason: str
+    why: str = ""
+
+
 @dataclass
 class History:
     """Accepted steps and cut-backs of a run.
@@ -67,11 +87,11 @@ class History:
     steps
         The accepted steps.
     cutbacks
-        Pseudo-time and SNES converged reason of every failed step.
+        Every failed step (:class:`Cutback`: pseudo-time, SNES converged reason, why).
     """
 
     steps: list[StepRecord] = field(default_factory=list)
-    cutbacks: list[tuple[float, str]] = field(default_factory=list)
+    cutbacks: list[Cutback] = field(default_factory=list)
 
 
 class LoadStepper:
@@ -132,15 +152,16 @@ class LoadStepper:
             problem.begin_step()
             ok, its, reason = solver.solve_step(t_new)
             if not ok:
+                why = solver.diagnose()
                 self._restore(saved, t_prev)
-                self.history.cutbacks.append((t_new, reason))
-                self._print(f"  step to t = {t_new:.5g} failed ({reason}): cutting back")
+                self.history.cutbacks.append(Cutback(t_new, reason, why))
+                self._print(f"  step to t = {t_new:.5g} failed ({reason}; {why}): cutting back")
                 dt, streak = 0.5 * dt, 0
                 if dt < dt0 * 0.5**max_cutbacks * (1.0 - 1e-9):
                     raise ConvergenceError(
-                        f"load step from t = {t_prev:.6g} to t = {t_new:.6g} did not converge "
-                        f"({reason}) after {max_cutbacks} cut-backs; the state of "
-                        f"t = {t_prev:.6g} is kept"
+                        f"load step {len(self.history.steps) + 1}, from t = {t_prev:.6g} to "
+                        f"t = {t_new:.6g}, did not converge ({reason}: {why}) after "
+                        f"{max_cutbacks} cut-backs; the state of t = {t_prev:.6g} is kept"
                     )
                 continue
             record = StepRecord(

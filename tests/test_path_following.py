@@ -78,8 +78,9 @@ def test_load_control_stops_at_the_maximum():
     the maximum converges."""
     pressure = cu.FollowerPressure("membrane", lambda t: 1.02 * P_MAX * t)
     problem = cu.ContactProblem(balloon(pressure), verbose=False)
-    with pytest.raises(cu.ConvergenceError):
+    with pytest.raises(cu.ConvergenceError, match="limit point"):
         problem.solve(num_steps=4, max_cutbacks=3)
+    assert all("limit point" in c.why for c in problem.history.cutbacks)
     reached = problem.history.steps[-1].t if problem.history.steps else 0.0
     assert reached * 1.02 < 1.0  # stopped below the maximum
 

@@ -37,7 +37,7 @@ def test_cutbacks_run_out_with_a_clear_error():
     problem.solve(num_steps=2, t_end=0.5)
     accepted = list(problem.history.steps)
     problem.solver.snes.setTolerances(max_it=1)  # now no step can converge
-    with pytest.raises(ConvergenceError, match=r"load step from t = .* did not converge"):
+    with pytest.raises(ConvergenceError, match=r"load step 3, from t = 0.5 to .* did not converge"):
         problem.solve(num_steps=1, t_end=1.0, max_cutbacks=2)
     assert problem.history.steps[: len(accepted)] == accepted  # nothing accepted is lost
     assert problem.t == pytest.approx(accepted[-1].t)  # state restored to the last accepted
@@ -106,3 +106,16 @@ def test_newton_timings_are_filled_and_reset():
     timings.reset()
     assert timings == NewtonTimings()
     assert timings.linear_solve == 0.0
+
+
+def test_a_failed_step_says_where_elements_invert():
+    """A load far beyond what one Newton step can take, without the line search: the trial
+    iterate inverts elements (its residual is not a number); the error names the step, the
+    reason and where the elements inverted (the loaded block's cells)."""
+    problem = ContactProblem(scenes.patch(pressure=3.0), verbose=False)
+    problem.solver.fallback_linesearch = None
+    with pytest.raises(ConvergenceError, match=r"load step 1.*inverted elements in \d+ cells"):
+        problem.solve(num_steps=1, max_cutbacks=1)
+    (first, second) = problem.history.cutbacks
+    assert first.reason == "DIVERGED_FUNCTION_NANORINF" and "inverted" in first.why
+    assert np.all(problem.u.x.array == 0.0)  # the start of the step is kept

@@ -185,6 +185,7 @@ class _FailureObserver:
                     "inverted_cells": inverted_cells(problem),
                     "active_points": problem.active_points(),
                     "status_changes": self._status_changes(),
+                    "why": problem.solver.diagnose(),
                 }
             )
         return ok, its, reason
@@ -200,7 +201,7 @@ def run_case(case: Case) -> dict:
         ``steps``, ``cutbacks``, ``newton_max``, ``newton_mean`` (per accepted step),
         ``all_converged`` (the run completed and every accepted step has a ``CONVERGED_*``
         SNES reason), ``step_reasons`` (the distinct reasons of the accepted steps),
-        ``failures`` (one record per failed try: ``from_time``, ``time``, ``reason``,
+        ``failures`` (one record per failed try: ``from_time``, ``time``, ``reason``, ``why``,
         ``newton_iterations``, ``inverted_cells``, ``active_points``, ``status_changes``:
         the points whose contact status differs from the last accepted step), ``error`` (the
         message of the :class:`ConvergenceError`, or ``None``), ``unknowns``, ``wall_s``.

@@ -130,7 +130,9 @@ def ironing_run(
         "h_block": h_block,
         "unknowns": problem.layout.global_size,
         "history": history,
-        "cutbacks": [{"time": t, "reason": r} for t, r in problem.history.cutbacks],
+        "cutbacks": [
+            {"time": c.t, "reason": c.reason, "why": c.why} for c in problem.history.cutbacks
+        ],
     }
     return run, problem
 
