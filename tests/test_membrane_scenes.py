@@ -99,3 +99,22 @@ def test_taylor_membrane_under_follower_pressure(dim):
     problem, dz, steps = membrane_pressure_case(dim)
     result = taylor_test(problem, dz, steps)
     assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
+
+
+def test_non_orientable_membrane_is_refused():
+    """A Moebius strip has no consistent normal: the problem refuses it on every rank."""
+    from contact_ufl.verification import membrane_meshes
+
+    data = membrane_meshes.with_tags(membrane_meshes.moebius_strip(COMM), {})
+    domain = cu.Domain.from_mesh_data(
+        data, bodies=[cu.Body("membrane", MembraneNeoHookean(1.0, 0.01))]
+    )
+    with pytest.raises(cu.ContactInputError, match="orient"):
+        cu.ContactProblem(cu.Scene(domains=[domain]), verbose=False)
+
+
+def test_pressure_on_solid_cells_is_refused():
+    """A follower pressure on a solid acts on its boundary facets, not on its cells."""
+    scene = scenes.patch()
+    with pytest.raises(cu.ContactInputError, match="facet group"):
+        dataclasses.replace(scene, loads=[cu.FollowerPressure("upper", 1.0)])
