@@ -104,16 +104,23 @@ CURVED_STATES = {
 }
 
 
-def curved_case(dim: int, num_steps: int = 4, mu: float = 0.0, master_normal: str = "facet"):
+def curved_case(
+    dim: int,
+    num_steps: int = 4,
+    mu: float = 0.0,
+    master_normal: str = "facet",
+    cell: str = "tetrahedron",
+):
     """The Taylor test case on curved surfaces: problem at its state, direction, steps.
 
     With ``mu > 0`` the state has a slip history: the step is committed half-way along the
     translation, and the tangential multipliers are smooth and non-zero (a small ``mu``
     puts the contact points in slip, a large one in stick). Over the steps no slave point
     changes master facet, contact status or stick/slip status. ``master_normal`` is that
-    of :class:`~contact_ufl.contact.ContactPair`.
+    of :class:`~contact_ufl.contact.ContactPair`; ``cell`` (3D) that of
+    :func:`~contact_ufl.verification.scenes.curved_pair`.
     """
-    scene = curved_pair(dim)
+    scene = curved_pair(dim, cell=cell)
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu, master_normal=master_normal)
     problem = ContactProblem(scene, verbose=False)
     solver = problem.solver  # made at the reference state, the converged state of step 0
