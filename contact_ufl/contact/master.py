@@ -88,7 +88,7 @@ class MeshMaster:
             self._ring, self._ring_flags = segment_neighbours(V.mesh.comm, self.global_nodes)
         elif smoothed:
             fans = node_fans(V.mesh.comm, self.global_nodes, self.nn)
-            self._ring = fans.reshape(len(fans), -1)
+            self._ring = fans.reshape(len(fans), fans.shape[1] * fans.shape[2])
             self._ring_flags = np.zeros((len(fans), 0), dtype=bool)
         if smoothed:
             self.nx += int(V.mesh.comm.allreduce(self._ring.shape[1], MPI.MAX))
