@@ -11,12 +11,20 @@ from mpi4py import MPI
 
 from contact_ufl.contact import master as master_module
 from contact_ufl.contact.facets import FACET_EDGES
-from contact_ufl.contact.master import fan_normals, node_fans, smoothed_normals_3d
+from contact_ufl.contact.master import (
+    CYCLIC_ORDER,
+    MeshMaster,
+    fan_normals,
+    node_fans,
+    smoothed_normals_3d,
+)
 from contact_ufl.contact.projection import shape_functions
 from contact_ufl.errors import ContactInputError
+from contact_ufl.layout import StackedLayout
 from contact_ufl.problem import ContactProblem
-from contact_ufl.verification.scenes import curved_pair
-from contact_ufl.verification.taylor_cases import curved_case
+from contact_ufl.verification.geometries import tag_single_body
+from contact_ufl.verification.scenes import curved_pair, warp_saddle
+from contact_ufl.verification.taylor_cases import curved_case, smooth_field
 
 #: reference coordinates of the vertices of a triangle and a quadrilateral (basix order)
 REFERENCE_VERTICES = {
@@ -46,6 +54,46 @@ def test_fans_reject_a_pinched_surface():
     triangles = np.array([[0, 1, 2], [0, 3, 4]])
     with pytest.raises(ContactInputError, match="one fan"):
         node_fans(MPI.COMM_SELF, triangles, 3)
+
+
+@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
+def test_nodal_normals_gather_the_facets_of_every_rank(cell):
+    """The nodal normals of the carried fans are those of all the facets around each node,
+    wherever they live: compared with the sum of the corner normals of every facet of every
+    rank. On two ranks the master surface (the top of one box) is split between them."""
+    cell_type = getattr(dolfinx.mesh.CellType, cell)
+    mesh = dolfinx.mesh.create_box(
+        MPI.COMM_WORLD,
+        [[0.0, 0.0, 0.0], [1.0, 1.0, 0.5]],
+        [6, 6, 2],
+        cell_type,
+        ghost_mode=dolfinx.mesh.GhostMode.shared_facet,
+    )
+    _, facet_tags = tag_single_body(mesh, [lambda x: np.isclose(x[2], 0.5)])
+    warp_saddle(mesh)
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (3,)))
+    u = dolfinx.fem.Function(V)
+    u.interpolate(lambda x: smooth_field(x, 0.05, 3))
+    master = MeshMaster(V, facet_tags, 1, smoothed=True)
+    nn, comm = master.nn, mesh.comm
+    normals = fan_normals(master.candidates(u, StackedLayout([V])).nodes, nn)
+    # the reference: the corner normals of all facets of all ranks, summed at their nodes
+    ids = np.concatenate(comm.allgather(master.global_nodes.astype(np.int64)))
+    X = np.concatenate(comm.allgather(master.current_nodes(u)))
+    cyclic = list(CYCLIC_ORDER[nn])
+    ids, X = ids[:, cyclic], X[:, cyclic]
+    corner = np.cross(np.roll(X, -1, axis=1) - X, np.roll(X, 1, axis=1) - X)
+    nodes, inverse = np.unique(ids, return_inverse=True)
+    summed = np.zeros((len(nodes), 3))
+    np.add.at(summed, inverse.ravel(), corner.reshape(-1, 3))
+    summed /= np.linalg.norm(summed, axis=1, keepdims=True)
+    expected = summed[np.searchsorted(nodes, master.global_nodes)]
+    assert np.abs(normals - expected).max(initial=0.0) < 1e-13
+    assert comm.allreduce(len(normals), MPI.SUM) == (72 if nn == 3 else 36)  # 6 x 6 squares
+    if comm.size > 1:  # every rank holds master facets, and fans reach the other's nodes
+        mine = np.isin(master._ring, master.global_nodes)
+        assert comm.allreduce(master.num_facets, MPI.MIN) > 0
+        assert comm.allreduce(int(np.count_nonzero(~mine)), MPI.MIN) > 0
 
 
 def test_too_many_facets_around_a_node(monkeypatch):

@@ -273,10 +273,12 @@ def curved_pair(
     ``dim = 2``: a half disc above a block with a circular top; ``dim = 3``: a half cylinder
     above a block with a cylindrical top of crossed axis, or with ``cell="hexahedron"`` the
     hexahedral stacked boxes of :func:`~contact_ufl.verification.geometries.patch_3d` warped
-    (:func:`warp_saddle`) so that their common surface is a saddle.
+    (:func:`warp_saddle`) so that their common surface is a saddle; the lower body is the
+    finer (element size 0.1 against 1/6), so a partition into two ranks splits it and its
+    master surface.
     """
     if dim == 3 and cell == "hexahedron":
-        sm = geometries.patch_3d(cell=cell, comm=comm)
+        sm = geometries.patch_3d(cell=cell, h_lower=0.1, comm=comm)
         warp_saddle(sm.mesh)
         names = ("upper", "lower", "upper_contact", "lower_contact")
     elif dim == 2:
