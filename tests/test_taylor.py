@@ -45,3 +45,21 @@ def test_taylor_smoothed_master_normal(mu):
     result = taylor_test(problem, dz, steps)
     assert not result.facets_changed and not result.active_changed
     assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
+
+
+@pytest.mark.parametrize("cell, nn", [("tetrahedron", 3), ("hexahedron", 4)])
+@pytest.mark.parametrize("mu", [0.0, 0.05])
+def test_taylor_smoothed_master_normal_3d(cell, nn, mu):
+    """In 3D the smoothed normal depends on the fans of the master facet's nodes (triangles
+    of tetrahedra, bilinear quadrilaterals of hexahedra), gathered with the facet's nodes:
+    the tangent is still exact, frictionless and in slip."""
+    problem, dz, steps = curved_case(3, mu=mu, master_normal="smoothed", cell=cell)
+    kinematics = problem.contacts[0].kinematics
+    assert kinematics.nx > nn and (kinematics.nx - nn) % nn == 0
+    assert problem.active_points() > 10
+    if cell == "hexahedron" and problem.comm.size > 1:  # fans of nodes on two ranks
+        master = problem.contacts[0].master
+        assert problem.comm.allreduce(master.num_facets, op=MPI.MIN) > 0
+    result = taylor_test(problem, dz, steps)
+    assert not result.facets_changed and not result.active_changed
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes

@@ -141,11 +141,6 @@ class ContactInterface:
         """The kinematics of a meshed master surface (with its search)."""
         comm, gdim = self.V.mesh.comm, self.gdim
         smoothed = pair.master_normal == "smoothed"
-        collective_check(
-            comm,
-            not smoothed or gdim == 2,
-            "master_normal='smoothed' is implemented for 2D (segment) master surfaces only",
-        )
         self.master = MeshMaster(master_u, facet_tags, pair.master, smoothed, block, orientation)
         size = global_diameter(
             comm,

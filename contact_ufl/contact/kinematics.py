@@ -92,6 +92,33 @@ def smoothed_normal(xi, nodes, flags, mask) -> ufl.core.expr.Expr:
     return n / ufl.sqrt(ufl.dot(n, n) + (1.0 - mask))
 
 
+def smoothed_normal_3d(xi, nodes, nn: int, mask) -> ufl.core.expr.Expr:
+    """3D master normal interpolated from averaged nodal normals over the facet.
+
+    ``nodes`` rows: the facet's ``nn`` nodes, then the fan of each (``K + 1`` slots, see
+    :mod:`.master`). The nodal normal of ``a`` is the normalised sum of the corner normals
+    ``(s_i - a) x (s_i+1 - a)`` of its fan (the area-weighted average of the unit normals of
+    the facets around ``a``; padded slots hold ``a`` and add zero); the normal at ``xi`` is
+    the normalised interpolation of the nodal normals with the facet's shape functions.
+    """
+    slots = (nodes.ufl_shape[0] - nn) // nn
+    N, _ = master_shape_functions(nn, xi)
+
+    def node(k):
+        return ufl.as_vector([nodes[k, i] for i in range(3)])
+
+    def unit(v):
+        return v / ufl.sqrt(ufl.dot(v, v) + (1.0 - mask))
+
+    n = 0
+    for a in range(nn):
+        x_a = node(a)
+        fan = [node(nn + a * slots + i) - x_a for i in range(slots)]
+        n_a = sum(ufl.cross(fan[i], fan[i + 1]) for i in range(slots - 1))
+        n = n + N[a] * unit(n_a)
+    return unit(n)
+
+
 class MeshKinematics:
     """Gap, normal and projected point of the slave points on a meshed master side.
 
@@ -142,8 +169,9 @@ class MeshKinematics:
         self.xi0 = dolfinx.fem.Function(space((self.fdim,)))
         self.M = dolfinx.fem.Function(space((self.fdim, self.fdim)))
         self.mask = dolfinx.fem.Function(space(()))
-        #: (smoothed normal) whether the neighbour before / after the facet exists
-        self.neighbour_flags = dolfinx.fem.Function(space((2,))) if master.smoothed else None
+        #: (smoothed normal, 2D) whether the neighbour before / after the segment exists
+        smoothed_2d = master.smoothed and self.gdim == 2
+        self.neighbour_flags = dolfinx.fem.Function(space((2,))) if smoothed_2d else None
         #: (two-sided master, a membrane) the side of the master each slave point is on:
         #: +1 in front of the master's oriented normal, -1 behind it (the normal acting on the
         #: point is ``side`` times the master's); 0 before a point was first paired
@@ -185,8 +213,10 @@ class MeshKinematics:
         self.xi = xi = self.xi0 + self.M * ufl.as_vector(b)
         self.N, dN = master_shape_functions(nn, xi)
         self.y = interpolate(self.N, xh, gdim)
-        if self.master.smoothed:
+        if self.master.smoothed and gdim == 2:
             self.nu = smoothed_normal(xi, xh, self.neighbour_flags, self.mask)
+        elif self.master.smoothed:
+            self.nu = smoothed_normal_3d(xi, xh, nn, self.mask)
         else:
             tangents = [interpolate([dN[a][al] for a in range(nn)], xh, gdim) for al in range(fdim)]
             self.nu = facet_normal(tangents, self.mask)

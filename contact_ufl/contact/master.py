@@ -6,6 +6,18 @@ the master virtual displacement U2*(Y) use one and the same surface. What the se
 of it (:meth:`MeshMaster.candidates`) is the current nodes of every facet, the stacked
 indices of the unknowns they gather, and per-facet data (keys for the tie-break, boundary
 edges, and for the smoothed normal the neighbouring nodes).
+
+The smoothed normal (``master_normal="smoothed"``) is interpolated from nodal normals, which
+depend on the nodes around each facet node; those nodes are carried with the facet's own:
+
+* 2D: the node before and the node after the segment (:func:`segment_neighbours`).
+* 3D: the *fan* of each facet node ``a``, the ring of its edge neighbours in cyclic order
+  (:func:`node_fans`): ``K + 1`` slots ``s_0 .. s_K``, consecutive slots being the two edge
+  neighbours of ``a`` in one facet around ``a``; ``K`` is the most facets around any node of
+  the master surface (at most :data:`MAX_FACETS_AROUND_NODE`). A closed fan repeats its first
+  neighbour, and unused slots hold ``a`` itself, so that every slot pair gives the corner
+  normal ``(s_i - a) x (s_i+1 - a)`` of one facet or zero: no flags are needed. A facet
+  carries ``nx = nn (K + 2)`` nodes (duplicates included: the fans of its nodes overlap).
 """
 
 from __future__ import annotations
@@ -25,7 +37,20 @@ from contact_ufl.contact.facets import (
     facet_normals,
     tagged_facets,
 )
+from contact_ufl.contact.projection import shape_functions
+from contact_ufl.errors import collective_check
 from contact_ufl.layout import StackedLayout
+
+#: The most master facets around one node of a 3D master surface with the smoothed normal.
+#: A slave point carries ``nn (K + 2)`` master nodes for ``K`` facets around a node (the most
+#: over the surface): with this bound at most 42 (triangles) or 56 (quadrilaterals); a
+#: structured triangulated surface has K = 6 to 8 (27 to 33 nodes), a structured quadrilateral
+#: one K = 4 (24 nodes).
+MAX_FACETS_AROUND_NODE = 12
+
+#: The nodes of a 3D master facet in cyclic order around it (basix vertex order in, so the
+#: bilinear quadrilateral's ``(0, 1, 3, 2)``); the order turns about the outward normal.
+CYCLIC_ORDER = {3: (0, 1, 2), 4: (0, 1, 3, 2)}
 
 
 class MeshMaster:
@@ -85,12 +110,17 @@ class MeshMaster:
             self._build()
         #: nodes of a facet (the largest over the ranks: a rank may have no facet)
         self.nn = int(self.V.mesh.comm.allreduce(self.nodes.shape[1], MPI.MAX))
-        #: nodes carried to a slave point: the facet's, and (smoothed) its two neighbours
-        self.nx = self.nn + (2 if smoothed else 0)
+        #: nodes carried to a slave point: the facet's, and (smoothed) in 2D its two
+        #: neighbours, in 3D the fans of its nodes (see the module's docstring)
+        self.nx = self.nn
+        if smoothed and self.V.mesh.geometry.dim == 2:
+            self._ring, self._ring_flags = segment_neighbours(self.V.mesh.comm, self.global_nodes)
+        elif smoothed:
+            fans = node_fans(self.V.mesh.comm, self.global_nodes, self.nn)
+            self._ring = fans.reshape(len(fans), fans.shape[1] * fans.shape[2])
+            self._ring_flags = np.zeros((len(fans), 0), dtype=bool)
         if smoothed:
-            self._neighbours, self._has_neighbour = segment_neighbours(
-                self.V.mesh.comm, self.global_nodes
-            )
+            self.nx += int(self.V.mesh.comm.allreduce(self._ring.shape[1], MPI.MAX))
 
     def candidates(self, layout: StackedLayout) -> MasterCandidates:
         """This rank's facets at the current displacement (collective with ``smoothed``)."""
@@ -99,11 +129,11 @@ class MeshMaster:
         current = self.current_nodes()
         global_nodes = self.global_nodes.astype(np.int64)
         flags = np.zeros((len(current), 0), dtype=np.int64)
-        if self.smoothed:  # carry the neighbour nodes of every segment along
-            before_after = gathered_node_positions(comm, global_nodes, current, self._neighbours)
-            current = np.concatenate([current, before_after], axis=1)
-            global_nodes = np.hstack([global_nodes, self._neighbours])
-            flags = self._has_neighbour.astype(np.int64)
+        if self.smoothed:  # carry the neighbour nodes of every facet along
+            ring = gathered_node_positions(comm, global_nodes, current, self._ring)
+            current = np.concatenate([current, ring], axis=1)
+            global_nodes = np.hstack([global_nodes, self._ring])
+            flags = self._ring_flags.astype(np.int64)
         columns = layout.from_block_global(self.block, global_nodes * bs)
         return MasterCandidates(
             current, columns, self.keys.astype(np.int64), self.boundary_edges, flags
@@ -235,6 +265,90 @@ def segment_neighbours(
     return np.stack([before, after], axis=1), np.stack([has_before, has_after], axis=1)
 
 
+def node_fans(comm: MPI.Comm, global_nodes: np.ndarray, nn: int) -> npt.NDArray[np.int64]:
+    """The fan of every node of the oriented 3D master facets, over all ranks.
+
+    The fan of a node ``a`` lists its edge neighbours in cyclic order about the outward
+    normal: ``s_0 = next(f_1)``, ``s_k = prev(f_k)`` for the facets ``f_1 .. f_v`` around
+    ``a`` in turn, ``next``/``prev`` being the nodes after and before ``a`` in a facet's
+    :data:`CYCLIC_ORDER` (the facet after ``f_k`` has ``next = prev(f_k)``). An open fan (a
+    node on the boundary of the surface) starts at the facet with no facet before it; a
+    closed fan ends with ``s_v = s_0``. The unused slots up to ``K`` hold ``a`` itself, ``K``
+    being the most facets around a node of the surface.
+
+    Returns
+    -------
+    ndarray, shape (nf, nn, K + 1)
+        Global node index of the slots of the fan of each node of this rank's facets.
+    """
+    everything = np.concatenate(comm.allgather(global_nodes.astype(np.int64).reshape(-1)))
+    ordered = everything.reshape(-1, nn)[:, list(CYCLIC_ORDER[nn])]
+    # the corners of all facets: node, the node after it and the node before it
+    node = ordered.ravel()
+    after = np.roll(ordered, -1, axis=1).ravel()
+    before = np.roll(ordered, 1, axis=1).ravel()
+    fan_nodes, counts = np.unique(node, return_counts=True)
+    K = int(counts.max(initial=0))
+    collective_check(
+        comm,
+        K <= MAX_FACETS_AROUND_NODE,
+        f"a node of the master surface has {K} facets around it: the smoothed master normal "
+        f"carries at most MAX_FACETS_AROUND_NODE = {MAX_FACETS_AROUND_NODE} "
+        "(contact_ufl.contact.master)",
+    )
+    span = int(node.max(initial=0)) + 1
+    find_after, unique_after = _lookup(node * span + after)
+    collective_check(
+        comm,
+        unique_after,
+        "the master surface is not a consistently oriented manifold (an edge is shared by "
+        "more than two facets, or twice in the same direction): no smoothed normal",
+    )
+    find_before, _ = _lookup(node * span + before)
+    # each fan starts at a corner with no corner before it (open fan), else at any corner
+    _, has_before = find_before(node * span + after)
+    by_node = np.lexsort((has_before, node))
+    start = by_node[np.searchsorted(node[by_node], fan_nodes)]
+    wanted = np.unique(global_nodes.astype(np.int64))
+    index = np.searchsorted(fan_nodes, wanted)
+    slots = np.repeat(wanted[:, None], K + 1, axis=1)
+    if len(wanted):
+        first, corner = start[index], start[index].copy()
+        slots[:, 0] = after[corner]
+        walking = np.ones(len(wanted), dtype=bool)
+        walked = np.zeros(len(wanted), dtype=np.int64)
+        for k in range(K):  # bounded by the fan size, vectorised over the nodes
+            slots[walking, k + 1] = before[corner[walking]]
+            walked += walking
+            following, found = find_after(node[corner] * span + before[corner])
+            walking &= found & (following != first)
+            corner = np.where(walking, following, corner)
+    complete = not len(wanted) or bool(np.all(walked == counts[index]))
+    collective_check(
+        comm,
+        complete,
+        "a node of the master surface has facets around it that do not form one fan (the "
+        "surface is pinched there): no smoothed normal",
+    )
+    return slots[np.searchsorted(wanted, global_nodes.astype(np.int64))]
+
+
+def _lookup(keys: np.ndarray):
+    """A vectorised search of the integer ``keys``: returns a function that gives, for
+    ``query``, the index of an equal key and whether there is one; and whether the keys are
+    unique."""
+    order = np.argsort(keys, kind="stable")
+    ordered = keys[order]
+
+    def find(query: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if len(keys) == 0:
+            return np.zeros(len(query), dtype=np.int64), np.zeros(len(query), dtype=bool)
+        pos = np.minimum(np.searchsorted(ordered, query), len(keys) - 1)
+        return order[pos], ordered[pos] == query
+
+    return find, bool(np.all(np.diff(ordered) != 0))
+
+
 def gathered_node_positions(
     comm: MPI.Comm, global_nodes: np.ndarray, positions: np.ndarray, wanted: np.ndarray
 ) -> np.ndarray:
@@ -292,3 +406,28 @@ def smoothed_normals(xi: np.ndarray, nodes: np.ndarray, flags: np.ndarray) -> np
         unit_perp(segment) + unit_perp(outgoing)
     )
     return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def fan_normals(nodes: np.ndarray, nn: int) -> np.ndarray:
+    """Unit nodal normals of 3D master facets from their carried nodes: ``nodes (n, nx, 3)``,
+    the ``nn`` facet nodes then the fans of :func:`node_fans`; returns ``(n, nn, 3)``.
+
+    The nodal normal of ``a`` is the sum over its fan of the corner normals ``(s_i - a) x
+    (s_i+1 - a)``: each the unit normal of a facet around ``a`` weighted by the area of the
+    parallelogram its two edges at ``a`` span (twice a triangle's area; a bilinear
+    quadrilateral's area when it is a parallelogram), normalised.
+    """
+    n, slots = len(nodes), (nodes.shape[1] - nn) // nn
+    own = nodes[:, :nn]
+    fan = nodes[:, nn:].reshape(n, nn, slots, 3) - own[:, :, None]
+    normal = np.cross(fan[:, :, :-1], fan[:, :, 1:]).sum(axis=2)
+    return normal / np.linalg.norm(normal, axis=2, keepdims=True)
+
+
+def smoothed_normals_3d(xi: np.ndarray, nodes: np.ndarray, nn: int) -> np.ndarray:
+    """NumPy twin of :func:`contact_ufl.contact.kinematics.smoothed_normal_3d` for paired
+    points: ``xi (n, 2)``, ``nodes (n, nx, 3)`` (see :func:`fan_normals`); returns unit
+    normals ``(n, 3)``: the normalised interpolation of the nodal normals."""
+    N = shape_functions(nn, 3, xi)[0]
+    normal = np.einsum("pa,pad->pd", N, fan_normals(nodes, nn))
+    return normal / np.linalg.norm(normal, axis=1, keepdims=True)

@@ -51,11 +51,14 @@ class ContactPair:
         slave edge or corner that meets the master surface (the tip of a beam) is itself a
         contact point and cannot sink into the master between Gauss points.
     master_normal
-        ``"facet"`` (default): the normal of the master facet. ``"smoothed"`` (2D): the
-        normal interpolated along the segment from averaged nodal normals, continuous from
-        one segment to the next; a slave point sliding over a master vertex then meets no
-        jump of the contact force's direction (large sliding, ironing). The nodal normals
-        depend on the neighbouring nodes, which are gathered with the segment's own.
+        ``"facet"`` (default): the normal of the master facet. ``"smoothed"``: the
+        normal interpolated over the facet from averaged nodal normals, continuous from
+        one facet to the next; a slave point sliding over a master vertex or edge then
+        meets no jump of the contact force's direction (large sliding, ironing). The nodal
+        normals depend on the neighbouring nodes, which are gathered with the facet's own:
+        in 2D the nodes before and after the segment, in 3D (triangles, bilinear
+        quadrilaterals; area-weighted nodal normals) the ring of facets around each node
+        (at most :data:`~contact_ufl.contact.master.MAX_FACETS_AROUND_NODE` facets).
     slave_domain, master_domain
         The domains (meshes) of the scene that hold the two surfaces: an index in
         :attr:`Scene.parts <contact_ufl.scene.Scene.parts>` or a domain's name. Needed only

@@ -19,7 +19,7 @@ import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.contact.facets import on_edges
-from contact_ufl.contact.master import MeshMaster, smoothed_normals
+from contact_ufl.contact.master import MeshMaster, smoothed_normals, smoothed_normals_3d
 from contact_ufl.contact.projection import Projection, TreeCache, closest_points
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
@@ -43,7 +43,7 @@ class Pairing:
         Stacked index of the displacement unknown each of those coordinates gathers,
         ``(np, nx, gdim)`` (``-1`` where unpaired).
     flags
-        (smoothed normal) whether the neighbours before / after the facet exist,
+        (smoothed normal, 2D) whether the neighbours before / after the segment exist,
         ``(np, 2)``; else ``None``.
     """
 
@@ -159,12 +159,16 @@ class ClosestPointSearch:
         paired = proj.facet >= 0
         flags = None
         if self.master.smoothed:
-            facet_flags = payload[proj.facet[paired], nx + nn + ne :].astype(bool)
-            normal = smoothed_normals(proj.xi[paired], nodes[proj.facet[paired]], facet_flags)
+            facet_nodes = nodes[proj.facet[paired]]
+            if gdim == 2:
+                facet_flags = payload[proj.facet[paired], nx + nn + ne :].astype(bool)
+                normal = smoothed_normals(proj.xi[paired], facet_nodes, facet_flags)
+                flags = np.zeros((len(points), 2))
+                flags[paired] = facet_flags
+            else:
+                normal = smoothed_normals_3d(proj.xi[paired], facet_nodes, nn)
             proj.normal[paired] = normal
             proj.gap[paired] = -np.einsum("pd,pd->p", normal, points[paired] - proj.y[paired])
-            flags = np.zeros((len(points), 2))
-            flags[paired] = facet_flags
         npts = len(points)
         gathered = np.zeros((npts, nx, gdim))
         gathered[paired] = nodes[proj.facet[paired]]

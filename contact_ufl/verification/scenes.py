@@ -262,14 +262,27 @@ def patch_3d_pressed(
 
 
 def curved_pair(
-    dim: int, comm: MPI.Comm = MPI.COMM_WORLD, E: float = 1.0, nu: float = 0.3, eps_N: float = 10.0
+    dim: int,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    E: float = 1.0,
+    nu: float = 0.3,
+    eps_N: float = 10.0,
+    cell: str = "tetrahedron",
 ) -> Scene:
     """Two bodies with curved contact surfaces and no supports (for Taylor tests).
 
     ``dim = 2``: a half disc above a block with a circular top; ``dim = 3``: a half cylinder
-    above a block with a cylindrical top of crossed axis.
+    above a block with a cylindrical top of crossed axis, or with ``cell="hexahedron"`` the
+    hexahedral stacked boxes of :func:`~contact_ufl.verification.geometries.patch_3d` warped
+    (:func:`warp_saddle`) so that their common surface is a saddle; the lower body is the
+    finer (element size 0.1 against 1/6), so a partition into two ranks splits it and its
+    master surface.
     """
-    if dim == 2:
+    if dim == 3 and cell == "hexahedron":
+        sm = geometries.patch_3d(cell=cell, h_lower=0.1, comm=comm)
+        warp_saddle(sm.mesh)
+        names = ("upper", "lower", "upper_contact", "lower_contact")
+    elif dim == 2:
         sm = geometries.curved_2d(h_contact=0.05, h_far=0.3, comm=comm)
         names = ("cylinder", "block", "cylinder_contact", "block_contact")
     else:
@@ -287,6 +300,13 @@ def curved_pair(
         contacts=[ContactPair(tags[names[2]], tags[names[3]], eps_N=eps_N)],
         tags=tags,
     )
+
+
+def warp_saddle(mesh: dolfinx.mesh.Mesh, depth: float = 0.2) -> None:
+    """Move the nodes of a mesh of the unit-square boxes vertically (in place) by
+    ``depth ((x - 1/2)^2 - (y - 1/2)^2 / 2)``: flat faces ``z = c`` become saddles."""
+    x = mesh.geometry.x
+    x[:, 2] += depth * ((x[:, 0] - 0.5) ** 2 - 0.5 * (x[:, 1] - 0.5) ** 2)
 
 
 def plastic_indentation(

@@ -116,6 +116,7 @@ def curved_case(
     own_meshes: bool = False,
     membrane: str | None = None,
     direction: float = 1.0,
+    cell: str = "tetrahedron",
 ):
     """The Taylor test case on curved surfaces: problem at its state, direction, steps.
 
@@ -127,9 +128,10 @@ def curved_case(
     mesh of its own (:func:`~contact_ufl.verification.scenes.on_meshes_of_their_own`). With
     ``membrane="master"`` (``"slave"``) the lower (upper) body is replaced by a Neo-Hookean
     membrane made of its contact surface (:func:`~contact_ufl.verification.scenes.with_membrane`),
-    its normal up (``direction = 1``) or down (``-1``).
+    its normal up (``direction = 1``) or down (``-1``); ``cell`` (3D) that of
+    :func:`~contact_ufl.verification.scenes.curved_pair`.
     """
-    scene = curved_pair(dim)
+    scene = curved_pair(dim, cell=cell)
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu, master_normal=master_normal)
     if own_meshes:
         scene = on_meshes_of_their_own(scene)

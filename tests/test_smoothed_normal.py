@@ -1,0 +1,167 @@
+"""The smoothed master normal of 3D master surfaces: the fans of the facet nodes, the normal's
+continuity across facet edges, its NumPy twin against UFL, and the bound on the fan size."""
+
+import dataclasses
+
+import dolfinx
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+
+from contact_ufl.contact import master as master_module
+from contact_ufl.contact.facets import FACET_EDGES
+from contact_ufl.contact.master import (
+    CYCLIC_ORDER,
+    MeshMaster,
+    fan_normals,
+    node_fans,
+    smoothed_normals_3d,
+)
+from contact_ufl.contact.projection import shape_functions
+from contact_ufl.errors import ContactInputError
+from contact_ufl.layout import StackedLayout
+from contact_ufl.problem import ContactProblem
+from contact_ufl.verification.geometries import tag_single_body
+from contact_ufl.verification.scenes import curved_pair, warp_saddle
+from contact_ufl.verification.taylor_cases import curved_case, smooth_field
+
+#: reference coordinates of the vertices of a triangle and a quadrilateral (basix order)
+REFERENCE_VERTICES = {
+    3: np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
+    4: np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]),
+}
+
+
+def test_fans_of_a_square_split_into_four_triangles():
+    """Centre 4 of the square 0-1-2-3 (counter-clockwise seen from +z): a closed fan of four
+    triangles; a corner: an open fan of two, padded with the node itself."""
+    triangles = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    fans = node_fans(MPI.COMM_SELF, triangles, 3)
+    assert fans.shape == (4, 3, 5)
+    assert fans[0, 2].tolist() == [0, 1, 2, 3, 0]  # closed: the first neighbour again
+    assert fans[0, 0].tolist() == [1, 4, 3, 0, 0]  # open: from the facet with none before
+    X = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0.2]])
+    nodes = np.concatenate([X[triangles], X[fans.reshape(4, -1)]], axis=1)
+    normals = fan_normals(nodes, 3)
+    assert np.allclose(normals[0, 2], [0.0, 0.0, 1.0])  # the apex of a symmetric pyramid
+    corner = np.cross(X[1] - X[0], X[4] - X[0]) + np.cross(X[4] - X[0], X[3] - X[0])
+    assert np.allclose(normals[0, 0], corner / np.linalg.norm(corner))
+
+
+def test_fans_reject_a_pinched_surface():
+    """Two triangles that meet at one node only: that node's facets are not one fan."""
+    triangles = np.array([[0, 1, 2], [0, 3, 4]])
+    with pytest.raises(ContactInputError, match="one fan"):
+        node_fans(MPI.COMM_SELF, triangles, 3)
+
+
+@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
+def test_nodal_normals_gather_the_facets_of_every_rank(cell):
+    """The nodal normals of the carried fans are those of all the facets around each node,
+    wherever they live: compared with the sum of the corner normals of every facet of every
+    rank. On two ranks the master surface (the top of one box) is split between them."""
+    cell_type = getattr(dolfinx.mesh.CellType, cell)
+    mesh = dolfinx.mesh.create_box(
+        MPI.COMM_WORLD,
+        [[0.0, 0.0, 0.0], [1.0, 1.0, 0.5]],
+        [6, 6, 2],
+        cell_type,
+        ghost_mode=dolfinx.mesh.GhostMode.shared_facet,
+    )
+    _, facet_tags = tag_single_body(mesh, [lambda x: np.isclose(x[2], 0.5)])
+    warp_saddle(mesh)
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (3,)))
+    u = dolfinx.fem.Function(V)
+    u.interpolate(lambda x: smooth_field(x, 0.05, 3))
+    master = MeshMaster(V, facet_tags, 1, smoothed=True)
+    nn, comm = master.nn, mesh.comm
+    normals = fan_normals(master.candidates(u, StackedLayout([V])).nodes, nn)
+    # the reference: the corner normals of all facets of all ranks, summed at their nodes
+    ids = np.concatenate(comm.allgather(master.global_nodes.astype(np.int64)))
+    X = np.concatenate(comm.allgather(master.current_nodes(u)))
+    cyclic = list(CYCLIC_ORDER[nn])
+    ids, X = ids[:, cyclic], X[:, cyclic]
+    corner = np.cross(np.roll(X, -1, axis=1) - X, np.roll(X, 1, axis=1) - X)
+    nodes, inverse = np.unique(ids, return_inverse=True)
+    summed = np.zeros((len(nodes), 3))
+    np.add.at(summed, inverse.ravel(), corner.reshape(-1, 3))
+    summed /= np.linalg.norm(summed, axis=1, keepdims=True)
+    expected = summed[np.searchsorted(nodes, master.global_nodes)]
+    assert np.abs(normals - expected).max(initial=0.0) < 1e-13
+    assert comm.allreduce(len(normals), MPI.SUM) == (72 if nn == 3 else 36)  # 6 x 6 squares
+    if comm.size > 1:  # every rank holds master facets, and fans reach the other's nodes
+        mine = np.isin(master._ring, master.global_nodes)
+        assert comm.allreduce(master.num_facets, MPI.MIN) > 0
+        assert comm.allreduce(int(np.count_nonzero(~mine)), MPI.MIN) > 0
+
+
+def test_too_many_facets_around_a_node(monkeypatch):
+    """The bound on the nodes carried to a slave point is named when exceeded."""
+    monkeypatch.setattr(master_module, "MAX_FACETS_AROUND_NODE", 3)
+    scene = curved_pair(3, cell="hexahedron")
+    pair = dataclasses.replace(scene.contacts[0], master_normal="smoothed")
+    with pytest.raises(ContactInputError, match="MAX_FACETS_AROUND_NODE = 3"):
+        ContactProblem(dataclasses.replace(scene, contacts=[pair]), verbose=False)
+
+
+def edge_jumps(problem, normal: str) -> np.ndarray:
+    """The jump of the master normal across every interior edge of the (deformed) master
+    surface: evaluated at a point of the edge from the facets on either side (all ranks)."""
+    master, comm = problem.contacts[0].master, problem.comm
+    nn = master.nn
+    candidates = master.candidates(problem.u, problem.full_layout)
+    nodes = np.concatenate(comm.allgather(candidates.nodes))
+    ids = np.concatenate(comm.allgather(master.global_nodes.astype(np.int64)))
+    ref = REFERENCE_VERTICES[nn]
+    keys, normals = [], []
+    for a, b in FACET_EDGES[nn]:  # the point 0.3 of the way from the smaller node index
+        lo = np.where(ids[:, a] < ids[:, b], a, b)
+        hi = np.where(ids[:, a] < ids[:, b], b, a)
+        xi = 0.7 * ref[lo] + 0.3 * ref[hi]
+        if normal == "smoothed":
+            normals.append(smoothed_normals_3d(xi, nodes, nn))
+        else:
+            dN = shape_functions(nn, 3, xi)[1]
+            a1, a2 = (np.einsum("pa,pad->pd", dN[:, :, k], nodes[:, :nn]) for k in range(2))
+            n = np.cross(a1, a2)
+            normals.append(n / np.linalg.norm(n, axis=1, keepdims=True))
+        keys.append(np.sort(ids[:, [a, b]], axis=1))
+    keys, normals = np.concatenate(keys), np.concatenate(normals)
+    _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    shared = np.flatnonzero(counts[inverse.ravel()] == 2)
+    order = shared[np.argsort(inverse.ravel()[shared], kind="stable")]
+    first, second = normals[order[0::2]], normals[order[1::2]]
+    assert len(first) > 20
+    return np.linalg.norm(first - second, axis=1)
+
+
+@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
+def test_smoothed_normal_is_continuous_across_edges(cell):
+    """At a point of an edge the two facets sharing it give the same smoothed normal; their
+    facet normals differ (the surface is deformed and curved)."""
+    problem = curved_case(3, master_normal="smoothed", cell=cell)[0]
+    assert edge_jumps(problem, "smoothed").max() < 1e-13
+    assert edge_jumps(problem, "facet").max() > 1e-2
+
+
+@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
+def test_smoothed_normal_twin_is_the_ufl_normal(cell):
+    """The search's NumPy normal (the pairing's, for results) is the UFL normal of the forms,
+    and it is not the facet normal."""
+    problem = curved_case(3, master_normal="smoothed", cell=cell)[0]
+    c = problem.contacts[0]
+    k, slave = c.kinematics, c.slave
+    twin = dolfinx.fem.Function(slave.point_space((3,)))
+    slave.set_at_points(twin, c.projection.normal)
+    facet = dolfinx.fem.Function(slave.point_space((3,)))
+    slave.set_at_points(facet, curved_case(3, cell=cell)[0].contacts[0].projection.normal)
+
+    def integral(f):
+        form = dolfinx.fem.form(
+            k.mask * ufl.dot(k.nu - f, k.nu - f) * slave.ds, entity_maps=[slave.entity_map]
+        )
+        return problem.comm.allreduce(dolfinx.fem.assemble_scalar(form), MPI.SUM)
+
+    assert integral(twin) < 1e-24
+    assert integral(facet) > 1e-6
