@@ -74,12 +74,12 @@ def test_nodal_normals_gather_the_facets_of_every_rank(cell):
     V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (3,)))
     u = dolfinx.fem.Function(V)
     u.interpolate(lambda x: smooth_field(x, 0.05, 3))
-    master = MeshMaster(V, facet_tags, 1, smoothed=True)
+    master = MeshMaster(u, facet_tags, 1, smoothed=True)
     nn, comm = master.nn, mesh.comm
-    normals = fan_normals(master.candidates(u, StackedLayout([V])).nodes, nn)
+    normals = fan_normals(master.candidates(StackedLayout([V])).nodes, nn)
     # the reference: the corner normals of all facets of all ranks, summed at their nodes
     ids = np.concatenate(comm.allgather(master.global_nodes.astype(np.int64)))
-    X = np.concatenate(comm.allgather(master.current_nodes(u)))
+    X = np.concatenate(comm.allgather(master.current_nodes()))
     cyclic = list(CYCLIC_ORDER[nn])
     ids, X = ids[:, cyclic], X[:, cyclic]
     corner = np.cross(np.roll(X, -1, axis=1) - X, np.roll(X, 1, axis=1) - X)
@@ -110,7 +110,7 @@ def edge_jumps(problem, normal: str) -> np.ndarray:
     surface: evaluated at a point of the edge from the facets on either side (all ranks)."""
     master, comm = problem.contacts[0].master, problem.comm
     nn = master.nn
-    candidates = master.candidates(problem.u, problem.full_layout)
+    candidates = master.candidates(problem.full_layout)
     nodes = np.concatenate(comm.allgather(candidates.nodes))
     ids = np.concatenate(comm.allgather(master.global_nodes.astype(np.int64)))
     ref = REFERENCE_VERTICES[nn]
