@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_quads
 
-from contact_ufl.contact import projection
 from contact_ufl.contact.projection import TreeCache, closest_points, shape_functions
 
 FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
@@ -134,32 +133,3 @@ def test_reused_tree_after_the_master_moves():
         check(points, moved, radius=0.2, trees=trees)
         assert (tree() is first) == reused
         check(points, moved, trees=trees)
-
-
-@pytest.mark.parametrize(
-    ("make", "nf"),
-    [(segment_polyline, 50), (triangle_soup, 40), (warped_quads, 20), (wavy_quads, 36)],
-    ids=["segments", "triangles", "quadrilaterals", "quad-grid"],
-)
-@pytest.mark.parametrize("radius", [np.inf, 0.3])
-def test_hierarchy_against_every_facet(make, nf, radius, monkeypatch):
-    """The points farther than R_max from every centroid searched through the hierarchy of
-    facets (the path of the points far from the master surface), fresh and with the
-    hierarchy of a moved master reused."""
-    monkeypatch.setitem(projection._NEAR, 2, 0.0)
-    monkeypatch.setitem(projection._NEAR, 3, 0.0)
-    searched = []
-    far_candidates = projection._far_candidates
-    monkeypatch.setattr(
-        projection,
-        "_far_candidates",
-        lambda master, x, far, r: searched.append(far.size) or far_candidates(master, x, far, r),
-    )
-    rng = np.random.default_rng(nf + 1)
-    nodes = make(rng, nf)
-    points = near_and_far(rng, nodes, 30)
-    trees = TreeCache()
-    check(points, nodes, radius, trees)
-    assert searched[0] > 0
-    moved = nodes + rng.uniform(-0.02, 0.02, size=nodes.shape)
-    check(points, moved, radius, trees)

@@ -76,15 +76,10 @@ _EDGES = {
 _K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
 _MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
-#: points farther than this times R_max from every centroid go to the hierarchy, by
-#: dimension (on a curve the ball query of a far point holds few facets: never)
-_NEAR = {2: np.inf, 3: 4.0}
-_LEAF = 2.0  # edge of the hierarchy's finest cells, times the mean facet size
 _BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
-_TOL = 1e-9  # relative widening of the bounds (keeps the pairs of the tie-break window)
 
 
 @dataclass
@@ -203,13 +198,6 @@ def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
     return np.einsum("...i,...i->...", a, b)
 
 
-def _normalise(v: list[FloatArray]) -> list[FloatArray]:
-    """Unit vectors from the coordinate columns ``v``; zero where ``v`` is zero."""
-    length = np.sqrt(sum(vk * vk for vk in v))
-    scale = np.divide(1.0, length, out=np.zeros_like(length), where=length > 0)
-    return [vk * scale for vk in v]
-
-
 def _unit_normal(a: FloatArray) -> FloatArray:
     """Unit normal from the tangent vectors ``a`` (P, fdim, gdim); zero if degenerate."""
     if a.shape[1] == 1:
@@ -228,39 +216,6 @@ class _Pairs:
     dist: FloatArray  # (P,)
     edge: IntArray  # (P,) -1 interior, else edge number in _EDGES[kind]
     vertex: npt.NDArray[np.bool_]  # (P,) closest point at a vertex
-
-
-def _slab_bound(
-    slab: tuple[FloatArray, ...], x: FloatArray, f: IntArray, pid: IntArray | None = None
-) -> FloatArray:
-    """A lower bound of the distance of the points ``x`` (P, gdim) to the point sets ``f``
-    (of the points ``x[pid]`` if ``pid`` is given).
-
-    ``slab`` holds the columns ``c_0 .. c_g-1, n_0 .. n_g-1, T, R`` of the sets: every point
-    ``p`` of a set is within ``R`` of its reference point ``c`` and within ``T`` of it along
-    the unit normal ``n`` (``n = 0``: a ball). With ``d = x - c``, ``|x - p|^2 >= (|n . d| -
-    T)_+^2 + (|d - (n . d) n| - R)_+^2``.
-    """
-    g = x.shape[1]
-    if pid is None:
-        return _slab_bound_at(slab, [x[:, k] for k in range(g)], f)
-    return _slab_bound_at(slab, [x[:, k][pid] for k in range(g)], f)
-
-
-def _slab_bound_at(slab: tuple[FloatArray, ...], xp: list[FloatArray], f: IntArray) -> FloatArray:
-    """:func:`_slab_bound` of the points of coordinate columns ``xp`` (one per pair)."""
-    g = len(xp)
-    d = [xp[k] - slab[k][f] for k in range(g)]
-    normal = d[0] * slab[g][f]
-    square = d[0] * d[0]
-    for k in range(1, g):
-        normal += d[k] * slab[g + k][f]
-        square += d[k] * d[k]
-    normal = np.abs(normal)
-    tangent = np.sqrt(np.maximum(square - normal * normal, 0.0))
-    a = np.maximum(normal - slab[2 * g][f], 0.0)
-    b = np.maximum(tangent - slab[2 * g + 1][f], 0.0)
-    return np.sqrt(a * a + b * b)
 
 
 class _Master:
@@ -296,8 +251,7 @@ class _Master:
         )
         self.R_max = float(self.size.max()) if self.nf else 0.0
         trees = trees if trees is not None else TreeCache()
-        self.tree, self.slack, self._store = trees.tree(nodes, self.centroid, self.R_max)
-        self._slabs: list[tuple[FloatArray, ...]] | None = None
+        self.tree, self.slack = trees.tree(nodes, self.centroid, self.R_max)
         # slab of the facet: unit normal at the centroid, largest node offset along it
         half = np.full((1, self.fdim), 0.5)
         _, dN, _ = shape_functions(self.nn, self.gdim, half)
@@ -309,7 +263,6 @@ class _Master:
         # the data of the lower bound as contiguous columns (gathered per pair: cheaper than
         # rows) c_0 .. c_g-1, n_0 .. n_g-1, T, R
         self.slab = (*c, *(np.ascontiguousarray(nk) for nk in n), self.thickness, self.size)
-        self.centroid_columns = c
         if self.kind == "triangle":
             a1 = nodes[:, 1] - nodes[:, 0]
             a2 = nodes[:, 2] - nodes[:, 0]
@@ -322,51 +275,6 @@ class _Master:
             x0, x1, x2, x3 = (nodes[:, a] for a in range(4))
             self.bilinear = np.stack([x0, x1 - x0, x2 - x0, x0 - x1 - x2 + x3], axis=1)
 
-    def hierarchy_slabs(self) -> tuple[_Hierarchy, list[tuple[FloatArray, ...]]]:
-        """The :class:`_Hierarchy` of the facets (built once per KD-tree) and the bounds of
-        its nodes, level by level, as the columns of :func:`_slab_bound`.
-
-        Level 0 from the facets' nodes, the others from their children: a child within
-        ``R_c`` of its reference point ``c_c`` and within ``T_c`` of it along ``n_c`` lies
-        within ``|c_c - c| + R_c`` of a parent's point ``c`` and within ``|n . (c_c - c)| +
-        T_c |n . n_c| + R_c (1 - (n . n_c)^2)^(1/2)`` of it along the parent's ``n``.
-        """
-        if "hierarchy" not in self._store:
-            self._store["hierarchy"] = _build_hierarchy(self.centroid, self.size)
-        H = self._store["hierarchy"]
-        if self._slabs is not None:
-            return H, self._slabs
-        g = self.gdim
-        first = H.start[:-1]
-        leaf = np.repeat(np.arange(first.size), np.diff(H.start))[np.argsort(H.order)]
-        c = [column[leaf] for column in H.centre[0]]
-        n = _normalise([np.add.reduceat(self.axis[H.order, k], first) for k in range(g)])
-        nl = [column[leaf] for column in n]
-        radius2 = np.zeros(self.nf)
-        offset = np.zeros(self.nf)
-        for a in range(self.nn):
-            d = [self.nodes[:, a, k] - c[k] for k in range(g)]
-            np.maximum(radius2, sum(dk * dk for dk in d), out=radius2)
-            np.maximum(offset, np.abs(sum(d[k] * nl[k] for k in range(g))), out=offset)
-        T = np.maximum.reduceat(offset[H.order], first)
-        R = np.sqrt(np.maximum.reduceat(radius2[H.order], first))
-        slabs = [(*H.centre[0], *n, T, R)]
-        for level, child in enumerate(H.child, start=1):
-            below, begin = slabs[-1], child[:-1]
-            parent = np.repeat(np.arange(begin.size), np.diff(child))
-            d = [H.centre[level][k][parent] - below[k] for k in range(g)]
-            n = _normalise([np.add.reduceat(below[g + k], begin) for k in range(g)])
-            np_ = [column[parent] for column in n]
-            cos = np.abs(sum(np_[k] * below[g + k] for k in range(g)))
-            sin = np.sqrt(np.maximum(1.0 - cos * cos, 0.0))
-            along = np.abs(sum(np_[k] * d[k] for k in range(g)))
-            T = np.maximum.reduceat(along + below[2 * g] * cos + below[2 * g + 1] * sin, begin)
-            dist = np.sqrt(sum(dk * dk for dk in d))
-            R = np.maximum.reduceat(dist + below[2 * g + 1], begin)
-            slabs.append((*H.centre[level], *n, T, R))
-        self._slabs = slabs
-        return H, slabs
-
     def lower_bound(self, x: FloatArray, f: IntArray, pid: IntArray | None = None) -> FloatArray:
         """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``
         (of the points ``x[pid]`` if ``pid`` is given).
@@ -375,7 +283,21 @@ class _Master:
         centroid ``c`` and within ``T_f`` of it along the normal ``n`` at the centre: with
         ``d = x - c``, ``|x - p|^2 >= (|n . d| - T_f)_+^2 + (|d - (n . d) n| - R_f)_+^2``.
         """
-        return _slab_bound(self.slab, x, f, pid)
+        g, slab = self.gdim, self.slab
+        if pid is None:
+            d = [x[:, k] - slab[k][f] for k in range(g)]
+        else:
+            d = [x[:, k][pid] - slab[k][f] for k in range(g)]
+        normal = d[0] * slab[g][f]
+        square = d[0] * d[0]
+        for k in range(1, g):
+            normal += d[k] * slab[g + k][f]
+            square += d[k] * d[k]
+        normal = np.abs(normal)
+        tangent = np.sqrt(np.maximum(square - normal * normal, 0.0))
+        a = np.maximum(normal - slab[2 * g][f], 0.0)
+        b = np.maximum(tangent - slab[2 * g + 1][f], 0.0)
+        return np.sqrt(a * a + b * b)
 
     # -- exact projections on (point, facet) pairs ----------------------------------------
 
@@ -574,86 +496,6 @@ def _dot3(a: list[FloatArray], b: list[FloatArray]) -> FloatArray:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def _morton(cell: IntArray, bits: int) -> npt.NDArray[np.uint64]:
-    """Morton codes of the non-negative cell coordinates ``cell`` (n, gdim) of ``bits``
-    bits each (``bits gdim <= 63``): the bits of the coordinates interleaved."""
-    n, g = cell.shape
-    q = cell.astype(np.uint64)
-    code = np.zeros(n, dtype=np.uint64)
-    one = np.uint64(1)
-    for b in range(bits):
-        for k in range(g):
-            code |= ((q[:, k] >> np.uint64(b)) & one) << np.uint64(g * b + k)
-    return code
-
-
-@dataclass
-class _Hierarchy:
-    """Nested groups of facets (a quadtree/octree of their centroids, empty cells dropped).
-
-    The facets are sorted along the Morton curve of the cells of a grid (edge ``_LEAF`` mean
-    facet sizes) holding their centroids; the nodes of level ``l`` are the runs of facets in
-    one cell of ``2^l`` times that edge, so each node holds a run of the sorted facets and a
-    run of the nodes of the level below. Level 0 nodes are the finest cells, the last level
-    has a single node. The reference point of a node (the mean of its centroids when built)
-    stays while the nodes move: the bounds about it are computed from the current nodes
-    (:meth:`_Master.hierarchy_slabs`).
-    """
-
-    order: IntArray  # (nf,) the facets in Morton order
-    start: IntArray  # (n_0 + 1,) first sorted facet of each level-0 node, then nf
-    child: list[IntArray]  # level l >= 1: first level l-1 node of each node, then n_(l-1)
-    centre: list[FloatArray]  # (gdim, n_l) reference points of the nodes of each level
-    rep: list[IntArray]  # (n_l,) a facet of each node: its centroid bounds the distance
-
-
-def _build_hierarchy(centroid: FloatArray, size: FloatArray) -> _Hierarchy:
-    """The :class:`_Hierarchy` of the facets of the given centroids and sizes."""
-    nf, g = centroid.shape
-    lo = centroid.min(axis=0)
-    edge = max(_LEAF * float(size.mean()), 1e-300)
-    span = float((centroid.max(axis=0) - lo).max())
-    bits = max(int(np.ceil(np.log2(span / edge + 2.0))), 1)
-    if bits > 63 // g:  # very long thin surfaces: coarser finest cells
-        edge *= 2.0 ** (bits - 63 // g)
-        bits = 63 // g
-    cell = np.minimum(np.floor((centroid - lo) / edge), 2.0**bits - 1).astype(np.int64)
-    code = _morton(cell, bits)
-    order = np.argsort(code, kind="stable")
-    code = code[order]
-    sorted_centroid = centroid[order]
-    starts, level = [], 0
-    while True:
-        key = code >> np.uint64(g * level)
-        first = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]]))
-        starts.append(first)
-        if first.size == 1:
-            break
-        level += 1
-    child = [
-        np.append(np.searchsorted(starts[l - 1], starts[l]), starts[l - 1].size)
-        for l in range(1, len(starts))
-    ]
-    centre, rep = [], []
-    for first in starts:
-        count = np.diff(np.append(first, nf))
-        centre.append(
-            np.stack([np.add.reduceat(sorted_centroid[:, k], first) / count for k in range(g)])
-        )
-        rep.append(order[first + count // 2])
-    return _Hierarchy(
-        order=order, start=np.append(starts[0], nf), child=child, centre=centre, rep=rep
-    )
-
-
-def _expand(pid: IntArray, begin: IntArray, end: IntArray) -> tuple[IntArray, IntArray]:
-    """The pairs ``(pid[i], j)`` for ``begin[i] <= j < end[i]``."""
-    count = end - begin
-    total = int(count.sum())
-    offset = np.repeat(begin - (np.cumsum(count) - count), count)
-    return np.repeat(pid, count), offset + np.arange(total)
-
-
 class TreeCache:
     """KD-trees of facet centroids, reused while the master surface has barely moved.
 
@@ -666,34 +508,33 @@ class TreeCache:
     """
 
     def __init__(self) -> None:
-        self.entries: OrderedDict[tuple[int, ...], tuple[FloatArray, cKDTree, dict]] = OrderedDict()
+        self.entries: OrderedDict[tuple[int, ...], tuple[FloatArray, cKDTree]] = OrderedDict()
 
     def tree(
         self, nodes: FloatArray, centroid: FloatArray, R_max: float
-    ) -> tuple[cKDTree | None, float, dict]:
-        """A KD-tree of centroids within ``slack`` of ``centroid``, that slack, and a store for
-        the structures built lazily with the tree (the :class:`_Hierarchy`).
+    ) -> tuple[cKDTree | None, float]:
+        """A KD-tree of centroids within ``slack`` of ``centroid``, and that slack.
 
         The centroid is the mean of the nodes, so it moves at most as far as the farthest
         node: a tree of earlier centroids serves with ``slack`` the largest node movement.
         """
         if len(nodes) == 0:
-            return None, 0.0, {}
+            return None, 0.0
         key = nodes.shape
         entry = self.entries.get(key)
         if entry is not None:
-            built, tree, store = entry
+            built, tree = entry
             # largest node movement (bounded by the largest coordinate change times sqrt(gdim))
             move = float(np.max(np.abs(nodes - built))) * np.sqrt(nodes.shape[2])
             if move <= _MOVE * R_max:
                 self.entries.move_to_end(key)
-                return tree, move, store
-        tree, store = cKDTree(centroid), {}
-        self.entries[key] = (nodes.copy(), tree, store)
+                return tree, move
+        tree = cKDTree(centroid)
+        self.entries[key] = (nodes.copy(), tree)
         self.entries.move_to_end(key)
         while len(self.entries) > _TREES:
             self.entries.popitem(last=False)
-        return tree, 0.0, store
+        return tree, 0.0
 
 
 def _candidates(
@@ -764,90 +605,35 @@ def _concatenate(a: _Pairs, b: _Pairs) -> _Pairs:
     )
 
 
-def _far_candidates(
-    master: _Master, x: FloatArray, far: IntArray, radius: float
-) -> tuple[IntArray, IntArray, IntArray, IntArray]:
-    """Candidate (point, facet) pairs of the points ``x[far]``, from the top of the
-    :class:`_Hierarchy` down, and the facet of the nearest centroid among them of each point
-    that has candidates (point, facet).
-
-    At each level the distance to the centroid of each node's representative facet lowers
-    the upper bound ``u`` of its point (``radius`` at first) and the nodes whose lower bound
-    exceeds it are dropped; the children of the others are examined at the level below.
-    The work follows the depth of the hierarchy, not the distance of the points.
-    """
-    H, slabs = master.hierarchy_slabs()
-    g = master.gdim
-    xs = [np.ascontiguousarray(x[:, k]) for k in range(g)]
-    c = master.centroid_columns
-    upper = np.full(x.shape[0], radius)
-    top = slabs[-1][0].size
-    pid, node = np.repeat(far, top), np.tile(np.arange(top), far.size)
-    for level in range(len(slabs) - 1, -1, -1):
-        xp = [column[pid] for column in xs]
-        rep = H.rep[level][node]
-        u = sum((xp[k] - c[k][rep]) ** 2 for k in range(g))
-        np.minimum.at(upper, pid, np.sqrt(u))
-        R = slabs[level][2 * g + 1]
-        lower = _slab_bound_at(slabs[level], xp, node)
-        keep = lower - _TOL * R[node] <= upper[pid] * (1 + _TOL)
-        pid, node = pid[keep], node[keep]
-        if level:
-            child = H.child[level - 1]
-            pid, node = _expand(pid, child[node], child[node + 1])
-    pid, sorted_facet = _expand(pid, H.start[node], H.start[node + 1])
-    fid = H.order[sorted_facet]
-    # the facet of the nearest centroid of each point (the pairs are grouped by point)
-    u = np.sqrt(sum((xs[k][pid] - c[k][fid]) ** 2 for k in range(g)))
-    umin = np.full(x.shape[0], np.inf)
-    np.minimum.at(umin, pid, u)
-    nearest = np.flatnonzero(u == umin[pid])
-    nearest = nearest[np.concatenate([[True], pid[nearest[1:]] != pid[nearest[:-1]]])]
-    return pid, fid, pid[nearest], fid[nearest]
-
-
 def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projection) -> None:
     """Fill ``out`` (arrays of this block of points) with the closest points of ``x``."""
     npts = x.shape[0]
-    # the K nearest centroids, where they can hold a facet point within the radius or the
-    # near range (the points farther than that from every centroid go to the hierarchy)
-    near_range = min(radius, _NEAR[master.gdim] * master.R_max)
-    # the largest reach of a near point, its centroids' bound (their distances are within
-    # the slack of a reused tree)
-    reach_max = min(radius, near_range + master.R_max + 2.0 * master.slack)
-    reach0 = (reach_max + master.R_max + master.slack) * (1 + 3 * _TOL)
+    # the K nearest centroids, where they can hold a facet point within the radius
+    reach0 = (radius + master.R_max + 2.0 * master.slack) * (1 + 1e-12)
     K = min(_K[master.gdim], master.nf)
     d, near = master.tree.query(x, k=K, distance_upper_bound=reach0)
     d, near = d.reshape(npts, K), near.reshape(npts, K)
-    is_near = d[:, 0] <= (near_range + master.R_max + master.slack) * (1 + _TOL)
-    active = np.flatnonzero(is_near)
-    far = np.flatnonzero(~is_near) if radius > near_range else np.zeros(0, dtype=np.int64)
-    if active.size == 0 and far.size == 0:
+    active = np.flatnonzero(d[:, 0] <= reach0)
+    if active.size == 0:
         return
     d, near = d[active], near[active].astype(np.int64)
-    # candidates: the centroids within reach + R_max, from the K found (a ball query for the
-    # points whose K-th neighbour is within it: they may have more); reach = min(d1,
-    # radius), d1 the exact distance to the facet of the nearest centroid (an upper bound)
     nearest = near[:, 0]
+    # an upper bound of the distance: the exact distance to the facet of the nearest centroid
     first = master.project(x[active], nearest, np.arange(active.size), active.size)
-    reach = np.full(npts, radius)
-    reach[active] = np.minimum(first.dist, radius)
-    bound = (reach + master.R_max) * (1 + _TOL)
+    d1 = np.full(npts, np.inf)
+    d1[active] = first.dist
+    reach = np.minimum(d1, radius)
+    # candidates: the centroids within reach + R_max, from the K found (a ball query for the
+    # points whose K-th neighbour is within it: they may have more)
+    bound = (reach + master.R_max) * (1 + 1e-12)
     within = d <= (bound[active] + master.slack)[:, None]
     cut = within[:, -1] if K < master.nf else np.zeros(active.size, dtype=bool)
     rows, cols = np.nonzero(within & ~cut[:, None])
     pid_ball, fid_ball = _candidates(master, x, bound, active[cut])
     pid = np.concatenate([active[rows], pid_ball])
     fid = np.concatenate([near[rows, cols], fid_ball])
-    if far.size:  # the same from the hierarchy
-        pid_far, fid_far, p_far, nearest_far = _far_candidates(master, x, far, radius)
-        first_far = master.project(x[p_far], nearest_far, p_far, npts)
-        reach[p_far] = np.minimum(first_far.dist, radius)
-        first = _concatenate(first, first_far)
-        pid, fid = np.concatenate([pid, pid_far]), np.concatenate([fid, fid_far])
-        active, nearest = np.concatenate([active, p_far]), np.concatenate([nearest, nearest_far])
     lower = master.lower_bound(x, fid, pid)
-    keep = lower - _TOL * master.size[fid] <= reach[pid] * (1 + _TOL)
+    keep = lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9)
     # the pair of the nearest centroid is projected already
     done = np.full(npts, -1, dtype=np.int64)
     done[active] = nearest
