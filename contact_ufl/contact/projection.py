@@ -80,6 +80,9 @@ _BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
+_CELLS = 64  # cells per dimension of the grid that orders the points
+_SORT = 1 << 14  # facets above which the points are ordered by cells
+_FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
 
 
 @dataclass
@@ -713,6 +716,20 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     )
 
 
+def _spatial_order(points: FloatArray) -> IntArray:
+    """An order of the points by the cells of a ``_CELLS^gdim`` grid over their bounding
+    box (lexicographic in the cell coordinates)."""
+    lo = points.min(axis=0)
+    span = float((points.max(axis=0) - lo).max())
+    if not span > 0.0:
+        return np.arange(points.shape[0])
+    cell = np.minimum((points - lo) * (_CELLS / span), _CELLS - 1).astype(np.int64)
+    key = cell[:, 0]
+    for k in range(1, points.shape[1]):
+        key = key * _CELLS + cell[:, k]
+    return np.argsort(key, kind="stable")
+
+
 def closest_points(
     points: npt.ArrayLike,
     nodes: npt.ArrayLike,
@@ -791,16 +808,16 @@ def closest_points(
     if npts == 0 or nf == 0:
         return out
     master = _Master(nodes, trees)
+    # on a large master the points in the order of a grid of cells (neighbours searched
+    # together: the KD-tree and the gathers of facet data stay in cache), results scattered
+    order = _spatial_order(points) if nf > _SORT else None
+    x = points if order is None else points[order]
+    work = out if order is None else Projection(*(getattr(out, k)[order] for k in _FIELDS))
     for start in range(0, npts, _BLOCK):
         block = slice(start, min(start + _BLOCK, npts))
-        view = Projection(
-            facet=out.facet[block],
-            xi=out.xi[block],
-            y=out.y[block],
-            normal=out.normal[block],
-            gap=out.gap[block],
-            distance=out.distance[block],
-            sliding=out.sliding[block],
-        )
-        _closest_block(master, points[block], radius, view)
+        view = Projection(*(getattr(work, k)[block] for k in _FIELDS))
+        _closest_block(master, x[block], radius, view)
+    if order is not None:
+        for k in _FIELDS:
+            getattr(out, k)[order] = getattr(work, k)
     return out
