@@ -37,6 +37,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse  # noqa: E402
 import json  # noqa: E402
 import time  # noqa: E402
+from collections.abc import Callable  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -100,26 +101,160 @@ def slave_points(gdim: int, npts: int, h: float, rng: np.random.Generator) -> np
     return np.stack([u[:, 0], u[:, 1], surface_3d(u[:, 0], u[:, 1]) + offset], axis=1)
 
 
-def time_call(
-    points: np.ndarray, nodes: np.ndarray, radius: float
-) -> tuple[float, float, np.ndarray]:
+def best_of(call: Callable[[], object]) -> tuple[float, float, object]:
+    """Best wall and CPU (this process) times over a few calls of ``call``, and its result.
+
+    One call if it takes over a second, three if over 0.2 s, else five."""
+    wall, cpu, calls, result = np.inf, np.inf, 0, None
+    while calls < 5:
+        start, start_cpu = time.perf_counter(), time.process_time()
+        result = call()
+        wall = min(wall, time.perf_counter() - start)
+        cpu = min(cpu, time.process_time() - start_cpu)
+        calls += 1
+        if wall > 1.0 or (calls >= 3 and wall > 0.2):
+            break
+    return wall, cpu, result
+
+
+def time_call(points: np.ndarray, nodes: np.ndarray, radius: float) -> dict:
     """Wall time of a first call of ``closest_points`` (no KD-tree kept from an earlier call),
-    the best over a few more calls (the tree of the unchanged master reused), and the facets
-    found."""
+    the best wall and CPU times over a few more calls (the tree of the unchanged master
+    reused), and the fraction of points paired."""
     trees = projection.TreeCache() if hasattr(projection, "TreeCache") else None
     options = {} if trees is None else {"trees": trees}
     start = time.perf_counter()
     closest_points(points, nodes, radius, **options)
     first = time.perf_counter() - start
-    best, calls = np.inf, 0
-    while calls < 5:
-        start = time.perf_counter()
-        proj = closest_points(points, nodes, radius, **options)
-        best = min(best, time.perf_counter() - start)
-        calls += 1
-        if best > 1.0 or (calls >= 3 and best > 0.2):
-            break
-    return first, best, proj.facet
+    wall, cpu, proj = best_of(lambda: closest_points(points, nodes, radius, **options))
+    npts = len(points)
+    return {
+        "paired_fraction": float(np.mean(proj.facet >= 0)),
+        "seconds": wall,
+        "cpu_seconds": cpu,
+        "first_call_s": first,
+        "points_per_s": npts / wall,
+        "cpu_points_per_s": npts / cpu,
+    }
+
+
+def stages(points: np.ndarray, nodes: np.ndarray) -> dict:
+    """CPU seconds of the parts of a search that any candidate pruning pays: the per-facet data
+    of the master (KD-tree reused), one K-nearest query of the centroids per point (K = 1
+    and the search's K), and one exact projection per point (on the facet of its nearest
+    centroid)."""
+    trees = projection.TreeCache()
+    master = projection._Master(nodes, trees)
+    K = min(projection._K[nodes.shape[2]], len(nodes))
+    _, master_s, _ = best_of(lambda: projection._Master(nodes, trees))
+    _, k1_s, (_, nearest) = best_of(lambda: master.tree.query(points, k=1))
+    _, kK_s, _ = best_of(lambda: master.tree.query(points, k=K))
+    n = len(points)
+    _, project_s, _ = best_of(lambda: master.project(points, nearest, np.arange(n), n))
+    return {
+        "master_s": master_s,
+        "query_k1_s": k1_s,
+        "query_kK_s": kK_s,
+        "K": K,
+        "one_projection_s": project_s,
+        "floor_points_per_s": n / (master_s + k1_s + project_s),
+    }
+
+
+def offset_points(gdim: int, npts: int, offset: float, rng: np.random.Generator) -> np.ndarray:
+    """Points over the parameter domain at the vertical distance ``+-offset`` from the
+    master surface."""
+    u = rng.uniform(0.0, 1.0, size=(npts, gdim - 1))
+    dz = offset * rng.choice([-1.0, 1.0], size=npts)
+    if gdim == 2:
+        return np.stack([u[:, 0], surface_2d(u[:, 0]) + dz], axis=1)
+    return np.stack([u[:, 0], u[:, 1], surface_3d(u[:, 0], u[:, 1]) + dz], axis=1)
+
+
+MAKERS = {
+    "segment": lambda nf, rng: segments(nf),
+    "triangle": triangles,
+    "quadrilateral": quadrilaterals,
+}
+
+
+def radius_sweep(sizes, npts, factors) -> list[dict]:
+    """The records of the radius sweep (the slave points of :func:`slave_points`)."""
+    records = []
+    print(
+        f"{'facets':>8} {'kind':>13} {'radius/h':>8} {'paired':>7} {'cpu s':>8} {'points/s':>10}"
+        f" {'first s':>8}"
+    )
+    for kind, make in MAKERS.items():
+        for nf in sizes:
+            rng = np.random.default_rng(nf)
+            nodes, h = make(nf, rng)
+            points = slave_points(nodes.shape[2], npts, h, rng)
+            for factor in factors:
+                record = {
+                    "sweep": "radius",
+                    "kind": kind,
+                    "gdim": int(nodes.shape[2]),
+                    "facets": int(nodes.shape[0]),
+                    "points": npts,
+                    "radius_over_h": None if np.isinf(factor) else factor,
+                    **time_call(points, nodes, factor * h),
+                }
+                records.append(record)
+                print(
+                    f"{record['facets']:8d} {kind:>13} {factor:8.0f} "
+                    f"{record['paired_fraction']:7.2f} {record['cpu_seconds']:8.4f} "
+                    f"{record['cpu_points_per_s']:10.3g} {record['first_call_s']:8.4f}",
+                    flush=True,
+                )
+            record = {
+                "sweep": "stages",
+                "kind": kind,
+                "gdim": int(nodes.shape[2]),
+                "facets": int(nodes.shape[0]),
+                "points": npts,
+                **stages(points, nodes),
+            }
+            records.append(record)
+            print(
+                f"{record['facets']:8d} {kind:>13} stages: master {record['master_s']:.4f} "
+                f"k=1 {record['query_k1_s']:.4f} k={record['K']} {record['query_kK_s']:.4f} "
+                f"one projection {record['one_projection_s']:.4f} -> floor "
+                f"{record['floor_points_per_s']:.3g} points/s",
+                flush=True,
+            )
+    return records
+
+
+def distance_sweep(nf: int, npts: int, offsets, factors) -> list[dict]:
+    """The records of the distance sweep: all points at ``offset h`` from the surface, radii
+    ``factor offset h`` (all points within them) and infinity."""
+    records = []
+    for kind, make in MAKERS.items():
+        rng = np.random.default_rng(nf)
+        nodes, h = make(nf, rng)
+        for offset in offsets:
+            points = offset_points(nodes.shape[2], npts, offset * h, rng)
+            for factor in factors:
+                radius = factor * offset * h
+                record = {
+                    "sweep": "distance",
+                    "kind": kind,
+                    "gdim": int(nodes.shape[2]),
+                    "facets": int(nodes.shape[0]),
+                    "points": npts,
+                    "offset_over_h": offset,
+                    "radius_over_h": None if np.isinf(radius) else radius / h,
+                    **time_call(points, nodes, radius),
+                }
+                records.append(record)
+                print(
+                    f"{record['facets']:8d} {kind:>13} offset {offset:6.1f} h radius "
+                    f"{radius / h:8.1f} h paired {record['paired_fraction']:5.2f} "
+                    f"{record['cpu_points_per_s']:10.3g} points/s",
+                    flush=True,
+                )
+    return records
 
 
 def main() -> None:
@@ -130,40 +265,8 @@ def main() -> None:
     sizes = (1_000, 10_000) if args.quick else (1_000, 10_000, 100_000)
     npts = 10_000 if args.quick else 50_000
     factors = (1.0, 10.0, np.inf) if args.quick else (1.0, 10.0, 100.0, np.inf)
-    makers = {
-        "segment": lambda nf, rng: segments(nf),
-        "triangle": triangles,
-        "quadrilateral": quadrilaterals,
-    }
-    records = []
-    print(
-        f"{'facets':>8} {'kind':>13} {'radius/h':>8} {'paired':>7} {'time s':>8} {'points/s':>10}"
-    )
-    for kind, make in makers.items():
-        for nf in sizes:
-            rng = np.random.default_rng(nf)
-            nodes, h = make(nf, rng)
-            points = slave_points(nodes.shape[2], npts, h, rng)
-            for factor in factors:
-                first, seconds, facet = time_call(points, nodes, factor * h)
-                record = {
-                    "kind": kind,
-                    "gdim": int(nodes.shape[2]),
-                    "facets": int(nodes.shape[0]),
-                    "points": npts,
-                    "radius_over_h": None if np.isinf(factor) else factor,
-                    "paired_fraction": float(np.mean(facet >= 0)),
-                    "seconds": seconds,
-                    "first_call_s": first,
-                    "points_per_s": npts / seconds,
-                }
-                records.append(record)
-                print(
-                    f"{record['facets']:8d} {kind:>13} {factor:8.0f} "
-                    f"{record['paired_fraction']:7.2f} {seconds:8.4f} {npts / seconds:10.3g} "
-                    f"{first:8.4f}",
-                    flush=True,
-                )
+    records = radius_sweep(sizes, npts, factors)
+    records += distance_sweep(sizes[-1], npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf))
     with open(args.json, "w") as f:
         json.dump({"quick": args.quick, "records": records}, f, indent=1)
 

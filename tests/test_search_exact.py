@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_quads
 
+from contact_ufl.contact import projection
 from contact_ufl.contact.projection import TreeCache, closest_points, shape_functions
 
 FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
@@ -133,3 +134,20 @@ def test_reused_tree_after_the_master_moves():
         check(points, moved, radius=0.2, trees=trees)
         assert (tree() is first) == reused
         check(points, moved, trees=trees)
+
+
+@pytest.mark.parametrize(
+    ("make", "nf"),
+    [(segment_polyline, 50), (triangle_soup, 40), (wavy_quads, 36)],
+    ids=["segments", "triangles", "quad-grid"],
+)
+def test_points_searched_in_cell_order(make, nf, monkeypatch):
+    """The points ordered by cells before the search (as on a large master surface): the
+    results come back in the order of the points given."""
+    monkeypatch.setattr(projection, "_SORT", 0)
+    rng = np.random.default_rng(nf + 2)
+    nodes = make(rng, nf)
+    points = near_and_far(rng, nodes, 30)
+    order = projection._spatial_order(points)
+    assert not np.array_equal(order, np.arange(len(points)))  # the order changes
+    check(points, nodes, 0.3)

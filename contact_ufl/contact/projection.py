@@ -80,6 +80,9 @@ _BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
+_CELLS = 64  # cells per dimension of the grid that orders the points
+_SORT = 1 << 14  # facets above which the points are ordered by cells
+_FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
 
 
 @dataclass
@@ -198,6 +201,13 @@ def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
     return np.einsum("...i,...i->...", a, b)
 
 
+def _normalise(v: list[FloatArray]) -> list[FloatArray]:
+    """Unit vectors from the coordinate columns ``v``; zero where ``v`` is zero."""
+    length = np.sqrt(sum(vk * vk for vk in v))
+    scale = np.divide(1.0, length, out=np.zeros_like(length), where=length > 0)
+    return [vk * scale for vk in v]
+
+
 def _unit_normal(a: FloatArray) -> FloatArray:
     """Unit normal from the tangent vectors ``a`` (P, fdim, gdim); zero if degenerate."""
     if a.shape[1] == 1:
@@ -236,7 +246,7 @@ class _Master:
         g = self.gdim
         # per-facet data from the coordinate columns of the nodes (a loop over the few nodes
         # and coordinates of a facet: reductions over such short axes are slow in NumPy)
-        X = [[nodes[:, a, k] for k in range(g)] for a in range(self.nn)]
+        X = [[np.ascontiguousarray(nodes[:, a, k]) for k in range(g)] for a in range(self.nn)]
         c = []
         for k in range(g):
             ck = X[0][k] + X[1][k]
@@ -246,34 +256,62 @@ class _Master:
         self.centroid = np.stack(c, axis=1)
         # every point of a facet is a convex combination of its nodes (also for the bilinear
         # quadrilateral), so it lies within this radius of the centroid, which is on the facet
-        self.size = np.sqrt(
-            np.maximum.reduce([sum((Xa[k] - c[k]) ** 2 for k in range(g)) for Xa in X])
-        )
+        offsets = [[Xa[k] - c[k] for k in range(g)] for Xa in X]
+        radius2 = sum(dk * dk for dk in offsets[0])
+        for d in offsets[1:]:
+            np.maximum(radius2, sum(dk * dk for dk in d), out=radius2)
+        self.size = np.sqrt(radius2)
         self.R_max = float(self.size.max()) if self.nf else 0.0
         trees = trees if trees is not None else TreeCache()
         self.tree, self.slack = trees.tree(nodes, self.centroid, self.R_max)
-        # slab of the facet: unit normal at the centroid, largest node offset along it
-        half = np.full((1, self.fdim), 0.5)
-        _, dN, _ = shape_functions(self.nn, self.gdim, half)
-        self.axis = _unit_normal(np.einsum("na,fng->fag", dN[0], nodes))
-        n = [self.axis[:, k] for k in range(g)]
-        self.thickness = np.maximum.reduce(
-            [np.abs(sum((Xa[k] - c[k]) * n[k] for k in range(g))) for Xa in X]
-        )
+        # slab of the facet: unit normal at the centre, largest node offset along it
+        n = _normalise(self._centre_normal(X))
+        self.axis = np.stack(n, axis=1)
+        thickness = np.abs(sum(offsets[0][k] * n[k] for k in range(g)))
+        for d in offsets[1:]:
+            np.maximum(thickness, np.abs(sum(d[k] * n[k] for k in range(g))), out=thickness)
+        self.thickness = thickness
         # the data of the lower bound as contiguous columns (gathered per pair: cheaper than
         # rows) c_0 .. c_g-1, n_0 .. n_g-1, T, R
-        self.slab = (*c, *(np.ascontiguousarray(nk) for nk in n), self.thickness, self.size)
+        self.slab = (*c, *n, self.thickness, self.size)
         if self.kind == "triangle":
-            a1 = nodes[:, 1] - nodes[:, 0]
-            a2 = nodes[:, 2] - nodes[:, 0]
-            g11, g12, g22 = _dot(a1, a1), _dot(a1, a2), _dot(a2, a2)
+            a1 = [X[1][k] - X[0][k] for k in range(3)]
+            a2 = [X[2][k] - X[0][k] for k in range(3)]
+            g11, g12, g22 = _dot3(a1, a1), _dot3(a1, a2), _dot3(a2, a2)
             det = g11 * g22 - g12 * g12
             ok = det > 1e-14 * g11 * g22
             inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)  # degenerate: never inside
             self.gram_inv = (g22 * inv, -g12 * inv, g11 * inv)
         elif self.kind == "quadrilateral":
-            x0, x1, x2, x3 = (nodes[:, a] for a in range(4))
-            self.bilinear = np.stack([x0, x1 - x0, x2 - x0, x0 - x1 - x2 + x3], axis=1)
+            # y = c0 + s c1 + t c2 + s t c3, by coordinate columns
+            x0, x1, x2, x3 = X
+            self.bilinear = [
+                x0,
+                [x1[k] - x0[k] for k in range(3)],
+                [x2[k] - x0[k] for k in range(3)],
+                [x0[k] - x1[k] - x2[k] + x3[k] for k in range(3)],
+            ]
+
+    def _centre_normal(self, X: list[list[FloatArray]]) -> list[FloatArray]:
+        """Columns of the normal ``a1 x a2`` (2D: ``(a1[1], -a1[0])``) at the centre of each
+        facet, from the coordinate columns ``X[a][k]`` of its nodes."""
+        g = self.gdim
+        _, dN, _ = shape_functions(self.nn, g, np.full((1, self.fdim), 0.5))
+        a = [
+            [
+                sum(dN[0, n, alpha] * X[n][k] for n in range(self.nn) if dN[0, n, alpha] != 0)
+                for k in range(g)
+            ]
+            for alpha in range(self.fdim)
+        ]
+        if g == 2:
+            return [a[0][1], -a[0][0]]
+        a1, a2 = a
+        return [
+            a1[1] * a2[2] - a1[2] * a2[1],
+            a1[2] * a2[0] - a1[0] * a2[2],
+            a1[0] * a2[1] - a1[1] * a2[0],
+        ]
 
     def lower_bound(self, x: FloatArray, f: IntArray, pid: IntArray | None = None) -> FloatArray:
         """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``
@@ -386,7 +424,7 @@ class _Master:
         if todo.size == 0:
             return
         X = x[todo]
-        coef = self.bilinear[f[todo]]
+        coef = [[column[f[todo]] for column in cj] for cj in self.bilinear]
         xi, dist, conv, pd = _quad_newton(X, coef, np.full((todo.size, 2), 0.5))
         # not converged, or stuck inside at a saddle or maximum: restart from four other points
         inner = np.all((xi > 0.0) & (xi < 1.0), axis=1)
@@ -394,7 +432,9 @@ class _Master:
         if redo.size:
             for start in ((0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)):
                 xi_r, dist_r, _, pd_r = _quad_newton(
-                    X[redo], coef[redo], np.tile(start, (redo.size, 1))
+                    X[redo],
+                    [[column[redo] for column in cj] for cj in coef],
+                    np.tile(start, (redo.size, 1)),
                 )
                 inner_r = np.all((xi_r > 0.0) & (xi_r < 1.0), axis=1)
                 inner = np.all((xi[redo] > 0.0) & (xi[redo] < 1.0), axis=1)
@@ -411,11 +451,11 @@ class _Master:
 
 
 def _quad_newton(
-    x: FloatArray, coef: FloatArray, xi: FloatArray
+    x: FloatArray, coef: list[list[FloatArray]], xi: FloatArray
 ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
     """Minimise ``|x - y(s, t)|^2`` over ``[0, 1]^2`` on bilinear patches by projected Newton.
 
-    ``y = c0 + s c1 + t c2 + s t c3`` with ``coef = [c0, c1, c2, c3]`` (P, 4, 3). The Hessian
+    ``y = c0 + s c1 + t c2 + s t c3`` with ``coef[j][k]`` coordinate ``k`` of ``c_j``. The Hessian
     is replaced by the Gauss-Newton matrix where it is not positive definite; a coordinate on
     a bound that the gradient pushes outwards is held there; the iterate is clamped to the box
     after each step, and a step that increases the distance is halved (at most three times).
@@ -425,7 +465,7 @@ def _quad_newton(
     """
     P = x.shape[0]
     # coordinate columns: C[j][k] = coordinate k of c_j, X[k] of the points
-    C = [[np.ascontiguousarray(coef[:, j, k]) for k in range(3)] for j in range(4)]
+    C = coef
     X = [np.ascontiguousarray(x[:, k]) for k in range(3)]
     s_all, t_all = xi[:, 0].copy(), xi[:, 1].copy()
     conv = np.zeros(P, dtype=bool)
@@ -676,6 +716,20 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     )
 
 
+def _spatial_order(points: FloatArray) -> IntArray:
+    """An order of the points by the cells of a ``_CELLS^gdim`` grid over their bounding
+    box (lexicographic in the cell coordinates)."""
+    lo = points.min(axis=0)
+    span = float((points.max(axis=0) - lo).max())
+    if not span > 0.0:
+        return np.arange(points.shape[0])
+    cell = np.minimum((points - lo) * (_CELLS / span), _CELLS - 1).astype(np.int64)
+    key = cell[:, 0]
+    for k in range(1, points.shape[1]):
+        key = key * _CELLS + cell[:, k]
+    return np.argsort(key, kind="stable")
+
+
 def closest_points(
     points: npt.ArrayLike,
     nodes: npt.ArrayLike,
@@ -754,16 +808,16 @@ def closest_points(
     if npts == 0 or nf == 0:
         return out
     master = _Master(nodes, trees)
+    # on a large master the points in the order of a grid of cells (neighbours searched
+    # together: the KD-tree and the gathers of facet data stay in cache), results scattered
+    order = _spatial_order(points) if nf > _SORT else None
+    x = points if order is None else points[order]
+    work = out if order is None else Projection(*(getattr(out, k)[order] for k in _FIELDS))
     for start in range(0, npts, _BLOCK):
         block = slice(start, min(start + _BLOCK, npts))
-        view = Projection(
-            facet=out.facet[block],
-            xi=out.xi[block],
-            y=out.y[block],
-            normal=out.normal[block],
-            gap=out.gap[block],
-            distance=out.distance[block],
-            sliding=out.sliding[block],
-        )
-        _closest_block(master, points[block], radius, view)
+        view = Projection(*(getattr(work, k)[block] for k in _FIELDS))
+        _closest_block(master, x[block], radius, view)
+    if order is not None:
+        for k in _FIELDS:
+            getattr(out, k)[order] = getattr(work, k)
     return out
