@@ -1,10 +1,18 @@
-"""Speed against error: the 2D Hertz problem on a sequence of meshes.
+"""Speed against error: the Hertz problem on a sequence of meshes.
 
 Prints a table and writes one JSON record per mesh: dofs, h, p0_error, a_error,
 newton_iterations, wall_s (solve time), search_s (time in the closest-point projection).
 
     python benchmarks/hertz.py --json benchmarks/results/hertz.json [--quick]
     mpirun -n 2 python benchmarks/hertz.py --json ...
+
+``--dim 3``: the 3D sphere on a block, quarter model, linear elastic
+(:func:`contact_ufl.verification.scenes.hertz_3d`, errors of
+:func:`contact_ufl.verification.runs.hertz_3d_errors`), on graded meshes given by
+``(h_contact, h_edge)``; the records add pressure_l2_error, newton_per_step, the cruder
+measures of a and p0 and the errors of the elastic sphere on a rigid flat (``--flat rigid``).
+
+    python benchmarks/hertz.py --dim 3 --json benchmarks/results/hertz_3d.json
 """
 
 import argparse
@@ -17,9 +25,13 @@ from contact_ufl.problem import ContactProblem
 from contact_ufl.results import contact_samples
 from contact_ufl.verification import scenes
 from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
+from contact_ufl.verification.runs import hertz_3d_run
 
 FULL = [0.02, 0.01, 0.005, 0.0025, 0.00125]
 QUICK = [0.02, 0.01, 0.005]
+#: 3D meshes: (h_contact, h_edge), a ~ 0.103 (a / h_contact ~ 4, 8, 8, 8)
+FULL_3D = [(0.025, None), (0.0125, None), (0.0125, 0.004), (0.0125, 0.003)]
+QUICK_3D = FULL_3D[:3]
 
 
 def run(h: float, depth: float, steps: int) -> dict:
@@ -44,13 +56,49 @@ def run(h: float, depth: float, steps: int) -> dict:
     }
 
 
+def run_3d(h: float, h_edge: float | None, depth: float, steps: int, flat: str) -> dict:
+    record, _ = hertz_3d_run(h, steps=steps, depth=depth, h_edge=h_edge, flat=flat)
+    return {"flat": flat, "h_edge": h_edge, **record}
+
+
+def main_3d(args) -> None:
+    comm = MPI.COMM_WORLD
+    records = []
+    if comm.rank == 0:
+        print(
+            f"{'h':>7} {'h_edge':>7} {'dofs':>7} {'a err':>8} {'p0 err':>8} {'L2 err':>7} "
+            f"{'nwt/st':>6} {'wall s':>7} {'search s':>8}"
+        )
+    for h, h_edge in QUICK_3D if args.quick else FULL_3D:
+        r = run_3d(h, h_edge, args.depth, args.steps, args.flat)
+        records.append(r)
+        if comm.rank == 0:
+            print(
+                f"{h:7.4f} {h_edge or 0:7.4f} {r['dofs']:7d} {r['a_error']:+8.4f} "
+                f"{r['p0_error']:+8.4f} {r['pressure_l2_error']:7.4f} "
+                f"{r['newton_per_step']:6.1f} {r['wall_s']:7.1f} {r['search_s']:8.1f}",
+                flush=True,
+            )
+            with open(args.json, "w") as f:
+                json.dump(records, f, indent=2)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--json", required=True, help="output file")
     parser.add_argument("--quick", action="store_true", help="three coarse meshes (< 1 min)")
-    parser.add_argument("--depth", type=float, default=0.005)
-    parser.add_argument("--steps", type=int, default=4)
+    parser.add_argument("--dim", type=int, choices=(2, 3), default=2)
+    parser.add_argument("--depth", type=float, default=None, help="2D: 0.005, 3D: 0.01")
+    parser.add_argument("--steps", type=int, default=None, help="2D: 4, 3D: 2")
+    parser.add_argument("--flat", choices=("elastic", "rigid"), default="elastic", help="3D")
     args = parser.parse_args()
+    if args.dim == 3:
+        args.depth = 0.01 if args.depth is None else args.depth
+        args.steps = 2 if args.steps is None else args.steps
+        main_3d(args)
+        return
+    args.depth = 0.005 if args.depth is None else args.depth
+    args.steps = 4 if args.steps is None else args.steps
     comm = MPI.COMM_WORLD
     records = []
     header = (

@@ -522,3 +522,87 @@ def pressurised_string(mu: float, t0: float, a: float, chord: float, p: float) -
         "tension": p * rho,
         "sag": rho * (1.0 - np.cos(theta)),
     }
+
+
+# -- 3D Hertz: a sphere on a flat ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Hertz3D:
+    """Hertz contact of a sphere of radius ``R`` on a flat (or of two spheres, ``1/R = 1/R1 +
+    1/R2``), both bodies elastic half-spaces of contact modulus ``E*``
+    (:func:`plane_strain_modulus`), under the force ``P``.
+
+    The contact area is a disc of radius ``a`` and the pressure ``p(r) = p0 sqrt(1 - r^2 /
+    a^2)`` (Johnson, *Contact Mechanics*, 1985, section 4.2). Derivation: this pressure on a
+    half-space displaces its surface normally by ``u_z = pi p0 (2 a^2 - r^2) / (4 a E_i')``,
+    ``E_i' = E_i / (1 - nu_i^2)``, for ``r <= a`` (Johnson 3.41); the two surfaces together
+    move by ``u_z1 + u_z2 = pi p0 (2 a^2 - r^2) / (4 a E*)``, and within the contact disc
+    this must close the initial gap ``r^2 / (2 R)`` up to the approach ``d`` of distant
+    points: ``pi p0 (2 a^2 - r^2) / (4 a E*) = d - r^2 / (2 R)`` for all ``r <= a``. The
+    ``r^2`` terms give ``a = pi p0 R / (2 E*)``, the constants ``d = pi a p0 / (2 E*) = a^2
+    / R``. The force is ``P = int p dA = 2 pi a^2 p0 / 3``. Eliminating ``p0``: ``a^3 = 3 P
+    R / (4 E*)``, ``p0 = 3 P / (2 pi a^2) = (6 P E*^2 / (pi^3 R^2))^(1/3)``; in terms of the
+    approach: ``a = sqrt(R d)`` and ``P = 4/3 E* sqrt(R) d^(3/2)``.
+    """
+
+    P: float
+    R: float
+    E_star: float
+
+    @classmethod
+    def from_approach(cls, d: float, R: float, E_star: float) -> Hertz3D:
+        """The contact under the approach ``d`` of distant points: ``P = 4/3 E* sqrt(R)
+        d^(3/2)``."""
+        return cls(4.0 / 3.0 * E_star * np.sqrt(R) * d**1.5, R, E_star)
+
+    @property
+    def a(self) -> float:
+        """Contact radius ``(3 P R / (4 E*))^(1/3)``."""
+        return float(np.cbrt(3.0 * self.P * self.R / (4.0 * self.E_star)))
+
+    @property
+    def p0(self) -> float:
+        """Peak pressure ``(6 P E*^2 / (pi^3 R^2))^(1/3) = 3 P / (2 pi a^2)``."""
+        return float(np.cbrt(6.0 * self.P * self.E_star**2 / (np.pi**3 * self.R**2)))
+
+    @property
+    def approach(self) -> float:
+        """Approach of distant points ``d = a^2 / R``."""
+        return self.a**2 / self.R
+
+    def pressure(self, r: np.ndarray) -> np.ndarray:
+        """Pressure at distance ``r`` from the centre of contact."""
+        return self.p0 * np.sqrt(np.clip(1.0 - (np.asarray(r) / self.a) ** 2, 0.0, None))
+
+
+def fit_radial_profile(
+    r: np.ndarray, p: np.ndarray, weights: np.ndarray | None = None
+) -> tuple[float, float]:
+    """The Hertz profile ``p0 sqrt(1 - r^2 / a^2)`` (zero beyond ``a``) nearest to samples
+    ``p`` at radii ``r`` in the weighted L2 sense; return ``(a, p0)``.
+
+    Minimises ``sum w (p - p0 s_a)^2``, ``s_a = sqrt(max(1 - r^2 / a^2, 0))``. For a given
+    ``a`` the best ``p0 = sum w p s_a / sum w s_a^2``; the misfit, continuous in ``a``, is
+    then minimised over ``a`` between half and twice the radius of the farthest sample
+    above a tenth of the largest (bounded Brent). With the quadrature weights of the samples
+    the fit uses the whole profile, the smeared edge and the tail beyond it included.
+    """
+    from scipy.optimize import minimize_scalar
+
+    r, p = np.asarray(r, dtype=float), np.asarray(p, dtype=float)
+    w = np.ones_like(p) if weights is None else np.asarray(weights, dtype=float)
+
+    def best_p0(a: float) -> tuple[float, float]:
+        s = np.sqrt(np.clip(1.0 - (r / a) ** 2, 0.0, None))
+        p0 = np.sum(w * p * s) / np.sum(w * s * s)
+        return float(p0), float(np.sum(w * (p - p0 * s) ** 2))
+
+    a0 = float(r[p > 0.1 * p.max()].max())
+    fit = minimize_scalar(
+        lambda a: best_p0(a)[1],
+        bounds=(0.5 * a0, 2.0 * a0),
+        method="bounded",
+        options={"xatol": 1e-8 * a0},
+    )
+    return float(fit.x), best_p0(fit.x)[0]

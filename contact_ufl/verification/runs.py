@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
+from mpi4py import MPI
 
 from contact_ufl.loads import evaluate
 from contact_ufl.problem import ContactProblem
@@ -14,14 +17,22 @@ from contact_ufl.results import (
     stored_energy,
 )
 from contact_ufl.verification import scenes
-from contact_ufl.verification.analytic import CattaneoMindlin2D, Hertz2D
+from contact_ufl.verification.analytic import (
+    CattaneoMindlin2D,
+    Hertz2D,
+    Hertz3D,
+    fit_radial_profile,
+)
 
 __all__ = [
     "cattaneo_mindlin_run",
     "energy_balance",
+    "hertz_3d_errors",
+    "hertz_3d_run",
     "history_at",
     "ironing_run",
     "shear_error",
+    "slave_point_weights",
     "steady_ratio",
 ]
 
@@ -186,3 +197,109 @@ def history_at(history: list[dict], t: float, key: str) -> float:
     """|``key``| of the records, interpolated linearly in pseudo-time at ``t``."""
     times = np.array([r["time"] for r in history])
     return float(np.interp(t, times, [abs(r[key]) for r in history]))
+
+
+# -- 3D Hertz -----------------------------------------------------------------------------------
+
+
+def slave_point_weights(problem, pair: int = 0) -> np.ndarray:
+    """Quadrature weights (reference area) of the slave points of all ranks, in the order of
+    :func:`~contact_ufl.results.contact_samples`: the reference rule's weights times twice
+    the area of each (flat, triangular) slave facet."""
+    slave = problem.contacts[pair].slave
+    nc = slave.num_cells
+    gdim = problem.V.mesh.geometry.dim
+    nodes = slave.submesh.geometry.dofmaps[0][:nc, :3]
+    v = slave.submesh.geometry.x[nodes, :gdim]  # (nc, 3, gdim)
+    area = 0.5 * np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=-1)
+    weights = (2.0 * area[:, None] * slave.weights_ref[None, :]).ravel()
+    return np.concatenate(problem.comm.allgather(weights))
+
+
+def hertz_3d_errors(problem, hertz: scenes.Hertz3DScene, pair: int = 0) -> dict:
+    """Errors of the 3D Hertz quarter model against :class:`Hertz3D` under the computed force.
+
+    The exact solution is that of the full force ``P = 4 F_z``, ``F_z`` the contact force on
+    the quarter ball. Hertz's solution is one of linear (small-strain) elasticity, where the
+    configurations and the stress measures coincide; the model's bulk
+    (:class:`~contact_ufl.materials.LinearElastic`) is Hooke's law for the *first Piola*
+    stress, so the pressure compared is the nominal one, the multiplier ``lambda_N`` (force
+    per unit reference area), at the reference positions of the slave points, ``r = sqrt(X^2
+    + Y^2)``. (The Cauchy pressure at the current positions differs from it by the change of
+    the surface's area, of the order of the strain ``p0 / E* ~ a / R``: 2-4% at the centre for
+    ``a / R = 0.1``; it is reported as ``p0_error_cauchy``.)
+
+    Returns
+    -------
+    dict
+        ``P``, ``a``, ``p0`` (exact), ``a_over_h``; ``a_error``, ``p0_error``: of the
+        L2-nearest profile ``p0 sqrt(1 - r^2 / a^2)``
+        (:func:`~contact_ufl.verification.analytic.fit_radial_profile`);
+        ``a_moment_error``: of ``a = sqrt(5/2 int p r^2 dA / int p dA)`` (the second moment of
+        Hertz's pressure); ``p0_node_error``: of the largest nodal multiplier (at the point of
+        first contact); ``a_last_error``: of the radius of the farthest slave point in
+        contact; ``pressure_l2_error``: ``||p_h - p||_L2 / ||p||_L2`` over the whole slave
+        surface (reference area); ``p0_error_cauchy``: the fit of the Cauchy pressure at the
+        current positions.
+    """
+    c = problem.contacts[pair]
+    comm = problem.comm
+    samples = contact_samples(problem, pair)
+    P = hertz.symmetry_factor * float(problem.contact_force(pair)[2])
+    exact = Hertz3D(P, hertz.radius, hertz.E_star)
+    X = np.concatenate(comm.allgather(c.slave.X.reshape(-1, c.gdim)))
+    r = np.linalg.norm(X[:, :2], axis=1)
+    lam = samples.lambda_N
+    w = slave_point_weights(problem, pair)
+    a, p0 = fit_radial_profile(r, lam, w)
+    p = exact.pressure(r)
+    a_moment = np.sqrt(2.5 * np.sum(w * lam * r**2) / np.sum(w * lam))
+    owned = c.slave.P1.dofmap.index_map.size_local
+    node_max = comm.allreduce(
+        float(np.max(c.normal.lambda_N.x.array[:owned], initial=-np.inf)), MPI.MAX
+    )
+    r_current = np.linalg.norm(samples.x[:, :2], axis=1)
+    p0_cauchy = fit_radial_profile(r_current, samples.pressure, w)[1]
+    return {
+        "P": P,
+        "a": exact.a,
+        "p0": exact.p0,
+        "a_over_h": exact.a / hertz.h_contact,
+        "a_error": a / exact.a - 1.0,
+        "p0_error": p0 / exact.p0 - 1.0,
+        "a_moment_error": float(a_moment) / exact.a - 1.0,
+        "p0_node_error": node_max / exact.p0 - 1.0,
+        "a_last_error": float(r[_in_contact(problem, pair)].max()) / exact.a - 1.0,
+        "pressure_l2_error": float(np.sqrt(np.sum(w * (lam - p) ** 2) / np.sum(w * p**2))),
+        "p0_error_cauchy": p0_cauchy / exact.p0 - 1.0,
+    }
+
+
+def _in_contact(problem, pair: int = 0) -> np.ndarray:
+    """Mask of the slave points of all ranks in contact (order of ``contact_samples``)."""
+    return np.concatenate(problem.comm.allgather(problem.contacts[pair].active()))
+
+
+def hertz_3d_run(h_contact: float, steps: int = 2, **options) -> tuple[dict, ContactProblem]:
+    """Solve :func:`~contact_ufl.verification.scenes.hertz_3d` (``options`` passed to it) in
+    ``steps`` load steps; return the record of :func:`hertz_3d_errors` with ``dofs``,
+    ``h_contact``, ``slave_points``, ``newton_iterations``, ``newton_per_step``, ``wall_s``
+    (the solve), ``search_s`` (its closest-point search) and ``ranks``, and the problem."""
+    hertz = scenes.hertz_3d(h_contact=h_contact, **options)
+    problem = ContactProblem(hertz.scene, verbose=False)
+    start = time.perf_counter()
+    problem.solve(num_steps=steps)
+    wall = time.perf_counter() - start
+    newton = sum(s.newton_iterations for s in problem.history.steps)
+    record = {
+        "dofs": problem.layout.global_size,
+        "h_contact": h_contact,
+        "slave_points": len(contact_samples(problem).pressure),
+        **hertz_3d_errors(problem, hertz),
+        "newton_iterations": newton,
+        "newton_per_step": newton / len(problem.history.steps),
+        "wall_s": wall,
+        "search_s": problem.search_time,
+        "ranks": problem.comm.size,
+    }
+    return record, problem
