@@ -9,9 +9,10 @@
   slave), both stretched in their plane: the exact solution is homogeneous, the multipliers
   are the contact tractions (property (c): ``lambda_N / (da/dA) = p``), and supports,
   pressure and contact forces balance to round-off.
-- Friction: a pre-tensioned string pressed onto a rigid plane and pulled by one end slips
-  near that end with ``|lambda_T| = mu lambda_N`` and sticks beyond, strictly inside the
-  cone; its end tension and the slip front follow the closed form below.
+- Friction: a pre-tensioned string (a membrane strip in 3D) pressed onto a rigid plane and
+  pulled by one end slips near that end with ``|lambda_T| = mu lambda_N`` and sticks
+  beyond, strictly inside the cone; the string's end tension and slip front follow the
+  closed form below.
 
 Closed form of the string (plane strain, per unit depth). A string of reference length
 ``2 a`` held at its ends ``(+-c, 0)`` is pressed at its middle by a rigid cylinder of radius
@@ -200,7 +201,7 @@ def _stick_zone(problem) -> tuple[float, float, float]:
     radius = float(friction.mu.value) * c.multiplier_at_points()
     ratio = np.linalg.norm(friction.tangential_multiplier_at_points(), axis=1)[stick]
     ratio = ratio / radius[stick]
-    x = c.slave.positions(c.u).reshape(-1, 2)[:, 0]
+    x = c.slave.positions(c.u).reshape(-1, c.gdim)[:, 0]
     return (
         COMM.allreduce(ratio.max(initial=0.0), MPI.MAX),
         COMM.allreduce(x[stick].max(initial=-np.inf), MPI.MAX),
@@ -208,24 +209,10 @@ def _stick_zone(problem) -> tuple[float, float, float]:
     )
 
 
-def test_string_dragged_on_a_rigid_plane():
-    """A pre-tensioned string (s = 1.02) pressed onto a RigidPlane (mu = 0.3) and pulled by
-    one end (:func:`~contact_ufl.verification.scenes.membrane_dragged_on_plane`).
-
-    Pressed, it sticks everywhere. Pulled, it slips near the pulled end and sticks beyond,
-    the zone of slip growing with the pull: the slipping points are on the cone,
-    ``|lambda_T| = mu lambda_N``, to round-off (the two-point Lobatto rule makes the
-    multiplier equations nodal, so the P1 multipliers are the traction at the nodes; with
-    Gauss points their L2 projection smears the kink at the stick/slip front, 1.1e-4 of
-    ``max mu lambda_N`` measured), and they slip along their tangential traction; the
-    sticking points are strictly inside it (``|lambda_T| < 0.9 mu lambda_N``; at most 0.69
-    measured, next to the front). Supports,
-    pressure and plane balance to round-off; the stuck end keeps the pre-tension; the slip
-    front is that of the closed form to within an element, and the pulled end's tension
-    within 2%: the end cells are left out of the contact surface, and the friction missing
-    over half a cell, ``mu p s h / 2``, is 1.6% of it (measured -1.7%)."""
-    mu, p, s, a, pull, n = 0.3, 0.01, 1.02, 0.5, 0.002, 32
-    scene, plane = scenes.membrane_dragged_on_plane(n, a, s, p, pull, mu)
+def _dragged(dim: int, mu: float, p: float, s: float, a: float, pull: float, n: int):
+    """The dragged strip solved: pressed (one step), then pulled (four steps); the problem,
+    the plane and ``(t, CoulombCheck, stick ratio, last stick x, first slip x)`` per step."""
+    scene, plane = scenes.membrane_dragged_on_plane(n, a, s, p, pull, mu, dim=dim)
     problem = cu.ContactProblem(scene, verbose=False, petsc_options=TIGHT_STRING)
     scenes.pretension(problem, s)
     log = []
@@ -235,22 +222,53 @@ def test_string_dragged_on_a_rigid_plane():
 
     problem.solve(num_steps=1, t_end=1.0, callback=record)
     problem.solve(num_steps=4, t_end=2.0, callback=record)
+    return problem, plane, log
+
+
+@pytest.mark.parametrize("dim, n", [(2, 32), (3, 16)])
+def test_membrane_dragged_on_a_rigid_plane(dim, n):
+    """A pre-tensioned string (2D) or membrane strip (3D, held in its plane on its long
+    edges), s = 1.02, pressed onto a RigidPlane (mu = 0.3) and pulled by one end
+    (:func:`~contact_ufl.verification.scenes.membrane_dragged_on_plane`).
+
+    Pressed, it sticks everywhere. Pulled, it slips near the pulled end and sticks beyond,
+    the zone of slip growing with the pull: the slipping points are on the cone,
+    ``|lambda_T| = mu lambda_N``, to solver tolerance (measured 1.4e-16 in 2D, 1.2e-12 in
+    3D, of ``max mu lambda_N``: the two-point Lobatto rule makes the multiplier equations
+    nodal, so the P1 multipliers are the traction at the nodes; with Gauss points their L2
+    projection smears the kink at the stick/slip front, 1.1e-4 measured), and they slip
+    along their tangential traction; the sticking points are strictly inside it
+    (``|lambda_T| / (mu lambda_N)`` at most 0.69 in 2D, 0.992 in 3D, next to the front).
+    Supports, pressure and plane balance to round-off."""
+    mu, p, s, a, pull = 0.3, 0.01, 1.02, 0.5, 0.002
+    problem, plane, log = _dragged(dim, mu, p, s, a, pull, n)
     assert not problem.history.cutbacks
-    (t, pressed, *_), *pulled = log
-    assert pressed.slipping == 0 and pressed.active == COMM.allreduce(
-        len(problem.contacts[0].active())
-    )
+    (_, pressed, *_), *pulled = log
+    contact_points = COMM.allreduce(len(problem.contacts[0].active()))
+    assert pressed.slipping == 0 and pressed.active == contact_points
     slipping = [check.slipping for _, check, *_ in pulled]
     assert 0 < slipping[0] and all(np.diff(slipping) > 0)
     for _, check, inside, last_stick, first_slip in pulled:
-        assert 0 < check.slipping < check.active
-        assert check.slip_excess < 1e-12 and check.excess < 1e-12
-        assert check.alignment > 1.0 - 1e-12
-        assert inside < 0.9
+        assert 0 < check.slipping < check.active == contact_points
+        assert check.slip_excess < 1e-10 and check.excess < 1e-10
+        assert check.alignment > 1.0 - 1e-10
+        assert inside < 1.0 - 1e-6
         assert last_stick < first_slip  # one stick zone, then one slip zone to the pulled end
-    assert equilibrium_error(problem, ["x0", "xmax"], [plane]) < 1e-12
+    edges = ["x0", "xmax", "y0", "ymax"][: 2 * (dim - 1)]
+    assert equilibrium_error(problem, edges, [plane]) < 1e-12
+
+
+def test_string_dragged_against_the_closed_form():
+    """2D: the stuck end keeps the pre-tension ``N(s)``, the slip front is that of the
+    closed form (module docstring) to within an element, and the pulled end's tension
+    ``N(l_e)`` within 2%: the end cells are left out of the contact surface, and the
+    friction missing over half a cell, ``mu p s h / 2``, is 1.6% of it (measured -1.7%)."""
+    mu, p, s, a, pull, n = 0.3, 0.01, 1.02, 0.5, 0.002, 32
+    problem, _, log = _dragged(2, mu, p, s, a, pull, n)
     exact = dragged_string(mu, p, s, a, pull)
+    assert exact["front"] > 0.5 * a and exact["stretch"] > s + 0.01
     assert np.isclose(-problem.reaction("x0")[0], exact["stuck"], rtol=1e-10)
     assert abs(problem.reaction("xmax")[0] / exact["tension"] - 1.0) < 0.02
     h = s * a / n
-    assert abs(0.5 * (pulled[-1][3] + pulled[-1][4]) - s * exact["front"]) < h
+    _, _, _, last_stick, first_slip = log[-1]
+    assert abs(0.5 * (last_stick + first_slip) - s * exact["front"]) < h

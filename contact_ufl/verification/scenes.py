@@ -1178,40 +1178,61 @@ def membrane_dragged_on_plane(
     pressure: float = 0.01,
     pull: float = 0.002,
     mu: float = 0.3,
+    dim: int = 2,
+    width: int = 4,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> tuple[Scene, RigidPlane]:
-    """A pre-tensioned string pressed onto a rigid plane by a follower pressure, then pulled
-    by one end: a frictional stick and slip (plane strain).
+    """A pre-tensioned membrane strip pressed onto a rigid plane by a follower pressure, then
+    pulled by one edge: a frictional stick and slip.
 
-    The string ``[0, a]`` on ``y = 0`` (``n`` intervals) lies on the
-    :class:`~contact_ufl.contact.obstacles.RigidPlane` ``y = 0`` with friction coefficient
-    ``mu``, its normal down (a positive pressure pushes it onto the plane). Its ends ``"x0"``
-    and ``"xmax"`` are held on the plane and stretched by ``stretch`` (``u = 0`` and ``u =
-    ((stretch - 1) a, 0)``: start the solve with :func:`pretension`). From t = 0 to 1 the
-    pressure grows to ``pressure``; from t = 1 to 2 it is held and the end ``x = a`` is pulled
-    out by a further ``pull (t - 1)``. Near the pulled end the string slips (``|lambda_T| =
-    mu lambda_N``; its tension falls by ``mu lambda_N`` per unit reference length), beyond
-    that it sticks.
+    ``dim`` 2: the string ``[0, a]`` on ``y = 0`` (``n`` intervals); ``dim`` 3: the strip
+    ``[0, a] x [0, b]``, ``b = a width / n``, in ``z = 0`` (``n x width`` quadrilaterals). It
+    lies on the :class:`~contact_ufl.contact.obstacles.RigidPlane` ``y = 0``
+    (``z = 0``) with friction coefficient ``mu``, its normal down (a positive pressure pushes
+    it onto the plane). Its edges are held on the plane and stretched by ``stretch``: ``u_x
+    = 0`` on ``"x0"``, ``(stretch - 1) a`` on ``"xmax"`` (3D: ``u_y = 0`` on ``"y0"``,
+    ``(stretch - 1) b`` on ``"ymax"``; start the solve with :func:`pretension`). From t = 0
+    to 1 the pressure grows to ``pressure``; from t = 1 to 2 it is held and the edge ``x =
+    a`` is pulled out by a further ``pull (t - 1)``. Near the pulled edge the strip slips
+    (``|lambda_T| = mu lambda_N``; its tension falls by ``mu lambda_N`` per unit reference
+    length), beyond that it sticks.
 
-    The contact surface is the cells ``"membrane"`` (tag 100) away from the ends; the end
-    cells ``"membrane_ends"`` (tag 101, the same law and pressure) are not in it: a
-    multiplier at a node whose displacement is prescribed would constrain that node twice
-    (normally and, in stick, tangentially), and the Jacobian is then singular (measured:
-    ``DIVERGED_LINEAR_SOLVE`` at every cut-back). Returns the scene and the plane.
+    The contact surface is the cells ``"membrane"`` (tag 100) with no vertex on a held edge;
+    the cells along the edges, ``"membrane_edges"`` (tag 101, the same law and pressure),
+    are not in it: a multiplier at a node whose displacement is prescribed would constrain
+    it twice (normally and, in stick, tangentially), and the Jacobian is then singular
+    (measured: ``DIVERGED_LINEAR_SOLVE`` at every cut-back). The multiplier equations use
+    the two-point Lobatto rule per direction (at the vertices: lumped, so the P1 multipliers
+    are the contact tractions at the nodes). Returns the scene and the plane.
     """
     from contact_ufl.loads import FollowerPressure
-    from contact_ufl.verification import membrane_meshes
 
-    data = membrane_meshes.drumhead(comm, a, n, quarter=True, dim=2)
-    mesh = data.mesh
-    cells = data.cell_tags.indices
-    x = dolfinx.mesh.compute_midpoints(mesh, 1, cells)[:, 0]
-    ends = (x < a / n) | (x > a - a / n)
-    cell_tags = dolfinx.mesh.meshtags(mesh, 1, cells, np.where(ends, 101, 100).astype(np.int32))
-    groups = {k: v for k, v in data.groups.items() if v[0] == 0}
-    groups.update({"membrane": (1, 100), "membrane_ends": (1, 101)})
     shift = (stretch - 1.0) * a
+    data, planes = _strip(n, a, dim, width, comm)
+    mesh = data.mesh
+    x = mesh.geometry.x[mesh.geometry.dofmaps[0]]  # (cells, vertices, 3)
+    held = np.zeros(x.shape[:2], dtype=bool)
+    for axis, value in planes.values():
+        held |= np.isclose(x[..., axis], value, atol=1e-9 * a)
+    edge_cells = held.any(axis=1)
+    cells = np.arange(len(x), dtype=np.int32)
+    values = np.where(edge_cells, 101, 100).astype(np.int32)
+    cell_tags = dolfinx.mesh.meshtags(mesh, dim - 1, cells, values)
+    groups = {k: v for k, v in data.groups.items() if v[0] == dim - 2}
+    groups.update({"membrane": (dim - 1, 100), "membrane_edges": (dim - 1, 101)})
     law = _membrane_law()
+    normal = dim - 1
+    supports = [
+        Dirichlet("x0", 0.0, component=0),
+        Dirichlet("xmax", lambda t: shift + pull * max(t - 1.0, 0.0), component=0),
+    ]
+    if dim == 3:
+        b = planes["ymax"][1]
+        supports += [
+            Dirichlet("y0", 0.0, component=1),
+            Dirichlet("ymax", (stretch - 1.0) * b, component=1),
+        ]
+    supports += [Dirichlet(edge, 0.0, component=normal) for edge in planes]
 
     def p(t: float) -> float:
         return pressure * min(t, 1.0)
@@ -1220,20 +1241,39 @@ def membrane_dragged_on_plane(
         mesh,
         cell_tags,
         data.facet_tags,
-        [Body("membrane", law, "membrane"), Body("membrane_ends", law, "membrane_ends")],
-        [
-            Dirichlet("x0", (0.0, 0.0)),
-            Dirichlet("xmax", lambda t: (shift + pull * max(t - 1.0, 0.0), 0.0)),
-        ],
-        [FollowerPressure("membrane", p), FollowerPressure("membrane_ends", p)],
+        [Body("membrane", law, "membrane"), Body("membrane_edges", law, "membrane_edges")],
+        supports,
+        [FollowerPressure("membrane", p), FollowerPressure("membrane_edges", p)],
         groups=groups,
         name="membrane",
-        direction=(0.0, -1.0),
+        direction=tuple(-np.eye(dim)[normal]),
     )
-    plane = RigidPlane((0.0, 0.0), (0.0, 1.0))
-    return Scene(
-        domains=[domain],
-        contacts=[
-            ContactPair("membrane", plane, mu=mu, quadrature_rule="lobatto", quadrature_degree=1)
-        ],
-    ), plane
+    up = np.eye(dim)[normal]
+    plane = RigidPlane(tuple(0.0 * up), tuple(up))
+    pair = ContactPair("membrane", plane, mu=mu, quadrature_rule="lobatto", quadrature_degree=1)
+    return Scene(domains=[domain], contacts=[pair]), plane
+
+
+def _strip(n: int, a: float, dim: int, width: int, comm: MPI.Comm):
+    """The string ``[0, a]`` (``dim`` 2) or the strip ``[0, a] x [0, a width / n]`` in ``z
+    = 0`` (``dim`` 3, ``n x width`` quadrilaterals) with its edges; returns the mesh data and
+    the edges' planes."""
+    from contact_ufl.verification import membrane_meshes
+
+    if dim == 2:
+        planes = {"x0": (0, 0.0), "xmax": (0, a)}
+        return membrane_meshes.drumhead(comm, a, n, quarter=True, dim=2), planes
+    if dim != 3:
+        raise ValueError(f"dim must be 2 or 3, got {dim}")
+    b = a * width / n
+    xs, ys = np.linspace(0.0, a, n + 1), np.linspace(0.0, b, width + 1)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    x = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], 1)
+    i, j = np.meshgrid(np.arange(n), np.arange(width), indexing="ij")
+    n00 = (i * (width + 1) + j).ravel()  # node i (width + 1) + j at (xs[i], ys[j])
+    cells = np.stack([n00, n00 + width + 1, n00 + 1, n00 + width + 2], 1)
+    mesh = membrane_meshes._create(
+        comm, "quadrilateral", cells, x, False, dolfinx.mesh.GhostMode.shared_facet
+    )
+    planes = {"x0": (0, 0.0), "xmax": (0, a), "y0": (1, 0.0), "ymax": (1, b)}
+    return membrane_meshes.with_tags(mesh, planes, name="membrane"), planes
