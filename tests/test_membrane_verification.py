@@ -209,10 +209,10 @@ def _stick_zone(problem) -> tuple[float, float, float]:
     )
 
 
-def _dragged(dim: int, mu: float, p: float, s: float, a: float, pull: float, n: int):
+def _dragged(dim: int, mu: float, p: float, s: float, a: float, pull: float, n: int, comm=COMM):
     """The dragged strip solved: pressed (one step), then pulled (four steps); the problem,
     the plane and ``(t, CoulombCheck, stick ratio, last stick x, first slip x)`` per step."""
-    scene, plane = scenes.membrane_dragged_on_plane(n, a, s, p, pull, mu, dim=dim)
+    scene, plane = scenes.membrane_dragged_on_plane(n, a, s, p, pull, mu, dim=dim, comm=comm)
     problem = cu.ContactProblem(scene, verbose=False, petsc_options=TIGHT_STRING)
     scenes.pretension(problem, s)
     log = []
@@ -239,7 +239,8 @@ def test_membrane_dragged_on_a_rigid_plane(dim, n):
     projection smears the kink at the stick/slip front, 1.1e-4 measured), and they slip
     along their tangential traction; the sticking points are strictly inside it
     (``|lambda_T| / (mu lambda_N)`` at most 0.69 in 2D, 0.992 in 3D, next to the front).
-    Supports, pressure and plane balance to round-off."""
+    Supports, pressure and plane balance to round-off; the same pull force and the same
+    slipping points on any number of ranks."""
     mu, p, s, a, pull = 0.3, 0.01, 1.02, 0.5, 0.002
     problem, plane, log = _dragged(dim, mu, p, s, a, pull, n)
     assert not problem.history.cutbacks
@@ -256,6 +257,11 @@ def test_membrane_dragged_on_a_rigid_plane(dim, n):
         assert last_stick < first_slip  # one stick zone, then one slip zone to the pulled end
     edges = ["x0", "xmax", "y0", "ymax"][: 2 * (dim - 1)]
     assert equilibrium_error(problem, edges, [plane]) < 1e-12
+    if COMM.size > 1:  # the same pull force and stick/slip states on one rank
+        alone, _, log_1 = _dragged(dim, mu, p, s, a, pull, n, MPI.COMM_SELF)
+        force, force_1 = problem.reaction("xmax"), alone.reaction("xmax")
+        assert np.allclose(force, force_1, rtol=0.0, atol=1e-10 * abs(force[0]))
+        assert [r[1].slipping for r in log] == [r[1].slipping for r in log_1]
 
 
 def test_string_dragged_against_the_closed_form():
