@@ -114,8 +114,11 @@ def test_solid_pressed_into_a_drumhead(dim, n):
     if COMM.size > 1:
         alone, _ = _indented(dim, MPI.COMM_SELF, n)
         force_1, lam_1 = _force_and_multiplier(alone, top)
-        assert np.allclose(force, force_1, rtol=1e-8, atol=1e-8 * abs(force[-1]))
-        assert abs(lam / lam_1 - 1.0) < 1e-8
+        # measured 2e-12 (2D) and 2e-13 (3D) of the force, 1e-14 of the multiplier
+        assert np.allclose(force, force_1, rtol=0.0, atol=1e-10 * abs(force[-1]))
+        assert abs(lam / lam_1 - 1.0) < 1e-10
+        iterations = [[s.newton_iterations for s in q.history.steps] for q in (problem, alone)]
+        assert iterations[0] == iterations[1]
 
 
 def test_string_drumhead_force_against_the_closed_form():
