@@ -174,6 +174,14 @@ class Bulk:
             if self._bc_dofs
             else np.zeros(0, np.int64)
         )
+        #: which components of each local (owned and ghost) dof block are prescribed
+        imap = self.V.dofmap.index_map
+        self.prescribed_components = np.zeros((imap.size_local + imap.num_ghosts, gdim), bool)
+        for bc in self.domain.dirichlet:
+            facets = self.domain.facet_tags.find(bc.tag)
+            blocks = dolfinx.fem.locate_dofs_topological(self.V, fdim, facets)
+            comps = range(gdim) if bc.component is None else [bc.component]
+            self.prescribed_components[np.ix_(blocks, list(comps))] = True
 
     def prescribed(self, t: float) -> np.ndarray:
         """The prescribed displacements ``g(t)`` of :attr:`dirichlet_dofs`."""

@@ -117,7 +117,9 @@ class ContactProblem:
         ``fields``).
     dirichlet_rows
         Local (owned) indices of the prescribed displacement dofs (unrolled) in a vector of
-        the unknowns.
+        the unknowns, then of the multipliers held at zero because the slave's displacement
+        is prescribed there (:meth:`ContactInterface.held_multipliers
+        <contact_ufl.contact.interface.ContactInterface.held_multipliers>`).
     dirichlet_scale
         The stiffness ``k = E L^(d-2)`` of the prescribed-displacement equations
         ``k (u - g) = 0`` (every row of the residual is then a force).
@@ -273,9 +275,18 @@ class ContactProblem:
         size, E = self.scales()
         self.dirichlet_scale = E * size ** (self.gdim - 2)
         offsets = np.concatenate([[0], np.cumsum(self.layout.local_sizes)])
-        self.dirichlet_rows = np.concatenate(
-            [offsets[k] + b.dirichlet_dofs for k, b in enumerate(self.bulks)]
-        ).astype(np.int64)
+        rows = [offsets[k] + b.dirichlet_dofs for k, b in enumerate(self.bulks)]
+        # multipliers where the slave's displacement is prescribed are held at zero
+        block = {id(f): k for k, f in enumerate(self.unknowns)}
+        for c in self.contacts:
+            held_N, held_T = c.held_multipliers(
+                self.bulks[c.pair.slave_domain].prescribed_components
+            )
+            rows.append(offsets[block[id(c.lambda_N)]] + held_N)
+            if c.friction:
+                rows.append(offsets[block[id(c.friction.lambda_T)]] + held_T)
+        self.dirichlet_rows = np.concatenate(rows).astype(np.int64)
+        self._held = len(self.dirichlet_rows) - sum(len(b.dirichlet_dofs) for b in self.bulks)
 
     def block_rows(self, k: int) -> slice:
         """Local (owned) range of the displacement of mesh ``k`` in a vector of the
@@ -284,8 +295,9 @@ class ContactProblem:
         return slice(int(offsets[k]), int(offsets[k + 1]))
 
     def prescribed(self, t: float) -> np.ndarray:
-        """The prescribed displacements ``g(t)`` of the rows :attr:`dirichlet_rows`."""
-        return np.concatenate([b.prescribed(t) for b in self.bulks])
+        """The prescribed values ``g(t)`` of the rows :attr:`dirichlet_rows`: the
+        displacements, then the held multipliers (zero)."""
+        return np.concatenate([*(b.prescribed(t) for b in self.bulks), np.zeros(self._held)])
 
     def scales(self) -> tuple[float, float]:
         """The scene's diameter L and largest modulus E of its bodies (collective; a

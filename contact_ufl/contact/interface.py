@@ -212,6 +212,37 @@ class ContactInterface:
         gathers = self.kinematics.update(layout)
         return gathers + (self.friction.gathers() if self.friction else [])
 
+    def held_multipliers(self, prescribed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The multiplier dofs to hold at zero where the slave's displacement is prescribed.
+
+        A multiplier at a node whose displacement is prescribed along the normal constrains
+        what the support holds already: the two equations are dependent and the tangent is
+        singular (likewise ``lambda_T`` where the tangential displacement is prescribed, at a
+        sticking point). Those multipliers are held at zero; the contact there is carried by
+        the neighbouring nodes and the supports.
+
+        Parameters
+        ----------
+        prescribed
+            Which components of each (local) dof block of the slave's displacement are
+            prescribed, ``(blocks, gdim)``.
+
+        Returns
+        -------
+        Owned local indices of ``lambda_N`` and of ``lambda_T`` (unrolled; empty without
+        friction) to hold.
+        """
+        held = prescribed[self.slave.node_blocks()].astype(float)  # (n, gdim)
+        projector = self.slave.nodal_normal_projectors()
+        normal_part = np.einsum("nk,nkk->n", held, projector)
+        tangential_part = held.sum(axis=1) - normal_part
+        rows_N = np.flatnonzero(normal_part > 0.5)
+        if not self.friction:
+            return rows_N, np.zeros(0, dtype=np.int64)
+        nodes_T = np.flatnonzero(tangential_part > 0.5)
+        rows_T = (nodes_T[:, None] * self.gdim + np.arange(self.gdim)).ravel()
+        return rows_N, rows_T
+
     # -- pseudo-time and the step protocol ------------------------------------------------
     def set_time(self, t: float) -> None:
         """Set the pseudo-time of the master side (the pose of a rigid obstacle)."""

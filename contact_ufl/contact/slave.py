@@ -86,7 +86,8 @@ class SlaveSurface:
         self.membrane = self.facet_tags.dim == tdim
         sdim = self.facet_tags.dim
         entities = tagged_facets(self.facet_tags, self.tag, "slave")
-        self.submesh, self.entity_map = dolfinx.mesh.create_submesh(mesh, sdim, entities)[:2]
+        submesh = dolfinx.mesh.create_submesh(mesh, sdim, entities)
+        self.submesh, self.entity_map, self._vertex_map = submesh[:3]
         num_owned = self.submesh.topology.index_map(sdim).size_local
         sub_cells = np.arange(num_owned, dtype=np.int32)
         parent = self.entity_map.sub_topology_to_topology(sub_cells, inverse=False)
@@ -290,6 +291,46 @@ class SlaveSurface:
         """``int phi_i dS_o`` of the owned multiplier nodes (the reference surface)."""
         form = dolfinx.fem.form(ufl.TestFunction(self.P1) * self.ds, entity_maps=[self.entity_map])
         return self.assemble_nodal(form, self.P1)[: self.P1.dofmap.index_map.size_local].copy()
+
+    def node_blocks(self) -> np.ndarray:
+        """For each owned multiplier node, the local dof block (node) of the parent
+        displacement at the same vertex, ``(n,)``."""
+        mesh, sdim = self.V.mesh, self.submesh.topology.dim
+        tdim = mesh.topology.dim
+        nv = self._phi_p1.shape[1]
+        self.submesh.topology.create_connectivity(sdim, 0)
+        mesh.topology.create_connectivity(tdim, 0)
+        sub_vertices = self.submesh.topology.connectivity(sdim, 0).array.reshape(-1, nv)
+        dofs = self.P1.dofmap.list  # (all local cells: an owned node may have no owned cell)
+        owned = self.P1.dofmap.index_map.size_local
+        vertex_of_node = np.full(owned + self.P1.dofmap.index_map.num_ghosts, -1, np.int64)
+        vertex_of_node[dofs.ravel()] = sub_vertices[: len(dofs)].ravel()
+        parent_vertex = self._vertex_map.sub_topology_to_topology(
+            vertex_of_node[:owned].astype(np.int32), inverse=False
+        )
+        nvc = len(basix.topology(basix_cell(mesh, tdim))[0])
+        cell_vertices = mesh.topology.connectivity(tdim, 0).array.reshape(-1, nvc)
+        vertices = mesh.topology.index_map(0)
+        block_of_vertex = np.full(vertices.size_local + vertices.num_ghosts, -1, np.int64)
+        block_of_vertex[cell_vertices.ravel()] = self.V.dofmap.list[:, :nvc].ravel()
+        return block_of_vertex[parent_vertex]
+
+    def nodal_normal_projectors(self) -> np.ndarray:
+        """``N N^T`` of the reference normals ``N`` of the slave cells around each owned
+        multiplier node, averaged, ``(n, gdim, gdim)`` (the sign of ``N`` does not matter:
+        a membrane's vertex-order normals may point either way)."""
+        gdim = self.normals.shape[1]
+        space = dolfinx.fem.functionspace(self.submesh, ("Lagrange", 1, (gdim * gdim + 1,)))
+        f = dolfinx.fem.Function(space)
+        values = f.x.array.reshape(-1, gdim * gdim + 1)
+        outer = np.einsum("ci,cj->cij", self.normals, self.normals).reshape(-1, gdim * gdim)
+        per_cell = np.hstack([outer, np.ones((len(outer), 1))])
+        dofs = space.dofmap.list[: self.num_cells]
+        np.add.at(values, dofs, per_cell[:, None, :])
+        f.x.scatter_reverse(dolfinx.la.InsertMode.add)
+        owned = space.dofmap.index_map.size_local
+        summed = f.x.array.reshape(-1, gdim * gdim + 1)[:owned]
+        return (summed[:, :-1] / summed[:, -1:]).reshape(-1, gdim, gdim)
 
     def count_at_nodes(self, mask: np.ndarray) -> np.ndarray:
         """For each owned multiplier node, how many of the (owned) points ``mask`` selects
