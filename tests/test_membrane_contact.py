@@ -151,3 +151,34 @@ def test_tube_contact_pressure_converges():
     e_coarse = _pressure_error(coarse[0], coarse[1], coarse[3])
     e_fine = _pressure_error(fine[0], fine[1], fine[3])
     assert e_fine < 0.25 * e_coarse, (e_coarse, e_fine)
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.3])
+def test_string_held_at_its_ends_on_a_plane(mu):
+    """A pre-tensioned string on a rigid plane, pressed by a pressure, its ends held in both
+    directions: the multipliers at the held ends would constrain what the supports hold (a
+    singular tangent, every cut-back failing); they are held at zero, and the step
+    converges at once, the plane carrying the pressure but for the ends' halves of a cell."""
+    from contact_ufl.verification import membrane_meshes
+
+    data = membrane_meshes.drumhead(COMM, 0.5, 8, quarter=True, dim=2)
+    supports = [cu.Dirichlet("x0", 0.0), cu.Dirichlet("xmax", (0.01, 0.0))]
+    domain = cu.Domain.from_mesh_data(
+        data,
+        [cu.Body("membrane", cu.MembraneNeoHookean(1.0, 0.01))],
+        supports,
+        [cu.FollowerPressure("membrane", lambda t: PRESSURE * t)],
+        name="string",
+    )
+    domain.direction = (0.0, -1.0)  # n0 towards the plane: the pressure pushes it down
+    plane = cu.RigidPlane((0.0, 0.0), (0.0, 1.0))
+    scene = cu.Scene(domains=[domain], contacts=[cu.ContactPair("membrane", plane, mu=mu)])
+    problem = cu.ContactProblem(scene, verbose=False)
+    scenes.pretension(problem, 1.02)
+    problem.solve(num_steps=1, max_cutbacks=0)
+    assert not problem.history.cutbacks and problem.history.steps[0].newton_iterations <= 3
+    (c,) = problem.contacts
+    assert COMM.allreduce(problem._held) == (2 if mu == 0.0 else 6)  # lambda_T: 2 components
+    load = np.linalg.norm(problem.load_resultant())
+    assert problem.obstacle_reaction(plane)[1] > 0.85 * load  # the plane carries the load
+    assert equilibrium_error(problem, ["x0", "xmax"], [plane]) < 1e-8  # the ends the rest
