@@ -71,6 +71,8 @@ class MeshMaster:
     keys
         Sorted input (mesh file) indices of the vertices of each facet, ``(nf, nn)``: the
         same on any number of ranks and in any rigidly moved copy of the scene.
+    node_keys
+        The input indices of the vertices of each facet in the order of ``nodes``.
     boundary_edges
         For each facet, which of its :data:`FACET_EDGES` lie on the boundary of the master
         surface (2D: which of its two nodes are end points of the surface), ``(nf, ne)``.
@@ -348,7 +350,8 @@ class MasterCandidates:
     ----------
     nodes
         Current positions of the gathered nodes of each facet, ``(nf, nx, gdim)``: the facet's
-        own ``nn`` nodes first, then (smoothed normal) the nodes before and after it.
+        own ``nn`` nodes first, then (smoothed normal) in 2D the nodes before and after it,
+        in 3D the fans of its nodes (:func:`node_fans`).
     columns
         Stacked index of the first displacement unknown of each gathered node, ``(nf, nx)``.
     keys
@@ -356,7 +359,7 @@ class MasterCandidates:
     boundary
         Which facet edges lie on the boundary of the master surface, ``(nf, ne)``.
     flags
-        (smoothed normal) whether the neighbour before / after exists, ``(nf, 2)``, else
+        (smoothed normal, 2D) whether the neighbour before / after exists, ``(nf, 2)``, else
         ``(nf, 0)``.
     """
 
