@@ -56,14 +56,12 @@ def test_fans_reject_a_pinched_surface():
         node_fans(MPI.COMM_SELF, triangles, 3)
 
 
-@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
-def test_nodal_normals_gather_the_facets_of_every_rank(cell):
-    """The nodal normals of the carried fans are those of all the facets around each node,
-    wherever they live: compared with the sum of the corner normals of every facet of every
-    rank. On two ranks the master surface (the top of one box) is split between them."""
+def warped_box_top(comm: MPI.Comm, cell: str):
+    """The top of a warped box as a smoothed master surface, and the nodal normals of its
+    facets at a smooth displacement ``(nf, nn, 3)``."""
     cell_type = getattr(dolfinx.mesh.CellType, cell)
     mesh = dolfinx.mesh.create_box(
-        MPI.COMM_WORLD,
+        comm,
         [[0.0, 0.0, 0.0], [1.0, 1.0, 0.5]],
         [6, 6, 2],
         cell_type,
@@ -75,8 +73,17 @@ def test_nodal_normals_gather_the_facets_of_every_rank(cell):
     u = dolfinx.fem.Function(V)
     u.interpolate(lambda x: smooth_field(x, 0.05, 3))
     master = MeshMaster(u, facet_tags, 1, smoothed=True)
-    nn, comm = master.nn, mesh.comm
-    normals = fan_normals(master.candidates(StackedLayout([V])).nodes, nn)
+    normals = fan_normals(master.candidates(StackedLayout([V])).nodes, master.nn)
+    return master, u, normals
+
+
+@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
+def test_nodal_normals_gather_the_facets_of_every_rank(cell):
+    """The nodal normals of the carried fans are those of all the facets around each node,
+    wherever they live: compared with the sum of the corner normals of every facet of every
+    rank. On two ranks the master surface (the top of one box) is split between them."""
+    master, u, normals = warped_box_top(MPI.COMM_WORLD, cell)
+    nn, comm = master.nn, MPI.COMM_WORLD
     # the reference: the corner normals of all facets of all ranks, summed at their nodes
     ids = np.concatenate(comm.allgather(master.global_nodes.astype(np.int64)))
     X = np.concatenate(comm.allgather(master.current_nodes()))
@@ -94,6 +101,30 @@ def test_nodal_normals_gather_the_facets_of_every_rank(cell):
         mine = np.isin(master._ring, master.global_nodes)
         assert comm.allreduce(master.num_facets, MPI.MIN) > 0
         assert comm.allreduce(int(np.count_nonzero(~mine)), MPI.MIN) > 0
+
+
+def fans_by_key(master: MeshMaster) -> np.ndarray:
+    """The fans of the master's facets with their nodes named by input index."""
+    comm = master.V.mesh.comm
+    ids = np.concatenate(comm.allgather(master.global_nodes.astype(np.int64).ravel()))
+    keys = np.concatenate(comm.allgather(master.node_keys.astype(np.int64).ravel()))
+    ids, first = np.unique(ids, return_index=True)
+    return keys[first][np.searchsorted(ids, master._ring)]
+
+
+@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
+def test_fans_are_the_same_on_any_number_of_ranks(cell):
+    """The fans start at partition-independent nodes: the fans (nodes named by input index,
+    in order) and the nodal normals of the distributed surface are those of the same surface
+    on one rank."""
+    master, _, normals = warped_box_top(MPI.COMM_WORLD, cell)
+    whole, _, whole_normals = warped_box_top(MPI.COMM_SELF, cell)
+    order = np.lexsort(whole.node_keys.T[::-1])
+    ordered = whole.node_keys[order]
+    at = order[[np.flatnonzero((ordered == k).all(axis=1))[0] for k in master.node_keys]]
+    assert np.array_equal(whole.node_keys[at], master.node_keys)
+    assert np.array_equal(fans_by_key(whole)[at], fans_by_key(master))
+    assert np.abs(whole_normals[at] - normals).max(initial=0.0) < 1e-14
 
 
 def test_too_many_facets_around_a_node(monkeypatch):

@@ -86,6 +86,8 @@ class MeshMaster:
     keys
         Sorted input (mesh file) indices of the vertices of each facet, ``(nf, nn)``: the
         same on any number of ranks and in any rigidly moved copy of the scene.
+    node_keys
+        The input indices of the vertices of each facet in the order of ``nodes``.
     boundary_edges
         For each facet, which of its :data:`FACET_EDGES` lie on the boundary of the master
         surface (2D: which of its two nodes are end points of the surface), ``(nf, ne)``.
@@ -116,7 +118,7 @@ class MeshMaster:
         if smoothed and self.V.mesh.geometry.dim == 2:
             self._ring, self._ring_flags = segment_neighbours(self.V.mesh.comm, self.global_nodes)
         elif smoothed:
-            fans = node_fans(self.V.mesh.comm, self.global_nodes, self.nn)
+            fans = node_fans(self.V.mesh.comm, self.global_nodes, self.nn, self.node_keys)
             self._ring = fans.reshape(len(fans), fans.shape[1] * fans.shape[2])
             self._ring_flags = np.zeros((len(fans), 0), dtype=bool)
         if smoothed:
@@ -181,7 +183,14 @@ class MeshMaster:
         # input (file) indices of its vertices, to break ties between equidistant facets
         node_keys = self.V.mesh.geometry.input_global_indices[geometry_nodes]
         self.keys = np.sort(node_keys, axis=1)
-        self.boundary_edges = _boundary_edges(self.V.mesh.comm, node_keys, nodes, flip, swap)
+        # the input indices of the nodes, oriented like ``nodes``
+        oriented = node_keys.copy()
+        oriented[flip, swap[0]], oriented[flip, swap[1]] = (
+            node_keys[flip, swap[1]],
+            node_keys[flip, swap[0]],
+        )
+        self.node_keys = oriented
+        self.boundary_edges = _boundary_edges(self.V.mesh.comm, oriented, nodes)
 
     def _build_membrane(self, orientation: dolfinx.fem.Function) -> None:
         """The master facets of a membrane (string): its tagged cells, ordered so that the
@@ -209,14 +218,11 @@ class MeshMaster:
         return self.X_nodes + self.u.x.array.reshape(-1, bs)[self.nodes]
 
 
-def _boundary_edges(comm: MPI.Comm, node_keys: np.ndarray, nodes: np.ndarray, flip, swap):
+def _boundary_edges(comm: MPI.Comm, keys: np.ndarray, nodes: np.ndarray):
     """Which facet edges (end points in 2D) belong to one master facet only, over all ranks.
 
-    ``node_keys`` are the input indices of the facet nodes before the orientation swap
-    ``swap`` applied to the facets ``flip``; they are swapped the same way here.
+    ``keys`` are the input indices of the (oriented) facet nodes ``nodes``.
     """
-    keys = node_keys.copy()
-    keys[flip, swap[0]], keys[flip, swap[1]] = node_keys[flip, swap[1]], node_keys[flip, swap[0]]
     nn = nodes.shape[1]
     edges = FACET_EDGES[nn]
     width = len(edges[0])
@@ -265,7 +271,9 @@ def segment_neighbours(
     return np.stack([before, after], axis=1), np.stack([has_before, has_after], axis=1)
 
 
-def node_fans(comm: MPI.Comm, global_nodes: np.ndarray, nn: int) -> npt.NDArray[np.int64]:
+def node_fans(
+    comm: MPI.Comm, global_nodes: np.ndarray, nn: int, node_keys: np.ndarray | None = None
+) -> npt.NDArray[np.int64]:
     """The fan of every node of the oriented 3D master facets, over all ranks.
 
     The fan of a node ``a`` lists its edge neighbours in cyclic order about the outward
@@ -273,19 +281,40 @@ def node_fans(comm: MPI.Comm, global_nodes: np.ndarray, nn: int) -> npt.NDArray[
     ``a`` in turn, ``next``/``prev`` being the nodes after and before ``a`` in a facet's
     :data:`CYCLIC_ORDER` (the facet after ``f_k`` has ``next = prev(f_k)``). An open fan (a
     node on the boundary of the surface) starts at the facet with no facet before it; a
-    closed fan ends with ``s_v = s_0``. The unused slots up to ``K`` hold ``a`` itself, ``K``
-    being the most facets around a node of the surface.
+    closed fan starts at the neighbour of smallest key and ends with ``s_v = s_0``. The
+    unused slots up to ``K`` hold ``a`` itself, ``K`` being the most facets around a node of
+    the surface.
+
+    Parameters
+    ----------
+    comm
+        Communicator of the master surface.
+    global_nodes
+        Global index of the nodes of this rank's oriented facets, ``(nf, nn)``.
+    nn
+        Nodes of a facet (3 or 4).
+    node_keys
+        Keys of those nodes that do not depend on the partition (input indices), so that
+        the fans, and the order of the sums over them, are the same on any number of ranks;
+        default: the global indices.
 
     Returns
     -------
     ndarray, shape (nf, nn, K + 1)
         Global node index of the slots of the fan of each node of this rank's facets.
     """
-    everything = np.concatenate(comm.allgather(global_nodes.astype(np.int64).reshape(-1)))
-    ordered = everything.reshape(-1, nn)[:, list(CYCLIC_ORDER[nn])]
+    cyclic = list(CYCLIC_ORDER[nn])
+
+    def corners_of_all_ranks(a: np.ndarray) -> np.ndarray:
+        everything = np.concatenate(comm.allgather(a.astype(np.int64).reshape(-1)))
+        return everything.reshape(-1, nn)[:, cyclic]
+
+    ordered = corners_of_all_ranks(global_nodes)
+    keys = corners_of_all_ranks(global_nodes if node_keys is None else node_keys)
     # the corners of all facets: node, the node after it and the node before it
     node = ordered.ravel()
     after = np.roll(ordered, -1, axis=1).ravel()
+    after_key = np.roll(keys, -1, axis=1).ravel()
     before = np.roll(ordered, 1, axis=1).ravel()
     fan_nodes, counts = np.unique(node, return_counts=True)
     K = int(counts.max(initial=0))
@@ -305,9 +334,10 @@ def node_fans(comm: MPI.Comm, global_nodes: np.ndarray, nn: int) -> npt.NDArray[
         "more than two facets, or twice in the same direction): no smoothed normal",
     )
     find_before, _ = _lookup(node * span + before)
-    # each fan starts at a corner with no corner before it (open fan), else at any corner
+    # each fan starts at a corner with no corner before it (open fan), else at the corner
+    # whose next neighbour has the smallest key
     _, has_before = find_before(node * span + after)
-    by_node = np.lexsort((has_before, node))
+    by_node = np.lexsort((after_key, has_before, node))
     start = by_node[np.searchsorted(node[by_node], fan_nodes)]
     wanted = np.unique(global_nodes.astype(np.int64))
     index = np.searchsorted(fan_nodes, wanted)
@@ -370,7 +400,8 @@ class MasterCandidates:
     ----------
     nodes
         Current positions of the gathered nodes of each facet, ``(nf, nx, gdim)``: the facet's
-        own ``nn`` nodes first, then (smoothed normal) the nodes before and after it.
+        own ``nn`` nodes first, then (smoothed normal) in 2D the nodes before and after it,
+        in 3D the fans of its nodes (:func:`node_fans`).
     columns
         Stacked index of the first displacement unknown of each gathered node, ``(nf, nx)``.
     keys
@@ -378,7 +409,7 @@ class MasterCandidates:
     boundary
         Which facet edges lie on the boundary of the master surface, ``(nf, ne)``.
     flags
-        (smoothed normal) whether the neighbour before / after exists, ``(nf, 2)``, else
+        (smoothed normal, 2D) whether the neighbour before / after exists, ``(nf, 2)``, else
         ``(nf, 0)``.
     """
 
