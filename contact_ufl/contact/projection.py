@@ -76,7 +76,7 @@ _EDGES = {
 _K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
 _MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
-_BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
+_BLOCK = 1 << 12  # points processed at once (keeps the arrays of the candidate pairs in cache)
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
@@ -770,7 +770,14 @@ def closest_points(
     the normal at the centre) exceeds ``r`` are dropped, the others projected exactly. Points
     with ``d0 > radius + R_max`` get ``facet = -1`` at once. The KD-tree is reused from one
     call to the next while the master nodes (same array shape) have moved less than ``0.25
-    R_max``, the bounds being widened by that movement.
+    R_max``, the bounds being widened by that movement. On a master of over ``2^14`` facets
+    the points are searched in the order of the cells of a ``64^gdim`` grid over them (the
+    results are returned in the order given): neighbouring points query the same branches of
+    the tree and gather the same facets' data while they are in cache.
+
+    The work of a point grows with its distance ``D`` from the master surface, not with the
+    search radius: its candidates are the facets with a centroid within ``min(D, radius) +
+    R_max`` (about ``D R_max / h^2`` of them on a surface of facet size ``h``).
 
     When several facets are at the same distance up to ``1e-10 (distance + facet size)``
     (the point projects onto a shared edge or vertex), the facet whose normal is the most
