@@ -455,10 +455,11 @@ def _quad_newton(
 ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
     """Minimise ``|x - y(s, t)|^2`` over ``[0, 1]^2`` on bilinear patches by projected Newton.
 
-    ``y = c0 + s c1 + t c2 + s t c3`` with ``coef[j][k]`` coordinate ``k`` of ``c_j``. The Hessian
-    is replaced by the Gauss-Newton matrix where it is not positive definite; a coordinate on
-    a bound that the gradient pushes outwards is held there; the iterate is clamped to the box
-    after each step, and a step that increases the distance is halved (at most three times).
+    ``y = c0 + s c1 + t c2 + s t c3`` with ``coef[j][k]`` the column of coordinate ``k`` of
+    ``c_j``. The Hessian is replaced by the Gauss-Newton matrix where it is not positive
+    definite; a coordinate on a bound that the gradient pushes outwards is held there; the
+    iterate is clamped to the box after each step, and a step that increases the distance is
+    halved (at most three times).
 
     Returns the final ``xi`` (P, 2), its distance, whether the step fell below the tolerance,
     and whether the Hessian is positive definite there.
@@ -721,7 +722,7 @@ def _spatial_order(points: FloatArray) -> IntArray:
     box (lexicographic in the cell coordinates)."""
     lo = points.min(axis=0)
     span = float((points.max(axis=0) - lo).max())
-    if not span > 0.0:
+    if not (np.isfinite(span) and span > 0.0):
         return np.arange(points.shape[0])
     cell = np.minimum((points - lo) * (_CELLS / span), _CELLS - 1).astype(np.int64)
     key = cell[:, 0]
