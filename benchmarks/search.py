@@ -17,16 +17,51 @@ to infinity. Each timing is the best of several calls (one call if it takes over
 
     python benchmarks/search.py --json benchmarks/results/search.json [--quick]
 
-Records: ``kind``, ``gdim``, ``facets``, ``points``, ``radius_over_h`` (``null``: infinite),
-``paired_fraction``, ``seconds`` (best repeated call: the KD-tree of the unchanged master is
-reused), ``first_call_s`` (the KD-tree built), ``points_per_s``.
+Records (``sweep``):
 
-Results on this machine: ``benchmarks/results/search_baseline.json`` (before the search was
-rewritten) and ``benchmarks/results/search.json`` (after; same results). Points per second
-at radius h / infinite radius, before -> after: 1e4 segments 1.0e6 -> 1.6e6 / 4.3e5 -> 5.5e5;
-1e5 segments 4.8e5 -> 9.7e5 / 2.5e5 -> 3.7e5; 1e4 triangles 2.4e5 -> 4.7e5 / 3.5e4 -> 7.5e4;
-1e5 triangles 8.9e4 -> 2.7e5 / 9.3e3 -> 2.8e4; 1e4 quadrilaterals 1.9e5 -> 4.6e5 / 3.7e4 ->
-8.0e4; 1e5 quadrilaterals 9.3e4 -> 2.7e5 / 1.3e4 -> 4.2e4 (the README has the table).
+* ``"radius"``: the slave points above, radii h to infinity: ``kind``, ``gdim``, ``facets``,
+  ``points``, ``radius_over_h`` (``null``: infinite), ``paired_fraction``, ``seconds`` and
+  ``cpu_seconds`` (best repeated call, wall and CPU of this process: the KD-tree of the
+  unchanged master is reused), ``first_call_s`` (wall, the KD-tree built),
+  ``points_per_s`` and ``cpu_points_per_s``;
+* ``"distance"`` (the largest master of each kind): all points at ``offset_over_h`` (0.1 to
+  50) from the surface, radii 2 and 10 times that offset and infinity (all points paired):
+  the cost against the points' distance and the radius;
+* ``"stages"``: CPU seconds of what any search built on the KD-tree of centroids and these
+  kernels pays per call: the per-facet data (``master_s``), one nearest-centroid query per
+  point (``query_k1_s``; ``query_kK_s`` with the search's K), one exact projection per point
+  (``one_projection_s``), and ``floor_points_per_s`` = points / (master + k=1 query + one
+  projection).
+
+Results on this machine (shared by several engineers: the wall times ran at 2 to 3 times the
+CPU times, so the CPU figures are the per-core throughput): ``search_baseline.json`` (before
+the first rewrite), ``search.json`` (now; same closest points, ``tests/test_search_exact.py``).
+The first rewrite (one K-nearest query, ball queries only where more centroids are in reach,
+kernels on coordinate columns; wall points/s at radius h / infinity, baseline -> rewrite): 1e4
+segments 1.0e6 -> 1.6e6 / 4.3e5 -> 5.5e5; 1e5 segments 4.8e5 -> 9.7e5 / 2.5e5 -> 3.7e5; 1e4
+triangles 2.4e5 -> 4.7e5 / 3.5e4 -> 7.5e4; 1e5 triangles 8.9e4 -> 2.7e5 / 9.3e3 -> 2.8e4; 1e4
+quadrilaterals 1.9e5 -> 4.6e5 / 3.7e4 -> 8.0e4; 1e5 quadrilaterals 9.3e4 -> 2.7e5 / 1.3e4 ->
+4.2e4 (the README has the table).
+This round, CPU points/s at radius h / infinity, the code before it (run just before with this
+script) -> now: 1e3 segments 1.5e6 -> 1.7e6 / 5.7e5 -> 6.1e5; 1e5
+segments 7.4e5 -> 8.8e5 / 3.1e5 -> 3.9e5; 1e3 triangles 4.3e5 -> 4.9e5 / 1.1e5 -> 1.4e5; 1e4
+triangles 4.0e5 -> 4.1e5 / 7.2e4 -> 7.2e4; 1e5 triangles 2.6e5 -> 3.0e5 / 2.7e4 -> 3.6e4; 1e4
+quadrilaterals 4.2e5 -> 3.7e5 / 7.4e4 -> 7.8e4; 1e5 quadrilaterals 2.4e5 -> 2.7e5 / 4.0e4 ->
+4.8e4 (per-facet data from contiguous columns: half the time; points ordered by grid cells
+on a master of over 2^14 facets; blocks of 4096 points).
+
+The distance sweep shows where the time goes: at a given distance the cost is flat in the
+radius (within the timing noise, e.g. 1e5 triangles at 1 h: 1.2e5 points/s at radii 2 h, 10
+h and infinity), but it falls with the distance (1e5 triangles: 2.5e5 at 0.1 h, 1.2e5 at 1 h,
+2.8e4 at 10 h, 7.7e3 at 50 h; segments 7.2e5 to 2.3e5): a point at distance D has all the
+facets with a centroid within D + R_max as candidates (about D R_max / h^2 on a surface). The
+stages bound any such search from above: on 1e5 triangles one unbounded nearest-centroid
+query per point of the radius sweep's points costs 6 microseconds (the KD-tree visits many
+cells for points off the surface), so the floor is 1.5e5 points/s at infinite radius
+(6.3e5 on 1e4 triangles, 1.7e6 on 1e3); one exact projection per point is 0.2 (triangles) to
+1.5 (quadrilaterals) microseconds. 1e6 points/s per core in 3D is therefore out of reach of a
+KD-tree of centroids driven from NumPy; it needs a compiled traversal (a bounding-volume tree
+with the slab bounds, walked per point).
 """
 
 import os

@@ -76,7 +76,7 @@ _EDGES = {
 _K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
 _MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
-_BLOCK = 1 << 15  # points processed at once (bounds the memory of the candidate pairs)
+_BLOCK = 1 << 12  # points processed at once (keeps the arrays of the candidate pairs in cache)
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
@@ -455,10 +455,11 @@ def _quad_newton(
 ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
     """Minimise ``|x - y(s, t)|^2`` over ``[0, 1]^2`` on bilinear patches by projected Newton.
 
-    ``y = c0 + s c1 + t c2 + s t c3`` with ``coef[j][k]`` coordinate ``k`` of ``c_j``. The Hessian
-    is replaced by the Gauss-Newton matrix where it is not positive definite; a coordinate on
-    a bound that the gradient pushes outwards is held there; the iterate is clamped to the box
-    after each step, and a step that increases the distance is halved (at most three times).
+    ``y = c0 + s c1 + t c2 + s t c3`` with ``coef[j][k]`` the column of coordinate ``k`` of
+    ``c_j``. The Hessian is replaced by the Gauss-Newton matrix where it is not positive
+    definite; a coordinate on a bound that the gradient pushes outwards is held there; the
+    iterate is clamped to the box after each step, and a step that increases the distance is
+    halved (at most three times).
 
     Returns the final ``xi`` (P, 2), its distance, whether the step fell below the tolerance,
     and whether the Hessian is positive definite there.
@@ -721,7 +722,7 @@ def _spatial_order(points: FloatArray) -> IntArray:
     box (lexicographic in the cell coordinates)."""
     lo = points.min(axis=0)
     span = float((points.max(axis=0) - lo).max())
-    if not span > 0.0:
+    if not (np.isfinite(span) and span > 0.0):
         return np.arange(points.shape[0])
     cell = np.minimum((points - lo) * (_CELLS / span), _CELLS - 1).astype(np.int64)
     key = cell[:, 0]
@@ -770,7 +771,14 @@ def closest_points(
     the normal at the centre) exceeds ``r`` are dropped, the others projected exactly. Points
     with ``d0 > radius + R_max`` get ``facet = -1`` at once. The KD-tree is reused from one
     call to the next while the master nodes (same array shape) have moved less than ``0.25
-    R_max``, the bounds being widened by that movement.
+    R_max``, the bounds being widened by that movement. On a master of over ``2^14`` facets
+    the points are searched in the order of the cells of a ``64^gdim`` grid over them (the
+    results are returned in the order given): neighbouring points query the same branches of
+    the tree and gather the same facets' data while they are in cache.
+
+    The work of a point grows with its distance ``D`` from the master surface, not with the
+    search radius: its candidates are the facets with a centroid within ``min(D, radius) +
+    R_max`` (about ``D R_max / h^2`` of them on a surface of facet size ``h``).
 
     When several facets are at the same distance up to ``1e-10 (distance + facet size)``
     (the point projects onto a shared edge or vertex), the facet whose normal is the most
