@@ -7,12 +7,14 @@ points (:func:`~contact_ufl.verification.runs.hertz_3d_errors`); a and p0 are th
 Hertz profile nearest to it in L2. Numbers over meshes: benchmarks/results/hertz_3d.json.
 """
 
+import dolfinx
 import numpy as np
 import pytest
+import ufl
 from mpi4py import MPI
 
 from contact_ufl.problem import ContactProblem
-from contact_ufl.verification import scenes
+from contact_ufl.verification import geometries, scenes
 from contact_ufl.verification.analytic import Hertz3D, fit_radial_profile
 from contact_ufl.verification.runs import hertz_3d_errors
 
@@ -48,6 +50,34 @@ def test_fit_recovers_a_profile():
     exact = Hertz3D(1e-3, 1.0, 0.5)
     a, p0 = fit_radial_profile(r, exact.pressure(r), 2.0 * np.pi * r)
     assert np.isclose(a, exact.a, rtol=1e-6) and np.isclose(p0, exact.p0, rtol=1e-6)
+
+
+def test_sphere_on_block_measures():
+    """Every group of the quarter model has its exact measure (curved ones to the faceting
+    error, flat ones to round-off); the contact surfaces end at ``contact_zone``."""
+    R, zone = 1.0, 0.3
+    data = geometries.sphere_on_block_3d(h_contact=0.025, contact_zone=zone)
+    cap = 2.0 * np.pi * R * (R - np.sqrt(R * R - zone * zone)) / 4.0
+    exact = {
+        "sphere": (np.pi * R**3 / 6.0, 0.02),
+        "block": (1.0, 1e-10),
+        "sphere_contact": (cap, 0.01),
+        "sphere_top": (np.pi * R * R / 4.0, 0.01),
+        "sphere_x0": (np.pi * R * R / 4.0, 0.01),
+        "sphere_y0": (np.pi * R * R / 4.0, 0.01),
+        "block_contact": (np.pi * zone * zone / 4.0, 0.01),
+        "block_bottom": (1.0, 1e-10),
+        "block_x0": (1.0, 1e-10),
+        "block_y0": (1.0, 1e-10),
+        "block_sides": (2.0, 1e-10),
+    }
+    dx = ufl.Measure("dx", domain=data.mesh, subdomain_data=data.cell_tags)
+    ds = ufl.Measure("ds", domain=data.mesh, subdomain_data=data.facet_tags)
+    for name, (value, rtol) in exact.items():
+        measure = dx if name in ("sphere", "block") else ds
+        form = dolfinx.fem.form(1.0 * measure(data.tags[name]))
+        computed = data.mesh.comm.allreduce(dolfinx.fem.assemble_scalar(form), MPI.SUM)
+        assert abs(computed / value - 1.0) < rtol, (name, computed, value)
 
 
 @pytest.fixture(scope="module")
