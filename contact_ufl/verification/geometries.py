@@ -16,6 +16,7 @@ Generators
   membrane).
 * :func:`beams_3d`: two cantilever beams, clamped on the same side or at opposite ends,
   overlapping in plan.
+* :func:`sphere_on_block_3d`: a half ball on a block, quarter model (3D Hertz).
 
 Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
 11, 12, ... in the order they are listed in each generator's documentation; always look them
@@ -47,6 +48,7 @@ __all__ = [
     "ironing_2d",
     "BeamPair",
     "beams_3d",
+    "sphere_on_block_3d",
     "tag_single_body",
 ]
 
@@ -1220,6 +1222,21 @@ def _on(faces: dict, axis: int, coord: float, tol: float) -> list[int]:
     ]
 
 
+def _block_groups(
+    pieces: tuple[int, int], block: tuple[float, float], tol: float
+) -> list[tuple[str, int, list[int]]]:
+    """Facet groups of the block of :func:`sphere_on_block_3d`, made of the quarter cylinder
+    under the contact disc and the rest."""
+    (w, height), fd, fb = block, _faces(pieces[0], tol), _faces(pieces[1], tol)
+    return [
+        ("block_contact", 2, _on(fd, 2, 0.0, tol)),
+        ("block_bottom", 2, _on(fb, 2, -height, tol)),
+        ("block_x0", 2, _on(fd, 0, 0.0, tol) + _on(fb, 0, 0.0, tol)),
+        ("block_y0", 2, _on(fd, 1, 0.0, tol) + _on(fb, 1, 0.0, tol)),
+        ("block_sides", 2, _on(fb, 0, w, tol) + _on(fb, 1, w, tol)),
+    ]
+
+
 def sphere_on_block_3d(
     radius: float = 1.0,
     block: tuple[float, float] | None = (1.0, 1.0),
@@ -1342,20 +1359,11 @@ def sphere_on_block_3d(
                 _restricted(_threshold(ring, edge[1], h_far, edge[2], d_ring), 3, [cap, rest])
             )
         if pieces is not None:
-            fd, fb = _faces(pieces[0], tol), _faces(pieces[1], tol)
-            w, height = block
-            groups += [
-                ("block_contact", 2, _on(fd, 2, 0.0, tol)),
-                ("block_bottom", 2, _on(fb, 2, -height, tol)),
-                ("block_x0", 2, _on(fd, 0, 0.0, tol) + _on(fb, 0, 0.0, tol)),
-                ("block_y0", 2, _on(fd, 1, 0.0, tol) + _on(fb, 1, 0.0, tol)),
-                ("block_sides", 2, _on(fb, 0, w, tol) + _on(fb, 1, w, tol)),
-            ]
+            groups += _block_groups(pieces, block, tol)
             coarse = _threshold(distance, master_ratio * h_contact, h_far, d_min, d_max)
             fields.append(_restricted(coarse, 3, list(pieces)))
             if edge is not None:
-                h_ring = master_ratio * edge[1]
-                coarse_ring = _threshold(ring, h_ring, h_far, edge[2], d_ring)
+                coarse_ring = _threshold(ring, master_ratio * edge[1], h_far, edge[2], d_ring)
                 fields.append(_restricted(coarse_ring, 3, list(pieces)))
         _add_groups(groups, tdim=3)
         _set_background(fields)

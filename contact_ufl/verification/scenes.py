@@ -149,7 +149,7 @@ def hertz_3d(
     growth: float = 0.3,
     contact_zone: float = 0.3,
     eps_factor: float = 1.0,
-    quadrature_degree: int | None = None,
+    quadrature_degree: int | None = 2,
     quadrature_subdivisions: int = 1,
     h_edge: float | None = None,
     edge_width: float | None = None,
@@ -189,19 +189,26 @@ def hertz_3d(
     h_far, master_ratio, refine_radius, growth, contact_zone
         Grading of the mesh (see :func:`~contact_ufl.verification.geometries.sphere_on_block_3d`).
     h_edge, edge_width
-        Element size of the slave within ``edge_width`` (default ``2.5 h_edge``) of the
+        Element size of the ball within ``edge_width`` (default ``2.5 h_edge``) of the
         expected edge of the contact zone (the block ``master_ratio`` times coarser); ``None``:
         no such refinement.
     eps_factor
         ``eps_N = eps_factor * E / h_contact``.
     quadrature_degree, quadrature_subdivisions
-        Quadrature rule of the contact integrals (see :class:`ContactPair`).
+        Quadrature rule of the contact integrals (see :class:`ContactPair`). Degree 2 (three
+        points per slave facet) gave the errors of the pair's default degree 3 (six points)
+        to 0.1%, with half the points to search.
     """
     if flat not in ("elastic", "rigid"):
         raise ValueError(f"flat must be 'elastic' or 'rigid', not {flat!r}")
     rigid = flat == "rigid"
     E_flat = E if E_flat is None else E_flat
+    radius = 1.0
+    edge = None
+    if h_edge is not None:
+        edge = (1.03 * np.sqrt(radius * depth), h_edge, edge_width or 2.5 * h_edge)
     sm = geometries.sphere_on_block_3d(
+        radius=radius,
         block=None if rigid else block,
         h_contact=h_contact,
         h_far=h_far,
@@ -209,9 +216,7 @@ def hertz_3d(
         refine_radius=refine_radius,
         growth=growth,
         contact_zone=contact_zone,
-        edge=None
-        if h_edge is None
-        else (1.03 * np.sqrt(depth), h_edge, edge_width or 2.5 * h_edge),
+        edge=edge,
         comm=comm,
     )
     bodies = [Body("sphere", LinearElastic(E, nu), "sphere")]
@@ -240,7 +245,7 @@ def hertz_3d(
         quadrature_subdivisions=quadrature_subdivisions,
     )
     scene = Scene.from_mesh_data(sm, bodies=bodies, contacts=[pair], dirichlet=supports)
-    return Hertz3DScene(scene, 1.0, E_star, h_contact)
+    return Hertz3DScene(scene, radius, E_star, h_contact)
 
 
 def patch(
