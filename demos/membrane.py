@@ -183,11 +183,11 @@ def plate_motion(t: float) -> tuple[float, float, float]:
 # The penalty-like parameter `eps_N` of the augmented Lagrangian is set, for both pairs, to
 # the transverse stiffness of the tensioned membrane at the scale of its cells: the hoop
 # tension $T = p R$ over $h^2$ (a membrane resists a normal load through $T \Delta w$).
-# The default, the softer body's modulus over the size of the slave surface, takes for a
-# membrane $E t_0 / L$ (here about $10^{-2}$) and gives $\varepsilon_N \approx 3 \cdot
-# 10^{-3}$, a hundred times less: with it, Newton 2-cycles as the block first touches the
-# tube (the residual alternates between two values at $10^{-7}$ of its start, at every
-# cut-back), the first points in contact toggling in and out.
+# The default, the softer body's modulus over the size $L$ of the slave surface (for a
+# membrane the modulus is $E t_0 / L$), is $\varepsilon_N = 2 \cdot 10^{-3}$ here, fifty
+# times less than $T / h^2 = 0.1$: with it, Newton 2-cycles as the block first touches the
+# tube (the residual alternates between two values at $10^{-7}$ of its start, down to the
+# last cut-back), the first points in contact toggling in and out.
 
 # %%
 # the tube: a surface mesh in 3D, read with its group names (`MeshData`)
