@@ -461,8 +461,9 @@ def membrane_contact_pressure(problem) -> dict[int, dolfinx.fem.Function]:
         for c in problem.contacts:
             if problem.bulk_of(c) is not bulk:
                 continue
-            t_N = c.normal_traction_at_points().reshape(len(c.slave.parent_cells), -1)
-            dofs = f.function_space.dofmap.list[c.slave.parent_cells, 0]
+            cells = c.slave.parent_cells  # (a rank may hold none)
+            t_N = c.normal_traction_at_points().reshape(len(cells), c.slave.num_points)
+            dofs = f.function_space.dofmap.list[cells, 0]
             f.x.array[dofs] += t_N.mean(axis=1)
         f.x.scatter_forward()
         out[k] = f
