@@ -30,7 +30,7 @@ test-mpi: install
 	timeout $(PYTEST_TIMEOUT) $(MPIRUN) -n 2 $(PY) -m pytest -q -p no:cacheprovider -m "not slow and not serial" tests
 
 demo: install
-	cd demos && ../$(PY) hertz.py && ../$(PY) plastic_indentation.py && ../$(MPIRUN) -n 2 ../$(PY) beams.py
+	cd demos && ../$(PY) hertz.py && ../$(PY) plastic_indentation.py && ../$(MPIRUN) -n 2 ../$(PY) beams.py && ../$(PY) membrane.py
 
 # demos/hertz.ipynb: the Hertz demo as a notebook, executed (pictures inline, files in demos/output)
 notebook: install

@@ -436,3 +436,91 @@ def plot_deformed(
         plotter.set_focus(focus)
     plotter.camera.zoom(zoom)
     _save(plotter, path)
+
+
+def _plane_patch(obstacle, t: float, size: float) -> pyvista.PolyData:
+    """A square of side ``size`` on the rigid plane ``obstacle`` at pseudo-time ``t``,
+    centred at its moved point (3D)."""
+    pv = _pyvista()
+    point, Q = obstacle.pose(t, 3)
+    normal = Q @ np.asarray(obstacle.normal, dtype=float)
+    return pv.Plane(center=point, direction=normal, i_size=size, j_size=size)
+
+
+def membrane_contact_pressure(problem) -> dict[int, dolfinx.fem.Function]:
+    """The contact pressure on the membranes as cellwise (DG0) functions: for each membrane
+    mesh (its index in ``problem.bulks``), the mean normal traction ``t_N`` over the slave
+    points of each of its cells, summed over the pairs whose slave surface it holds (0 on
+    cells of no slave surface or open)."""
+    out = {}
+    for k, bulk in enumerate(problem.bulks):
+        if not bulk.membrane:
+            continue
+        mesh = bulk.V.mesh
+        f = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("DG", 0)))
+        for c in problem.contacts:
+            if problem.bulk_of(c) is not bulk:
+                continue
+            cells = c.slave.parent_cells  # (a rank may hold none)
+            t_N = c.normal_traction_at_points().reshape(len(cells), c.slave.num_points)
+            dofs = f.function_space.dofmap.list[cells, 0]
+            f.x.array[dofs] += t_N.mean(axis=1)
+        f.x.scatter_forward()
+        out[k] = f
+    return out
+
+
+def plot_membrane_contact(
+    problem,
+    path: str | Path,
+    view: str | tuple[float, float, float] = "iso",
+    title: str = "",
+    obstacles: list | tuple = (),
+    zoom: float = 1.0,
+) -> None:
+    """The deformed bodies of a 3D scene with its membranes coloured by their contact
+    pressure (collective; rank 0 writes the picture).
+
+    A membrane's cells are its contact surface, and may be the slave of several pairs: each
+    membrane cell is coloured by the mean normal traction ``t_N`` of its slave points, over
+    all pairs (:func:`membrane_contact_pressure`), and grey where open; the solids are drawn
+    translucent, and the rigid planes of ``obstacles`` as squares at their current
+    position.
+    """
+    _direction(view)  # bad input fails on every rank, before the collective gathers
+    if problem.gdim != 3:
+        raise ValueError(f"plot_membrane_contact draws 3D scenes, got gdim = {problem.gdim}")
+    pressures = membrane_contact_pressure(problem)
+    grid = gathered_grid(problem, cell_data={f"t_N {k}": f for k, f in pressures.items()})
+    if grid is None:
+        return
+    pv = _pyvista()
+    values = np.column_stack(
+        [grid.cell_data[f"t_N {k}"] for k in pressures] or [np.full(grid.n_cells, np.nan)]
+    )
+    on_membrane = ~np.all(np.isnan(values), axis=1)
+    grid.cell_data["t_N"] = np.nansum(values, axis=1)
+    plotter = pv.Plotter(off_screen=True, window_size=(1200, 800))
+    size = 1.2 * float(np.ptp(grid.points, axis=0).max())
+    for obstacle in obstacles:
+        plotter.add_mesh(_plane_patch(obstacle, problem.t, size), color="steelblue", opacity=0.4)
+    if not np.all(on_membrane):
+        solids = grid.extract_cells(np.flatnonzero(~on_membrane))
+        plotter.add_mesh(solids, color="lightgrey", show_edges=True, opacity=0.35)
+    if np.any(on_membrane):
+        membranes = grid.extract_cells(np.flatnonzero(on_membrane))
+        top = float(membranes["t_N"].max())
+        membranes["t_N"] = np.where(membranes["t_N"] > 0.0, membranes["t_N"], np.nan)  # open
+        plotter.add_mesh(
+            membranes,
+            scalars="t_N",
+            cmap="plasma",
+            clim=(0.0, top if top > 0.0 else 1.0),
+            nan_color="lightgrey",
+            show_edges=True,
+            edge_color="dimgrey",
+            scalar_bar_args={"title": "t_N = lambda_N (cell mean)"},
+        )
+    _view(plotter, view)
+    plotter.camera.zoom(zoom)
+    _screenshot(plotter, path, title)

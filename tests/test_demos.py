@@ -74,6 +74,21 @@ def test_plastic_indentation_demo_runs(tmp_path, ranks):
     assert (out / "indentation_plastic" / "plastic_strain_2.bp").is_dir()
 
 
+@pytest.mark.serial
+@RANKS
+def test_membrane_demo_runs(tmp_path, ranks):
+    out = tmp_path / "out"
+    args = ["--mu", "0.3", "--out", str(out)]
+    stdout = run_demo("membrane.py", args, tmp_path, ranks=ranks)
+    assert "12 steps, 0 cut-backs" in stdout
+    # the plate slides under the whole underside: the sideways force is mu times the normal
+    assert "sideways / normal plate force +0.300" in stdout
+    for name in ("membrane_mu0.3_above.png", "membrane_mu0.3_below.png"):
+        assert (out / name).stat().st_size > 10_000
+    for name in ("displacement_0.bp", "displacement_1.bp", "contact_0.bp", "contact_1.bp"):
+        assert (out / "membrane_mu0.3" / name).is_dir()
+
+
 @pytest.mark.parametrize("demo", sorted(DEMOS.glob("*.py")), ids=lambda p: p.name)
 def test_demo_is_a_notebook(demo):
     notebook = jupytext.read(demo)

@@ -57,3 +57,21 @@ def test_hertz_notebook_shows_pictures(tmp_path, kernel):
     images = [o for o in outputs if "image/png" in o.get("data", {})]
     assert images, "no cell output holds an image/png"
     assert list(work.rglob("*.png")), "the notebook did not write its pictures as files"
+
+
+@pytest.mark.slow
+@pytest.mark.serial
+def test_membrane_notebook_shows_pictures(tmp_path, kernel):
+    """The membrane demo (two meshes, a rigid plate, both friction coefficients) as a
+    notebook: its four pictures inline and as files."""
+    work = tmp_path / "run"
+    work.mkdir()
+    notebook = jupytext.read(DEMOS / "membrane.py")
+    client = nbclient.NotebookClient(
+        notebook, kernel_name=kernel, timeout=600, resources={"metadata": {"path": str(work)}}
+    )
+    client.execute()
+    outputs = [o for cell in notebook.cells if cell.cell_type == "code" for o in cell.outputs]
+    images = [o for o in outputs if "image/png" in o.get("data", {})]
+    assert len(images) == 4
+    assert len(list(work.rglob("membrane_mu*.png"))) == 4
