@@ -138,14 +138,19 @@ class Domain:
         rank: int = 0,
         ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
         name: str = "",
+        outward: Sequence[float] | None = None,
+        direction: Sequence[float] | None = None,
     ) -> Domain:
         """The domain on the mesh of a ``.msh`` file or a live gmsh model, in one call.
 
-        Parameters are those of :meth:`Scene.from_gmsh` (and ``name``, as in
-        :class:`Domain`).
+        Parameters are those of :meth:`Scene.from_gmsh` (and ``name``, ``outward``,
+        ``direction``, as in :class:`Domain`). For membranes (strings) give ``gdim``, 3 (2):
+        the mesh is then a surface (curve) in it.
         """
         data = _read(source, [*bodies, *dirichlet, *loads], [], comm, gdim, rank, ghost_mode)
-        return cls.from_mesh_data(data, bodies, dirichlet, loads, name)
+        domain = cls.from_mesh_data(data, bodies, dirichlet, loads, name)
+        domain.outward, domain.direction = outward, direction
+        return domain
 
     @classmethod
     def from_mesh_data(
@@ -623,6 +628,10 @@ def _read(source, parts, contacts, comm, gdim, rank, ghost_mode) -> MeshData:
 
     keys = [p.tag for p in parts] + [k for c in contacts for k in (c.slave, c.master)]
     # (rigid obstacles among the keys are not strings: they need no physical group)
+    bodies = [p for p in parts if isinstance(p, Body)]
+    membranes = bool(bodies) and all(b.membrane for b in bodies)
+    # a membrane (string) mesh is a surface (curve) in gdim: one dimension less
+    tdim = gdim - 1 if membranes and gdim is not None else None if membranes else gdim
     return read_gmsh(
         source,
         comm,
@@ -630,7 +639,7 @@ def _read(source, parts, contacts, comm, gdim, rank, ghost_mode) -> MeshData:
         rank=rank,
         ghost_mode=ghost_mode,
         require_names=any(isinstance(k, str) for k in keys),
-        tdim=gdim,
+        tdim=tdim,
     )
 
 

@@ -38,7 +38,6 @@ from mpi4py import MPI
 import contact_ufl as cu
 from contact_ufl import output
 from contact_ufl.gmshio import gmsh_session
-from contact_ufl.membranes import MembraneNeoHookean
 from contact_ufl.results import coulomb_law
 
 parser = argparse.ArgumentParser(description="An inflated membrane tube squeezed and slid")
@@ -192,7 +191,7 @@ def plate_motion(t: float) -> tuple[float, float, float]:
 # %%
 # the tube: a surface mesh in 3D, read with its group names (`MeshData`)
 tube_data = cu.read_gmsh(tube_msh, comm, gdim=3, require_names=True)
-membrane = MembraneNeoHookean(MU_SHEAR, T0)
+membrane = cu.MembraneNeoHookean(MU_SHEAR, T0)
 rubber = cu.NeoHookean(E=0.05, nu=0.3)
 
 

@@ -118,3 +118,37 @@ def test_pressure_on_solid_cells_is_refused():
     scene = scenes.patch()
     with pytest.raises(cu.ContactInputError, match="facet group"):
         dataclasses.replace(scene, loads=[cu.FollowerPressure("upper", 1.0)])
+
+
+def test_membrane_domain_from_a_gmsh_file(tmp_path):
+    """A membrane meshed with gmsh (a square surface in 3D, named groups) read in one call:
+    its cells are the body, its boundary edges a support group."""
+    import gmsh
+
+    from contact_ufl.gmshio import gmsh_session
+
+    path = tmp_path / "membrane.msh"
+    if COMM.rank == 0:
+        with gmsh_session("membrane"):
+            square = gmsh.model.occ.addRectangle(0.0, 0.0, 0.0, 1.0, 1.0)
+            gmsh.model.occ.synchronize()
+            edges = [tag for _, tag in gmsh.model.getBoundary([(2, square)], oriented=False)]
+            gmsh.model.addPhysicalGroup(2, [square], 1, name="membrane")
+            gmsh.model.addPhysicalGroup(1, edges, 2, name="frame")
+            gmsh.option.setNumber("Mesh.MeshSizeMax", 0.25)
+            gmsh.model.mesh.generate(2)
+            gmsh.write(str(path))
+    COMM.barrier()
+    path = COMM.bcast(str(path))
+    domain = cu.Domain.from_gmsh(
+        path,
+        bodies=[cu.Body("membrane", MembraneNeoHookean(1.0, 0.01))],
+        dirichlet=[cu.Dirichlet("frame", 0.0)],
+        gdim=3,
+        comm=COMM,
+        direction=(0.0, 0.0, 1.0),
+    )
+    assert domain.membrane and domain.mesh.geometry.dim == 3
+    bulk = cu.ContactProblem(cu.Scene(domains=[domain]), verbose=False).bulks[0]
+    held = COMM.allreduce(len(bulk.dirichlet_dofs))
+    assert bulk.membrane and held > 0
