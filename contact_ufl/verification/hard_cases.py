@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from mpi4py import MPI
 
 from contact_ufl.errors import ConvergenceError
+from contact_ufl.materials import NeoHookean
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import inverted_cells
 from contact_ufl.verification import scenes
@@ -103,6 +104,41 @@ def deep_indentation(
     )
 
 
+def deep_indentation_3d(
+    h_contact: float = 0.1, steps: int = 10, max_cutbacks: int = 4, master_normal: str = "facet"
+) -> Case:
+    """The 3D ball (quarter model, Neo-Hookean) pressed into the block by half its radius
+    (the geometry of :func:`~contact_ufl.verification.scenes.hertz_3d` with the contact
+    surfaces widened to 0.95 R): with the facet normal it stops near depth 0.24 R, where
+    Newton cycles between contact states (the facet normals jump at every master edge); the
+    smoothed normal (continuous over the edges) runs to the end."""
+
+    def scene():
+        hertz = scenes.hertz_3d(
+            h_contact=h_contact,
+            depth=0.5,
+            contact_zone=0.95,
+            h_far=0.3,
+            refine_radius=0.8,
+            growth=0.5,
+        )
+        scene = hertz.scene
+        scene.bodies = [
+            dataclasses.replace(b, material=NeoHookean(b.material.E, b.material.nu))
+            for b in scene.bodies
+        ]
+        pair = scene.contacts[0]
+        scene.contacts[0] = dataclasses.replace(pair, master_normal=master_normal)
+        return scene
+
+    return Case(
+        f"deep_indentation_3d_h{h_contact:g}_{master_normal}",
+        _problem(scene),
+        [(steps, 1.0)],
+        max_cutbacks,
+    )
+
+
 def cases(quick: bool = False) -> list[Case]:
     """The hard cases that exist today (``quick``: the ironing on coarse meshes, with
     larger sliding steps, and the deep indentation on the coarser mesh only)."""
@@ -135,6 +171,7 @@ def cases(quick: bool = False) -> list[Case]:
         out.append(deep_indentation(0.02, 10, master_normal=normal))
         if not quick:
             out.append(deep_indentation(0.01, 20, master_normal=normal))
+            out.append(deep_indentation_3d(0.1, 10, master_normal=normal))
     return out
 
 
