@@ -120,6 +120,9 @@ class ContactProblem:
         the unknowns, then of the multipliers held at zero because the slave's displacement
         is prescribed there (:meth:`ContactInterface.held_multipliers
         <contact_ufl.contact.interface.ContactInterface.held_multipliers>`).
+    held_multipliers
+        How many of this rank's multiplier dofs are held at zero (the last rows of
+        :attr:`dirichlet_rows`).
     dirichlet_scale
         The stiffness ``k = E L^(d-2)`` of the prescribed-displacement equations
         ``k (u - g) = 0`` (every row of the residual is then a force).
@@ -286,7 +289,8 @@ class ContactProblem:
             if c.friction:
                 rows.append(offsets[block[id(c.friction.lambda_T)]] + held_T)
         self.dirichlet_rows = np.concatenate(rows).astype(np.int64)
-        self._held = len(self.dirichlet_rows) - sum(len(b.dirichlet_dofs) for b in self.bulks)
+        displacements = sum(len(b.dirichlet_dofs) for b in self.bulks)
+        self.held_multipliers = len(self.dirichlet_rows) - displacements
 
     def block_rows(self, k: int) -> slice:
         """Local (owned) range of the displacement of mesh ``k`` in a vector of the
@@ -297,7 +301,8 @@ class ContactProblem:
     def prescribed(self, t: float) -> np.ndarray:
         """The prescribed values ``g(t)`` of the rows :attr:`dirichlet_rows`: the
         displacements, then the held multipliers (zero)."""
-        return np.concatenate([*(b.prescribed(t) for b in self.bulks), np.zeros(self._held)])
+        held = np.zeros(self.held_multipliers)
+        return np.concatenate([*(b.prescribed(t) for b in self.bulks), held])
 
     def scales(self) -> tuple[float, float]:
         """The scene's diameter L and largest modulus E of its bodies (collective; a

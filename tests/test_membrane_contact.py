@@ -178,7 +178,8 @@ def test_string_held_at_its_ends_on_a_plane(mu):
     problem.solve(num_steps=1, max_cutbacks=0)
     assert not problem.history.cutbacks and problem.history.steps[0].newton_iterations <= 3
     (c,) = problem.contacts
-    assert COMM.allreduce(problem._held) == (2 if mu == 0.0 else 6)  # lambda_T: 2 components
+    held = COMM.allreduce(problem.held_multipliers)
+    assert held == (2 if mu == 0.0 else 6)  # the two ends; lambda_T: two components each
     load = np.linalg.norm(problem.load_resultant())
     assert problem.obstacle_reaction(plane)[1] > 0.85 * load  # the plane carries the load
     assert equilibrium_error(problem, ["x0", "xmax"], [plane]) < 1e-8  # the ends the rest
