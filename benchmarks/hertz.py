@@ -1,10 +1,17 @@
 """Speed against error: the Hertz problem on a sequence of meshes.
 
-Prints a table and writes one JSON record per mesh: dofs, h, p0_error, a_error,
-newton_iterations, wall_s (solve time), search_s (time in the closest-point projection).
+Prints a table and writes one JSON record per mesh: dofs, degree, h, p0_error, a_error,
+pressure_l2_error (2D: of the fitted elliptic profile against the samples, weighted by the
+slave points' reference lengths), newton_iterations, newton_per_step, wall_s (solve time),
+assembly_s (residual and Jacobian assembly), search_s (the closest-point projection),
+solver_s (factorisation and solves), ranks, material.
 
-    python benchmarks/hertz.py --json benchmarks/results/hertz.json [--quick]
+    python benchmarks/hertz.py --json benchmarks/results/hertz.json [--quick] [--material linear]
     mpirun -n 2 python benchmarks/hertz.py --json ...
+    python benchmarks/hertz.py --plot benchmarks/results/hertz.png RESULTS.json [...]
+
+``--plot``: p0 error against wall time of the given result files (one line each), the
+speed-against-error picture of the README.
 
 ``--dim 3``: the 3D sphere on a block, quarter model, linear elastic
 (:func:`contact_ufl.verification.scenes.hertz_3d`, errors of
@@ -16,11 +23,16 @@ measures of a and p0 and the errors of the elastic sphere on a rigid flat (``--f
 """
 
 import argparse
+import dataclasses
 import json
+import os
+import sys
 import time
 
+import numpy as np
 from mpi4py import MPI
 
+from contact_ufl.materials import LinearElastic
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import contact_samples
 from contact_ufl.verification import scenes
@@ -34,26 +46,79 @@ FULL_3D = [(0.025, None), (0.0125, None), (0.0125, 0.004), (0.0125, 0.003)]
 QUICK_3D = FULL_3D[:3]
 
 
-def run(h: float, depth: float, steps: int) -> dict:
+def run(h: float, depth: float, steps: int, material: str = "neo-hookean") -> dict:
     hertz = scenes.hertz_2d(h_contact=h, depth=depth)
-    problem = ContactProblem(hertz.scene, verbose=False)
+    scene = hertz.scene
+    if material == "linear":
+        scene.bodies = [
+            dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
+            for b in scene.bodies
+        ]
+    problem = ContactProblem(scene, verbose=False)
     start = time.perf_counter()
     problem.solve(num_steps=steps)
     wall = time.perf_counter() - start
     samples = contact_samples(problem)
     exact = Hertz2D(problem.contact_force()[1], hertz.radius, hertz.E_star)
     a, p0, _ = fit_elliptic_profile(samples.x[:, 0], samples.pressure)
+    timings = problem.solver.timings
+    newton = sum(r.newton_iterations for r in problem.history.steps)
     return {
         "dofs": problem.layout.global_size,
+        "degree": 1,
+        "material": material,
         "h": h,
         "a_over_h": exact.a / h,
         "p0_error": p0 / exact.p0 - 1.0,
         "a_error": a / exact.a - 1.0,
-        "newton_iterations": sum(r.newton_iterations for r in problem.history.steps),
+        "pressure_l2_error": _pressure_l2_error(problem, samples, exact),
+        "newton_iterations": newton,
+        "newton_per_step": newton / len(problem.history.steps),
         "wall_s": wall,
+        "assembly_s": timings.residual_assembly + timings.jacobian_assembly + timings.ptap,
         "search_s": problem.search_time,
+        "solver_s": timings.linear_solve,
         "ranks": problem.comm.size,
     }
+
+
+def _pressure_l2_error(problem, samples, exact: Hertz2D) -> float:
+    """``||p_h - p||_L2 / ||p||_L2`` over the slave points (Cauchy pressure at the current
+    positions against Hertz's profile), weighted by the slave facets' reference lengths."""
+    slave = problem.contacts[0].slave
+    nodes = slave.submesh.geometry.dofmaps[0][: slave.num_cells, :2]
+    x = slave.submesh.geometry.x[nodes, :2]
+    length = np.linalg.norm(x[:, 1] - x[:, 0], axis=1)
+    weights = (length[:, None] * slave.weights_ref[None, :]).ravel()
+    weights = np.concatenate(problem.comm.allgather(weights))
+    r = samples.x[:, 0]
+    p = exact.p0 * np.sqrt(np.clip(1.0 - (r / exact.a) ** 2, 0.0, None))
+    error = np.sum(weights * (samples.pressure - p) ** 2)
+    return float(np.sqrt(error / np.sum(weights * p**2)))
+
+
+def plot(path: str, files: list[str]) -> None:
+    """p0 error against wall time of the records of ``files``, one line each."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for name in files:
+        with open(name) as f:
+            records = json.load(f)
+        wall = [r["wall_s"] for r in records]
+        error = [abs(r["p0_error"]) for r in records]
+        dim = "3D" if "h_contact" in records[0] else "2D"
+        label = f"{dim} P{records[0].get('degree', 1)} ({os.path.basename(name)})"
+        ax.loglog(wall, error, "o-", label=label)
+    ax.set_xlabel("wall time of the solve (s)")
+    ax.set_ylabel("|p0 error| against Hertz")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
 
 
 def run_3d(h: float, h_edge: float | None, depth: float, steps: int, flat: str) -> dict:
@@ -84,8 +149,13 @@ def main_3d(args) -> None:
 
 
 def main() -> None:
+    if "--plot" in sys.argv:
+        k = sys.argv.index("--plot")
+        plot(sys.argv[k + 1], sys.argv[k + 2 :])
+        return
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--json", required=True, help="output file")
+    parser.add_argument("--material", choices=("neo-hookean", "linear"), default="neo-hookean")
     parser.add_argument("--quick", action="store_true", help="three coarse meshes (< 1 min)")
     parser.add_argument("--dim", type=int, choices=(2, 3), default=2)
     parser.add_argument("--depth", type=float, default=None, help="2D: 0.005, 3D: 0.01")
@@ -102,19 +172,20 @@ def main() -> None:
     comm = MPI.COMM_WORLD
     records = []
     header = (
-        f"{'h':>8} {'dofs':>8} {'a/h':>6} {'a err':>9} {'p0 err':>9} {'newton':>6} "
-        f"{'wall s':>8} {'search s':>8}"
+        f"{'h':>8} {'dofs':>8} {'a/h':>6} {'a err':>9} {'p0 err':>9} {'L2 err':>7} "
+        f"{'newton':>6} {'wall s':>8} {'search s':>8} {'solver s':>8}"
     )
     if comm.rank == 0:
         print(header)
     for h in QUICK if args.quick else FULL:
-        r = run(h, args.depth, args.steps)
+        r = run(h, args.depth, args.steps, args.material)
         records.append(r)
         if comm.rank == 0:
             print(
                 f"{r['h']:8.5f} {r['dofs']:8d} {r['a_over_h']:6.1f} {r['a_error']:+9.4f} "
-                f"{r['p0_error']:+9.4f} {r['newton_iterations']:6d} {r['wall_s']:8.2f} "
-                f"{r['search_s']:8.3f}",
+                f"{r['p0_error']:+9.4f} {r['pressure_l2_error']:7.4f} "
+                f"{r['newton_iterations']:6d} {r['wall_s']:8.2f} {r['search_s']:8.3f} "
+                f"{r['solver_s']:8.3f}",
                 flush=True,
             )
     if comm.rank == 0:
