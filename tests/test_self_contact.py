@@ -1,11 +1,19 @@
-"""Self-contact: a surface searched against itself (the admissibility of pairs)."""
+"""Self-contact: a surface searched against itself (the admissibility of pairs), and a slot
+in a block pressed until it closes on itself."""
 
+import basix.ufl
+import dolfinx
 import numpy as np
 import pytest
+from mpi4py import MPI
 from scipy.spatial import ConvexHull
 
+import contact_ufl as cu
 from contact_ufl.contact import projection
 from contact_ufl.contact.projection import SelfContact, closest_points
+from contact_ufl.errors import ContactInputError
+from contact_ufl.problem import ContactProblem
+from contact_ufl.verification.geometries import tag_single_body
 
 
 def _slit_2d(n: int = 40, a: float = 1.0, b: float = 0.06):
@@ -138,3 +146,160 @@ def test_self_contact_shapes_are_checked():
     bad = SelfContact(rule.point_nodes[:-1], rule.facet_nodes, rule.point_normals)
     with pytest.raises(ValueError, match="self_contact must hold"):
         closest_points(points, nodes, self_contact=bad)
+
+
+# -- a slot closing on itself -------------------------------------------------------------
+
+
+def _slot_mesh(comm: MPI.Comm, nx: int = 20, ny: int = 10) -> dolfinx.mesh.Mesh:
+    """The block [0, 2] x [0, 1] in nx x ny quadrilaterals without the cells of one row
+    between x = 0.5 and 1.5: a slot 0.1 high, y in [0.5, 0.6]."""
+    X, Y = np.meshgrid(np.linspace(0, 2, nx + 1), np.linspace(0, 1, ny + 1))
+    x = np.stack([X.ravel(), Y.ravel()], axis=1)
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny)))
+    keep = ~((j == ny // 2) & (i >= nx // 4) & (i < 3 * nx // 4))
+    n0 = j[keep] * (nx + 1) + i[keep]
+    cells = np.stack([n0, n0 + 1, n0 + nx + 1, n0 + nx + 2], axis=1)
+    used = np.unique(cells)
+    cells, x = np.searchsorted(used, cells), x[used]
+    if comm.rank != 0:
+        cells, x = np.empty((0, 4), np.int64), np.empty((0, 2))
+    element = basix.ufl.element("Lagrange", "quadrilateral", 1, shape=(2,))
+    partitioner = dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet, 2)
+    return dolfinx.mesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
+
+
+def _in_slot(x, y0=0.5, y1=0.6):
+    e = 1e-9
+    return (x[0] > 0.5 - e) & (x[0] < 1.5 + e) & (x[1] > y0 - e) & (x[1] < y1 + e)
+
+
+def _slot_scene(comm: MPI.Comm, self_contact: bool = True, depth: float = 0.15) -> cu.Scene:
+    """The slotted block clamped at y = 0 (tag 1), its top (tag 2) moved down by ``depth``:
+    the slot closes. Self-contact of the slot's surface (tag 3), or the classical pair of its
+    lower face (tag 3, slave) and upper face (tag 4, master); eps_N = E / (slot length)."""
+    mesh = _slot_mesh(comm)
+    sides = [lambda x: np.isclose(x[1], 0.0), lambda x: np.isclose(x[1], 1.0)]
+    if self_contact:
+        sides.append(_in_slot)
+        pairs = [cu.ContactPair(3, 3, eps_N=1.0)]
+    else:
+        sides += [lambda x: _in_slot(x, 0.5, 0.5), lambda x: _in_slot(x, 0.6, 0.6)]
+        pairs = [cu.ContactPair(3, 4, eps_N=1.0)]
+    cells, facets = tag_single_body(mesh, sides)
+    return cu.Scene(
+        mesh,
+        cells,
+        facets,
+        [cu.Body(1, cu.NeoHookean(1.0, 0.3))],
+        contacts=pairs,
+        dirichlet=[cu.Dirichlet(1, (0.0, 0.0)), cu.Dirichlet(2, lambda t: (0.0, -depth * t))],
+    )
+
+
+def _solved(comm: MPI.Comm, self_contact: bool = True) -> ContactProblem:
+    problem = ContactProblem(_slot_scene(comm, self_contact), verbose=False)
+    problem.solve(num_steps=4)
+    return problem
+
+
+def _point_tractions(problem: ContactProblem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Reference positions, partner facet flags and normal tractions of all slave points."""
+    c = problem.contacts[0]
+    proj = c.kinematics.projection
+    t_N = c.normal.traction_at_points(proj)
+    X = c.slave.X.reshape(-1, 2)
+    gathered = problem.comm.allgather((X, proj.facet >= 0, t_N))
+    return tuple(np.concatenate([g[k] for g in gathered]) for k in range(3))
+
+
+@pytest.fixture(scope="module")
+def closed_slot():
+    return _solved(MPI.COMM_WORLD)
+
+
+def test_slot_closes_on_itself(closed_slot):
+    """The slot pressed shut: Newton converges quadratically (a single pass: the lower face
+    is the slave, the upper face its master), the block is in equilibrium, the contact
+    forces on the one body cancel (property (e)) and the result is symmetric about x = 1."""
+    problem = closed_slot
+    assert [s.newton_iterations for s in problem.history.steps] == [3, 3, 4, 4]
+    assert problem.active_points() >= 12
+    # equilibrium: the two supports' reactions balance (the contact forces are internal)
+    top = problem.reaction(2)
+    assert top[1] < -0.2
+    assert np.linalg.norm(problem.reaction([1, 2])) < 1e-12 * np.linalg.norm(top)
+    # property (e): the contact residual sums to zero over the body (slave and master sides
+    # on the same body), while its slave side alone does not
+    R = problem.contact_residual()
+    local = R.array[problem.block_rows(0)].reshape(-1, 2).sum(axis=0)
+    resultant = problem.comm.allreduce(local, MPI.SUM)
+    slave_side = problem.contact_force()
+    assert slave_side[1] < -0.05
+    assert np.linalg.norm(resultant) < 1e-12 * np.linalg.norm(slave_side)
+    # one pass: only the lower face's points are paired; symmetric tractions about x = 1
+    X, paired, t_N = _point_tractions(problem)
+    assert np.all(np.isclose(X[paired, 1], 0.5))
+    assert np.count_nonzero(t_N > 0) >= 12
+    mirror = np.stack([2.0 - X[:, 0], X[:, 1]], axis=1)
+    image = np.argmin(np.linalg.norm(X[:, None] - mirror[None], axis=2), axis=0)
+    np.testing.assert_allclose(X[image], mirror, atol=1e-12)
+    np.testing.assert_allclose(t_N[image], t_N, rtol=0, atol=1e-9 * t_N.max())
+
+
+def test_slot_self_contact_equals_the_two_surface_pair(closed_slot):
+    """The same slot with the classical pair (lower face slave, upper face master): the same
+    contact up to the multiplier space. The self-contact slave surface also holds the side
+    walls and the upper face (unpaired: lambda_N = 0 there), and the multiplier equation
+    ties lambda_N to t_N in L2 over the whole slave surface, so lambda_N differs near the
+    slot's ends: by 1% of the peak at the edge of the contact zone, 2e-5 of the total force
+    (measured 1.6e-5)."""
+    classical = _solved(MPI.COMM_WORLD, self_contact=False)
+    assert [s.newton_iterations for s in classical.history.steps] == [
+        s.newton_iterations for s in closed_slot.history.steps
+    ]
+    assert classical.active_points() == closed_slot.active_points()
+    a, b = closed_slot.reaction(2), classical.reaction(2)
+    assert np.linalg.norm(a - b) < 5e-5 * np.linalg.norm(b)
+    X, _, t_self = _point_tractions(closed_slot)
+    Y, _, t_classical = _point_tractions(classical)
+    lower = np.isclose(X[:, 1], 0.5)
+    mine, theirs = np.lexsort(X[lower].T), np.lexsort(Y.T)
+    np.testing.assert_allclose(X[lower][mine], Y[theirs], atol=1e-14)
+    difference = np.abs(t_self[lower][mine] - t_classical[theirs])
+    assert difference.max() < 0.02 * t_classical.max()
+
+
+def test_slot_same_result_on_any_number_of_ranks(closed_slot):
+    """One rank and this communicator's ranks: the same reaction and Newton iterations."""
+    alone = _solved(MPI.COMM_SELF)
+    a, b = alone.reaction(2), closed_slot.reaction(2)
+    np.testing.assert_allclose(a, b, rtol=0, atol=1e-10 * np.linalg.norm(a))
+    assert [s.newton_iterations for s in alone.history.steps] == [
+        s.newton_iterations for s in closed_slot.history.steps
+    ]
+
+
+def test_self_contact_of_a_flat_face_is_refused():
+    """The top face of a square as a self-contact pair: it never faces itself."""
+    mesh = dolfinx.mesh.create_unit_square(
+        MPI.COMM_WORLD, 4, 4, ghost_mode=dolfinx.mesh.GhostMode.shared_facet
+    )
+    cells, facets = tag_single_body(
+        mesh, [lambda x: np.isclose(x[1], 0.0), lambda x: np.isclose(x[1], 1.0)]
+    )
+    scene = cu.Scene(
+        mesh,
+        cells,
+        facets,
+        [cu.Body(1, cu.NeoHookean(1.0, 0.3))],
+        contacts=[cu.ContactPair(2, 2)],
+        dirichlet=[cu.Dirichlet(1, (0.0, 0.0))],
+    )
+    with pytest.raises(ContactInputError, match="never faces itself"):
+        ContactProblem(scene, verbose=False)
+
+
+def test_frictional_self_contact_is_refused():
+    with pytest.raises(ContactInputError, match="self-contact pair .* is frictionless"):
+        cu.ContactPair(3, 3, mu=0.2).validate(MPI.COMM_WORLD)
