@@ -13,7 +13,9 @@ from contact_ufl.contact import projection
 from contact_ufl.contact.projection import SelfContact, closest_points
 from contact_ufl.errors import ContactInputError
 from contact_ufl.problem import ContactProblem
+from contact_ufl.taylor import taylor_test
 from contact_ufl.verification.geometries import tag_single_body
+from contact_ufl.verification.taylor_cases import sliding_direction
 
 
 def _slit_2d(n: int = 40, a: float = 1.0, b: float = 0.06):
@@ -303,3 +305,14 @@ def test_self_contact_of_a_flat_face_is_refused():
 def test_frictional_self_contact_is_refused():
     with pytest.raises(ContactInputError, match="self-contact pair .* is frictionless"):
         cu.ContactPair(3, 3, mu=0.2).validate(MPI.COMM_WORLD)
+
+
+def test_taylor_of_the_closed_slot(closed_slot):
+    """The tangent at the closed slot (the lower face pressed by the upper one, both sides of
+    one surface and of one body): second-order remainders along a smooth direction that
+    deforms the block and changes the multipliers."""
+    problem = closed_slot
+    dz = sliding_direction(problem, 1, np.zeros(2), amplitude=0.02, multiplier=0.01)
+    result = taylor_test(problem, dz, [1e-3 * 2.0**-k for k in range(4)])
+    assert not result.facets_changed and not result.active_changed
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
