@@ -318,6 +318,80 @@ def test_taylor_of_the_closed_slot(closed_slot):
     assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
 
 
+def _slot_mesh_3d(comm: MPI.Comm, nx: int = 20, ny: int = 2, nz: int = 10) -> dolfinx.mesh.Mesh:
+    """The block [0, 2] x [0, 0.2] x [0, 1] in nx x ny x nz hexahedra without the cells of
+    one layer between x = 0.5 and 1.5: a slot through the block, z in [0.5, 0.6]."""
+    g = [np.linspace(0, 2, nx + 1), np.linspace(0, 0.2, ny + 1), np.linspace(0, 1, nz + 1)]
+    Z, Y, X = np.meshgrid(g[2], g[1], g[0], indexing="ij")
+    x = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+    k, j, i = (
+        a.ravel() for a in np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij")
+    )
+    keep = ~((k == nz // 2) & (i >= nx // 4) & (i < 3 * nx // 4))
+    sy, sz = nx + 1, (nx + 1) * (ny + 1)
+    n0 = k[keep] * sz + j[keep] * sy + i[keep]
+    corners = [0, 1, sy, sy + 1]
+    cells = np.stack([n0 + c for c in corners] + [n0 + sz + c for c in corners], axis=1)
+    used = np.unique(cells)
+    cells, x = np.searchsorted(used, cells), x[used]
+    if comm.rank != 0:
+        cells, x = np.empty((0, 8), np.int64), np.empty((0, 3))
+    element = basix.ufl.element("Lagrange", "hexahedron", 1, shape=(3,))
+    partitioner = dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet, 2)
+    return dolfinx.mesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
+
+
+def test_slot_closes_on_itself_in_3d():
+    """The slot through a 3D block (plane strain by u_y = 0 on the sides y = 0, 0.2) pressed
+    shut: quadratic Newton, equilibrium, property (e) and symmetric tractions about x = 1."""
+    comm = MPI.COMM_WORLD
+    mesh = _slot_mesh_3d(comm)
+    e = 1e-9
+    cells, facets = tag_single_body(
+        mesh,
+        [
+            lambda x: np.isclose(x[2], 0.0),
+            lambda x: np.isclose(x[2], 1.0),
+            lambda x: (x[0] > 0.5 - e) & (x[0] < 1.5 + e) & (x[2] > 0.5 - e) & (x[2] < 0.6 + e),
+            lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 0.2),
+        ],
+    )
+    scene = cu.Scene(
+        mesh,
+        cells,
+        facets,
+        [cu.Body(1, cu.NeoHookean(1.0, 0.3))],
+        contacts=[cu.ContactPair(3, 3, eps_N=1.0)],
+        dirichlet=[
+            cu.Dirichlet(1, (0.0, 0.0, 0.0)),
+            cu.Dirichlet(2, lambda t: (0.0, 0.0, -0.15 * t)),
+            cu.Dirichlet(4, 0.0, component=1),
+        ],
+    )
+    problem = ContactProblem(scene, verbose=False)
+    problem.solve(num_steps=4)
+    assert [s.newton_iterations for s in problem.history.steps] == [3, 3, 4, 4]
+    assert problem.active_points() >= 60
+    top = problem.reaction(2)
+    assert top[2] < -0.05
+    assert np.linalg.norm(problem.reaction([1, 2, 4])) < 1e-12 * np.linalg.norm(top)
+    R = problem.contact_residual()
+    local = R.array[problem.block_rows(0)].reshape(-1, 3).sum(axis=0)
+    resultant = problem.comm.allreduce(local, MPI.SUM)
+    slave_side = problem.contact_force()
+    assert slave_side[2] < -0.01
+    assert np.linalg.norm(resultant) < 1e-12 * np.linalg.norm(slave_side)
+    c = problem.contacts[0]
+    t_N = c.normal.traction_at_points(c.kinematics.projection)
+    X = c.slave.X.reshape(-1, 3)
+    gathered = problem.comm.allgather((X, t_N))
+    X, t_N = (np.concatenate([g[k] for g in gathered]) for k in range(2))
+    mirror = X * [-1.0, 1.0, 1.0] + [2.0, 0.0, 0.0]
+    image = np.argmin(np.linalg.norm(X[:, None] - mirror[None], axis=2), axis=0)
+    np.testing.assert_allclose(X[image], mirror, atol=1e-12)
+    np.testing.assert_allclose(t_N[image], t_N, rtol=0, atol=1e-9 * t_N.max())
+
+
 # -- a ring squeezed between two plates until its hole closes ----------------------------
 
 
