@@ -11,6 +11,7 @@ from scipy.spatial import ConvexHull
 import contact_ufl as cu
 from contact_ufl.contact import projection
 from contact_ufl.contact.projection import SelfContact, closest_points
+from contact_ufl.contact.search import release_master_side
 from contact_ufl.errors import ContactInputError
 from contact_ufl.problem import ContactProblem
 from contact_ufl.taylor import taylor_test
@@ -129,6 +130,23 @@ def test_self_contact_within_a_radius():
     wide = closest_points(points, nodes, radius=0.11, self_contact=rule)
     np.testing.assert_array_equal(wide.facet >= 0, width <= 0.11)
     np.testing.assert_allclose(wide.distance[wide.facet >= 0], width[width <= 0.11], rtol=1e-12)
+
+
+def test_one_pass_per_facing_couple():
+    """Of two facing facets only the one of lower vertex key keeps its points paired: no
+    couple of facets is paired both ways (the constraint is imposed once)."""
+    nodes, facet_nodes = _slit_2d(n=80, b=0.05)
+    points, rule = _facet_points(nodes, facet_nodes)  # point k is the centroid of facet k
+    proj = closest_points(points, nodes, self_contact=rule)
+    partner = proj.facet.copy()
+    assert np.all(partner >= 0)
+    release_master_side(proj, rule)
+    kept = proj.facet >= 0
+    np.testing.assert_array_equal(kept, facet_nodes[partner].min(axis=1) > facet_nodes.min(axis=1))
+    assert np.all(proj.gap[~kept] == -np.inf)
+    couples = set(zip(np.flatnonzero(kept).tolist(), proj.facet[kept].tolist(), strict=True))
+    assert not any((f, F) in couples for F, f in couples)
+    assert 0 < np.count_nonzero(kept) < len(points)
 
 
 def test_self_contact_of_a_flat_surface_finds_nothing():
