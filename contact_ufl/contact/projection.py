@@ -712,12 +712,16 @@ def _nearest_admissible(
     nearest = np.zeros(active.size, dtype=np.int64)
     found = np.zeros(active.size, dtype=bool)
     rows = np.arange(active.size)
-    k = d.shape[1]
+    start, k = 0, d.shape[1]
     while True:
+        # the neighbours start .. k-1 (the nearer ones were tested by the previous query; a
+        # tie reordered between two queries at worst gives a farther admissible facet: the
+        # bound stays valid)
+        d, near = d[:, start:], near[:, start:].astype(np.int64)
         valid = d <= reach0
         r, c = np.nonzero(valid)
         ok = np.zeros(d.shape, dtype=bool)
-        ok[r, c] = admit(active[rows[r]], near[r, c].astype(np.int64))
+        ok[r, c] = admit(active[rows[r]], near[r, c])
         has = ok.any(axis=1)
         nearest[rows[has]] = near[has, ok[has].argmax(axis=1)]
         found[rows[has]] = True
@@ -725,7 +729,7 @@ def _nearest_admissible(
         more = ~has & valid[:, -1]
         if k >= master.nf or not more.any():
             return nearest, found
-        rows, k = rows[more], min(2 * k, master.nf)
+        rows, start, k = rows[more], k, min(2 * k, master.nf)
         d, near = master.tree.query(x[active[rows]], k=k, distance_upper_bound=reach0)
         d, near = d.reshape(rows.size, k), near.reshape(rows.size, k)
 
