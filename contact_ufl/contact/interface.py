@@ -149,10 +149,20 @@ class ContactInterface:
         #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see ``macaulay``)
         self.touching = 1e-12 * size
         radius = pair.search_radius or 0.25 * size
-        search = ClosestPointSearch(self.slave, self.master, radius, self.touching)
+        collective_check(
+            comm,
+            not (pair.self_contact and (self.master.two_sided or self.slave.membrane)),
+            f"self-contact of a membrane (tag {pair.slave}) is not implemented: its two sides "
+            "would both have to be searched",
+        )
+        search = ClosestPointSearch(
+            self.slave, self.master, radius, self.touching, pair.self_contact
+        )
         kinematics = MeshKinematics(self.u, self.slave, self.master, search)
         kinematics.check_facing(
             f"slave surface (tag {pair.slave}) of the pair with master surface (tag {pair.master})"
+            if not pair.self_contact
+            else f"the self-contact surface (tag {pair.slave})"
         )
         return kinematics
 

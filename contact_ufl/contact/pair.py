@@ -19,7 +19,10 @@ class ContactPair:
     ----------
     slave
         Facet tag (or physical-group name) of the slave (contactor) surface; it carries the
-        multipliers. Make it the finer of the two surfaces.
+        multipliers. Make it the finer of the two surfaces. The same surface as ``master``
+        (same tag, same domain) makes a self-contact pair (frictionless, solid bodies): each
+        point pairs with the facets of the surface that share no vertex with its own facet
+        and whose normals oppose its own (no tolerance to set).
     master
         Facet tag (or physical-group name) of the master (target) surface, or a rigid
         obstacle (:class:`~contact_ufl.contact.obstacles.RigidPlane`, ``RigidSphere``,
@@ -85,6 +88,15 @@ class ContactPair:
         return self.mu > 0.0
 
     @property
+    def self_contact(self) -> bool:
+        """Whether slave and master are the same surface of the same domain (self-contact:
+        a point pairs only with the facets that share no vertex with its own and face it)."""
+        return not self.on_obstacle and (self.slave_domain, self.slave) == (
+            self.master_domain,
+            self.master,
+        )
+
+    @property
     def on_obstacle(self) -> bool:
         """Whether the master side is a rigid obstacle."""
         return isinstance(self.master, RigidObstacle)
@@ -128,6 +140,7 @@ class ContactPair:
         )
         collective_check(
             comm,
-            (self.slave_domain, self.slave) != (self.master_domain, self.master),
-            f"slave and master surfaces must differ (both are facet tag {self.slave})",
+            not (self.self_contact and self.frictional),
+            "a self-contact pair (slave and master the same surface, tag "
+            f"{self.slave}) is frictionless for now: got mu = {self.mu}",
         )

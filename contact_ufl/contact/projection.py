@@ -43,16 +43,25 @@ from __future__ import annotations
 
 import itertools
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-__all__ = ["Projection", "TreeCache", "closest_points", "facet_kind", "shape_functions"]
+__all__ = [
+    "Projection",
+    "SelfContact",
+    "TreeCache",
+    "closest_points",
+    "facet_kind",
+    "shape_functions",
+]
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
+BoolArray = npt.NDArray[np.bool_]
 
 #: Facet kind of each supported ``(nn, gdim)``.
 _KINDS = {(2, 2): "segment", (3, 3): "triangle", (4, 3): "quadrilateral"}
@@ -83,6 +92,9 @@ _TIE = 1e-10  # relative distance tolerance of the tie-break
 _CELLS = 64  # cells per dimension of the grid that orders the points
 _SORT = 1 << 14  # facets above which the points are ordered by cells
 _FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
+
+#: An admissibility test of (point, facet) pairs: point and facet indices in, mask out.
+Admit = Callable[[IntArray, IntArray], npt.NDArray[np.bool_]]
 
 
 @dataclass
@@ -121,6 +133,45 @@ class Projection:
     gap: FloatArray
     distance: FloatArray
     sliding: FloatArray
+
+
+@dataclass
+class SelfContact:
+    """Which (point, facet) pairs may pair when a surface is searched against itself.
+
+    A point of a surface is at distance zero from the facet that holds it and close to that
+    facet's neighbours: those are excluded by topology, not by a distance, so that no
+    tolerance is needed. A pair (point ``p``, facet ``f``) is admissible when
+
+    * ``f`` shares no node with the facet holding ``p`` (node numbers compared exactly), and
+    * the normal ``n_f`` at the centre of ``f`` opposes the point's current outward normal
+      ``n_p``: ``n_f . n_p < 0`` (a facet behind the point, on the same side of the body,
+      faces the same way and is not a contact partner).
+
+    Attributes
+    ----------
+    point_nodes : ndarray of int64, shape (np, m)
+        Node numbers of the facet holding each point (``m`` nodes per slave facet).
+    facet_nodes : ndarray of int64, shape (nf, nn)
+        Node numbers of each master facet, in the same numbering (global or input indices).
+    point_normals : ndarray, shape (np, gdim)
+        Current outward unit normal of the surface at each point.
+    """
+
+    point_nodes: IntArray
+    facet_nodes: IntArray
+    point_normals: FloatArray
+
+    def admissible(self, pid: IntArray, fid: IntArray, facet_normal: FloatArray) -> BoolArray:
+        """Mask of the admissible pairs (points ``pid``, facets ``fid``, (P,) each), given
+        the unit normals ``facet_normal`` (P, gdim) of the facets at their centres."""
+        mine, theirs = self.point_nodes[pid], self.facet_nodes[fid]
+        share = np.zeros(pid.shape, dtype=bool)
+        for i in range(mine.shape[1]):
+            for j in range(theirs.shape[1]):
+                share |= mine[:, i] == theirs[:, j]
+        opposed = _dot(self.point_normals[pid], facet_normal) < 0.0
+        return ~share & opposed
 
 
 def facet_kind(nn: int, gdim: int) -> str:
@@ -646,8 +697,48 @@ def _concatenate(a: _Pairs, b: _Pairs) -> _Pairs:
     )
 
 
-def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projection) -> None:
-    """Fill ``out`` (arrays of this block of points) with the closest points of ``x``."""
+def _nearest_admissible(
+    master: _Master,
+    x: FloatArray,
+    active: IntArray,
+    d: FloatArray,
+    near: IntArray,
+    reach0: float,
+    admit: Admit,
+) -> tuple[IntArray, BoolArray]:
+    """The admissible facet of the nearest centroid of each point ``x[active]``, and
+    whether there is one within ``reach0`` (the K nearest ``d, near`` first, then queries
+    of twice as many neighbours for the points that have none among them)."""
+    nearest = np.zeros(active.size, dtype=np.int64)
+    found = np.zeros(active.size, dtype=bool)
+    rows = np.arange(active.size)
+    start, k = 0, d.shape[1]
+    while True:
+        # the neighbours start .. k-1 (the nearer ones were tested by the previous query; a
+        # tie reordered between two queries at worst gives a farther admissible facet: the
+        # bound stays valid)
+        d, near = d[:, start:], near[:, start:].astype(np.int64)
+        valid = d <= reach0
+        r, c = np.nonzero(valid)
+        ok = np.zeros(d.shape, dtype=bool)
+        ok[r, c] = admit(active[rows[r]], near[r, c])
+        has = ok.any(axis=1)
+        nearest[rows[has]] = near[has, ok[has].argmax(axis=1)]
+        found[rows[has]] = True
+        # the points with no admissible facet among k neighbours all within reach0
+        more = ~has & valid[:, -1]
+        if k >= master.nf or not more.any():
+            return nearest, found
+        rows, start, k = rows[more], k, min(2 * k, master.nf)
+        d, near = master.tree.query(x[active[rows]], k=k, distance_upper_bound=reach0)
+        d, near = d.reshape(rows.size, k), near.reshape(rows.size, k)
+
+
+def _closest_block(
+    master: _Master, x: FloatArray, radius: float, out: Projection, admit: Admit | None = None
+) -> None:
+    """Fill ``out`` (arrays of this block of points) with the closest points of ``x``, over
+    the pairs that ``admit`` (block point indices, facets) accepts if it is given."""
     npts = x.shape[0]
     # the K nearest centroids, where they can hold a facet point within the radius
     reach0 = (radius + master.R_max + 2.0 * master.slack) * (1 + 1e-12)
@@ -658,7 +749,14 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     if active.size == 0:
         return
     d, near = d[active], near[active].astype(np.int64)
-    nearest = near[:, 0]
+    if admit is None:
+        nearest = near[:, 0]
+    else:
+        # the bound d1 must come from an admissible facet (a point's own facet is at 0)
+        nearest, found = _nearest_admissible(master, x, active, d, near, reach0, admit)
+        active, d, near, nearest = active[found], d[found], near[found], nearest[found]
+        if active.size == 0:
+            return
     # an upper bound of the distance: the exact distance to the facet of the nearest centroid
     first = master.project(x[active], nearest, np.arange(active.size), active.size)
     d1 = np.full(npts, np.inf)
@@ -675,6 +773,8 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     fid = np.concatenate([near[rows, cols], fid_ball])
     lower = master.lower_bound(x, fid, pid)
     keep = lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9)
+    if admit is not None:
+        keep[keep] = admit(pid[keep], fid[keep])
     # the pair of the nearest centroid is projected already
     done = np.full(npts, -1, dtype=np.int64)
     done[active] = nearest
@@ -717,6 +817,29 @@ def _closest_block(master: _Master, x: FloatArray, radius: float, out: Projectio
     )
 
 
+def _check_self_contact(self_contact: SelfContact, npts: int, nf: int, gdim: int) -> None:
+    """Raise if the arrays of ``self_contact`` do not match the points and facets."""
+    shapes = (
+        np.shape(self_contact.point_nodes)[:1],
+        np.shape(self_contact.facet_nodes)[:1],
+        np.shape(self_contact.point_normals),
+    )
+    if shapes != ((npts,), (nf,), (npts, gdim)):
+        raise ValueError(
+            f"self_contact must hold the nodes of {npts} points' facets, of {nf} facets and "
+            f"{npts} normals in {gdim}D, got shapes {shapes}"
+        )
+
+
+def _admission(self_contact: SelfContact, master: _Master, index: IntArray) -> Admit:
+    """The admissibility test of a block of points (``index``: their indices in the call)."""
+
+    def admit(pid: IntArray, fid: IntArray) -> npt.NDArray[np.bool_]:
+        return self_contact.admissible(index[pid], fid, master.axis[fid])
+
+    return admit
+
+
 def _spatial_order(points: FloatArray) -> IntArray:
     """An order of the points by the cells of a ``_CELLS^gdim`` grid over their bounding
     box (lexicographic in the cell coordinates)."""
@@ -736,6 +859,7 @@ def closest_points(
     nodes: npt.ArrayLike,
     radius: float = np.inf,
     trees: TreeCache | None = None,
+    self_contact: SelfContact | None = None,
 ) -> Projection:
     """Closest points of slave points on a master surface, in the current configuration.
 
@@ -751,6 +875,10 @@ def closest_points(
     trees : TreeCache, optional
         KD-trees of earlier calls on the same master surface, reused while it has barely
         moved (and updated); without it the tree is built anew.
+    self_contact : SelfContact, optional
+        For a surface searched against itself: only the admissible (point, facet) pairs of
+        :class:`SelfContact` are considered (the facet holding the point, its neighbours and
+        the facets that do not face the point are skipped).
 
     Returns
     -------
@@ -785,6 +913,12 @@ def closest_points(
     aligned with ``x - y`` wins; at equal alignment the one with the nearer centroid, then the
     lower index (so that the order the caller gives the facets in decides exact ties).
 
+    Self-contact (``self_contact`` given): the inadmissible pairs are dropped before any
+    distance bounds the search, so the bound ``d1`` is the distance of the facet of the
+    nearest centroid *among the admissible ones* (found by K-nearest queries of doubling K);
+    a point with no admissible facet within ``radius + R_max`` is unpaired. Without it the
+    search is unchanged.
+
     Quadrilaterals: clamped Newton from the centre (restarted from four other points where it
     does not converge or stops at a saddle), compared with the projections on the four
     straight edges. A strongly warped quadrilateral seen from beyond its radius of curvature
@@ -815,6 +949,8 @@ def closest_points(
     )
     if npts == 0 or nf == 0:
         return out
+    if self_contact is not None:
+        _check_self_contact(self_contact, npts, nf, gdim)
     master = _Master(nodes, trees)
     # on a large master the points in the order of a grid of cells (neighbours searched
     # together: the KD-tree and the gathers of facet data stay in cache), results scattered
@@ -824,7 +960,11 @@ def closest_points(
     for start in range(0, npts, _BLOCK):
         block = slice(start, min(start + _BLOCK, npts))
         view = Projection(*(getattr(work, k)[block] for k in _FIELDS))
-        _closest_block(master, x[block], radius, view)
+        admit = None
+        if self_contact is not None:
+            index = (np.arange(npts) if order is None else order)[block]
+            admit = _admission(self_contact, master, index)
+        _closest_block(master, x[block], radius, view, admit)
     if order is not None:
         for k in _FIELDS:
             getattr(out, k)[order] = getattr(work, k)

@@ -6,7 +6,9 @@ points are exchanged (a bounding-box filter), put in a rank-independent order (s
 between equidistant facets break the same way on any number of ranks), and projected onto
 by the vectorised kernels of :mod:`.projection`. Points whose closest point lies on the
 boundary of the master surface and off its normal are released (they are beyond the
-surface, not on it).
+surface, not on it). On a self-contact surface (slave and master the same surface) a point
+pairs only with the facets that share no vertex with its own and face it, and of two facing
+facets only the one of lower vertex key is the slave (:func:`release_master_side`).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from mpi4py import MPI
 
 from contact_ufl.contact.facets import on_edges
 from contact_ufl.contact.master import MeshMaster, smoothed_normals, smoothed_normals_3d
-from contact_ufl.contact.projection import Projection, TreeCache, closest_points
+from contact_ufl.contact.projection import Projection, SelfContact, TreeCache, closest_points
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
 from contact_ufl.layout import StackedLayout
@@ -71,11 +73,23 @@ class ClosestPointSearch:
         not sent to it, and points with no facet within it are unpaired.
     touching
         A length of round-off: a point this close to the master surface counts as on it.
+    self_contact
+        Whether slave and master are the same surface: a point then pairs only with the
+        facets that share no vertex with its own facet and whose normal opposes its current
+        normal (:class:`~contact_ufl.contact.projection.SelfContact`; no tolerance).
     """
 
-    def __init__(self, slave: SlaveSurface, master: MeshMaster, radius: float, touching: float):
+    def __init__(
+        self,
+        slave: SlaveSurface,
+        master: MeshMaster,
+        radius: float,
+        touching: float,
+        self_contact: bool = False,
+    ):
         self.slave, self.master = slave, master
         self.radius, self.touching = radius, touching
+        self.self_contact = self_contact
         self.comm = slave.V.mesh.comm
         self.gdim = slave.V.mesh.geometry.dim
         #: seconds spent in :meth:`pair` so far
@@ -111,11 +125,13 @@ class ClosestPointSearch:
         """Raise (on every rank) if no slave point faces the master surface in the reference
         configuration; ``description`` names the pair in the message."""
         x = self.slave.X.reshape(-1, self.gdim)
-        nodes, _ = self.exchange(self.master.X_nodes, x)
-        proj = closest_points(x, nodes, np.inf)
+        keys = self.master.keys.astype(np.int64)
+        nodes, keys = self.exchange(self.master.X_nodes, x, keys)
+        normals = np.repeat(self.slave.normals, self.slave.num_points, axis=0)
+        rule = self._self_contact(keys, normals)
+        proj = closest_points(x, nodes, np.inf, self_contact=rule)
         # a slave point faces the master when it lies on the outer side of the master facet
         # and the two outward normals oppose each other
-        normals = np.repeat(self.slave.normals, self.slave.num_points, axis=0)
         outside = np.einsum("pd,pd->p", proj.normal, x - proj.y) >= -1e-8 * (1 + proj.distance)
         opposed = np.einsum("pd,pd->p", proj.normal, normals) < 0.0
         if self.master.two_sided:  # a membrane master: either side may face the point
@@ -124,12 +140,26 @@ class ClosestPointSearch:
             opposed = True
         facing = np.count_nonzero((proj.facet >= 0) & outside & opposed)
         total = self.comm.allreduce(facing, MPI.SUM)
-        collective_check(
-            self.comm,
-            total > 0,
-            f"{description} never faces its master surface: no slave point lies on the outer "
-            "side of the master facets (wrong tags or swapped bodies?)",
-        )
+        if self.self_contact:
+            message = (
+                f"{description} never faces itself: no point of the surface lies in front of "
+                "another part of it with opposed normals (a self-contact pair needs a surface "
+                "that can fold onto itself: a hole, a slit, a curved face; not a flat face)"
+            )
+        else:
+            message = (
+                f"{description} never faces its master surface: no slave point lies on the "
+                "outer side of the master facets (wrong tags or swapped bodies?)"
+            )
+        collective_check(self.comm, total > 0, message)
+
+    def _self_contact(self, keys: np.ndarray, normals: np.ndarray) -> SelfContact | None:
+        """The admissibility rule of a self-contact search (``None`` for other pairs): the
+        master facets' vertex ``keys`` and the slave points' outward ``normals``."""
+        if not self.self_contact:
+            return None
+        own = np.repeat(self.slave.vertex_keys, self.slave.num_points, axis=0)
+        return SelfContact(own, keys.astype(np.int64), normals)
 
     def pair(self, u: dolfinx.fem.Function, layout: StackedLayout) -> Pairing:
         """Project the current slave points onto the current master surface (collective).
@@ -154,7 +184,11 @@ class ClosestPointSearch:
         nodes, payload = nodes[order], payload[order]
         columns = payload[:, :nx]
         boundary = payload[:, nx + nn : nx + nn + ne].astype(bool)
-        proj = closest_points(points, nodes[:, :nn], self.radius, self.trees)
+        rule = self._self_contact(payload[:, nx : nx + nn], self.slave.current_normals(u))
+        proj = closest_points(points, nodes[:, :nn], self.radius, self.trees, rule)
+        if rule is not None:
+            release_beside_own_facet(proj, points, rule, self.touching)
+            release_master_side(proj, rule)
         release_beyond_boundary(proj, points, boundary, self.touching)
         paired = proj.facet >= 0
         flags = None
@@ -203,3 +237,73 @@ def release_beyond_boundary(
     released = paired[beyond]
     proj.facet[released] = -1
     proj.gap[released] = -np.inf
+
+
+def release_master_side(proj: Projection, rule: SelfContact) -> None:
+    """Keep one side of every self-contact interface as the slave (in place).
+
+    Two facing parts of a self-contact surface would each find the other: the constraint
+    would be imposed twice, by two multipliers whose split is undetermined (a singular
+    tangent). A pair (point of facet ``F``, facet ``f``) is kept only if the smallest vertex
+    key of ``F`` is below that of ``f`` (the two facets share no vertex, so the keys differ:
+    no tie, no tolerance, the same on any number of ranks): of two facing facets, the one of
+    lower key is the slave, the other the master. The closest point itself is not changed.
+    """
+    paired = np.flatnonzero(proj.facet >= 0)
+    own = rule.point_nodes[paired].min(axis=1)
+    partner = rule.facet_nodes[proj.facet[paired]].min(axis=1)
+    released = paired[partner < own]
+    proj.facet[released] = -1
+    proj.gap[released] = -np.inf
+
+
+def release_beside_own_facet(
+    proj: Projection, points: np.ndarray, rule: SelfContact, tolerance: float = 0.0
+) -> None:
+    """Unpair the self-contact points beyond the edge of their admissible facets (in place).
+
+    The facets around a point's own facet (those sharing a vertex with it) are excluded from
+    its search: the rest of the surface has there an edge, as a surface has at its boundary.
+    A point whose closest point is on the boundary of a facet that touches the excluded ones
+    (a vertex of the facet is a vertex of an excluded facet), off the facet's normal through
+    it by more than ``tolerance`` (round-off), lies beyond that edge: the surface continues
+    into the excluded facets there, and the point is not in contact with it (as in
+    :func:`release_beyond_boundary`).
+    """
+    paired = np.flatnonzero(proj.facet >= 0)
+    if len(paired) == 0:
+        return
+    facet = proj.facet[paired]
+    nn = rule.facet_nodes.shape[1]
+    on_boundary = on_edges(nn, proj.xi[paired]).any(axis=1)
+    d = points[paired] - proj.y[paired]
+    normal_part = np.einsum("pd,pd->p", d, proj.normal[paired])
+    off_normal = np.linalg.norm(d - normal_part[:, None] * proj.normal[paired], axis=1)
+    off = on_boundary & (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > tolerance)
+    # vertex pairs of the same facet, over the facets of the search (the excluded facets
+    # around a point's facet are among them: they are within a facet's size of the point)
+    pairs = np.unique(
+        np.concatenate(
+            [
+                _pair_codes(rule.facet_nodes[:, i], rule.facet_nodes[:, j])
+                for i in range(nn)
+                for j in range(nn)
+                if i != j
+            ]
+        )
+    )
+    own, theirs = rule.point_nodes[paired], rule.facet_nodes[facet]
+    touches = np.zeros(len(paired), dtype=bool)
+    for i in range(theirs.shape[1]):
+        for j in range(own.shape[1]):
+            code = _pair_codes(theirs[:, i], own[:, j])
+            pos = np.minimum(np.searchsorted(pairs, code), len(pairs) - 1)
+            touches |= pairs[pos] == code
+    released = paired[off & touches]
+    proj.facet[released] = -1
+    proj.gap[released] = -np.inf
+
+
+def _pair_codes(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """One integer per ordered pair of vertex keys (keys below 2^31)."""
+    return a.astype(np.int64) * (1 << 31) + b.astype(np.int64)

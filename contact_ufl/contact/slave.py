@@ -68,6 +68,9 @@ class SlaveSurface:
         Parent cell of each owned submesh cell.
     X
         Reference (undeformed) positions of the quadrature points, ``(ncells, nq, gdim)``.
+    vertex_keys
+        Input (mesh file) indices of the vertices of each owned slave facet, ``(ncells,
+        nv)``: the numbering of :attr:`MeshMaster.keys <.master.MeshMaster.keys>`.
     """
 
     V: dolfinx.fem.FunctionSpace
@@ -118,6 +121,12 @@ class SlaveSurface:
         phi_geom = phi_geom.reshape(nc, nq, phi_geom.shape[-1])
         xg = mesh.geometry.x[mesh.geometry.dofmaps[0][self.parent_cells], : mesh.geometry.dim]
         self.X = np.einsum("cqn,cnd->cqd", phi_geom, xg)
+        # the input (mesh file) indices of each facet's vertices: the numbering of the master
+        # facets' keys, rank-independent (a self-contact search excludes a point's own facet)
+        geometry_vertices = np.take_along_axis(
+            mesh.geometry.dofmaps[0][self.parent_cells], local_vertices, axis=1
+        )
+        self.vertex_keys = mesh.geometry.input_global_indices[geometry_vertices].astype(np.int64)
         nv = len(basix.topology(sub_cell)[0])
         vertices = self.submesh.geometry.x[
             self.submesh.geometry.dofmaps[0][:nc, :nv], : mesh.geometry.dim
