@@ -78,6 +78,15 @@ class ResultWriter:
         self.write(record.t)
 
 
+def say(text: str, comm=None) -> None:
+    """Print ``text`` on rank 0 of ``comm`` (default: ``MPI.COMM_WORLD``), flushed: the
+    progress lines of a script that runs on any number of ranks."""
+    from mpi4py import MPI
+
+    if (comm or MPI.COMM_WORLD).rank == 0:
+        print(text, flush=True)
+
+
 def _pyvista():
     import pyvista
 

@@ -49,10 +49,7 @@ args, _ = parser.parse_known_args()
 comm = MPI.COMM_WORLD
 out = Path(args.out)
 
-
-def say(text: str) -> None:
-    if comm.rank == 0:
-        print(text, flush=True)
+say = cu.output.say  # progress on rank 0
 
 
 # %% [markdown]
