@@ -11,6 +11,8 @@ Prints the forces on the die's top and writes JSON: a list of runs, each with ``
 ``history`` (records ``time``, ``Fx``, ``Fy``, ``Fz``, ``newton_iterations``,
 ``converged``, contact force parts, energies) and ``cutbacks``.
 
+Status: the pressing converges (tests/test_ironing_3d.py); the sliding on the quick mesh
+did not finish within ten minutes in a first try (TODO: find why; no results file yet).
 The comparison with the published force histories is a TODO: no digitised numbers of the
 published curves were reachable (see :data:`contact_ufl.verification.literature.IRONING_3D`).
 
