@@ -17,6 +17,7 @@ Generators
 * :func:`beams_3d`: two cantilever beams, clamped on the same side or at opposite ends,
   overlapping in plan.
 * :func:`sphere_on_block_3d`: a half ball on a block, quarter model (3D Hertz).
+* :func:`ironing_3d`: a cylindrical die over a slab (3D ironing, Puso & Laursen 2004).
 
 Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
 11, 12, ... in the order they are listed in each generator's documentation; always look them
@@ -46,6 +47,7 @@ __all__ = [
     "cylinders_3d",
     "hemisphere_3d",
     "ironing_2d",
+    "ironing_3d",
     "BeamPair",
     "beams_3d",
     "sphere_on_block_3d",
@@ -947,6 +949,90 @@ def ironing_2d(
         gmsh.model.mesh.generate(2)
 
     return generate_mesh(comm, "ironing_2d", build, 2, _mesh_options(1), msh_file, ghost_mode)
+
+
+def ironing_3d(
+    radius: float = 3.0,
+    die_width: float = 5.2,
+    die_height: float = 2.0,
+    slab: tuple[float, float, float] = (9.0, 4.0, 3.0),
+    x_die: float = 2.5,
+    gap: float = 0.0,
+    h_die: float = 0.3,
+    h_slab: float = 0.5,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> MeshData:
+    """The 3D ironing scene: a cylindrical die over a slab (Puso & Laursen 2004, example 2).
+
+    Slab ``[0, lx] x [-ly/2, ly/2] x [-lz, 0]`` (9 x 4 x 3). Die: the part of the cylinder
+    of radius ``radius`` (3) with axis along y through ``(x_die, ., radius + gap)`` that lies
+    below ``z = gap + die_height``, for ``|y| <= die_width / 2`` (5.2, wider than the slab),
+    its lowest line ``gap`` above the slab. The publication's die is a cylindrical shell 0.2
+    thick; a thousand times stiffer than the slab it is all but rigid, so its contact face
+    (the same cylinder) is what matters, and it is meshed here as a solid segment.
+    Tetrahedra of size ``h_die`` in the die and ``h_slab`` in the slab.
+
+    Returns
+    -------
+    MeshData
+        Cells ``"die"`` (1), ``"slab"`` (2); facets ``"die_contact"`` (the curved face, 11),
+        ``"die_top"`` (the flat face, 12), ``"slab_contact"`` (top, 13), ``"slab_bottom"``
+        (14), ``"slab_sides"`` (15), ``"die_ends"`` (the faces y = +-die_width/2, 16).
+    """
+    lx, ly, lz = slab
+    _check_positive(
+        radius=radius, die_width=die_width, die_height=die_height, lx=lx, ly=ly, lz=lz,
+        h_die=h_die, h_slab=h_slab,
+    )  # fmt: skip
+    if die_height >= radius:
+        raise ValueError(f"die_height {die_height} must be below the radius {radius}")
+    _check_common(gap, 1)
+    tol = 1e-5 * max(radius, lx, ly, lz)
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        zc = radius + gap
+        cyl = occ.addCylinder(x_die, -0.5 * die_width, zc, 0.0, die_width, 0.0, radius)
+        cut = occ.addBox(
+            x_die - 2 * radius, -die_width, gap - radius, 4 * radius, 2 * die_width,
+            radius + die_height,
+        )  # fmt: skip
+        (die_dt,), _ = occ.intersect([(3, cyl)], [(3, cut)])
+        slab_v = occ.addBox(0.0, -0.5 * ly, -lz, lx, ly, lz)
+        occ.synchronize()
+        die = die_dt[1]
+        names: dict[str, list[int]] = {
+            "die_contact": [], "die_top": [], "slab_contact": [], "slab_bottom": [],
+            "slab_sides": [], "die_ends": [],
+        }  # fmt: skip
+        for face in _boundary(3, [die], 2):
+            flat = _flat(face, tol)
+            if flat is None:
+                names["die_contact"].append(face)
+            else:
+                names["die_top" if flat[0] == 2 else "die_ends"].append(face)
+        for face in _boundary(3, [slab_v], 2):
+            axis, coord = _flat(face, tol)
+            if axis == 2:
+                names["slab_contact" if coord > -0.5 * lz else "slab_bottom"].append(face)
+            else:
+                names["slab_sides"].append(face)
+        _add_groups(
+            [("die", 3, [die]), ("slab", 3, [slab_v])]
+            + [(key, 2, value) for key, value in names.items()],
+            tdim=3,
+        )
+        _set_background(
+            [
+                _restricted(_constant(h_die), 3, [die]),
+                _restricted(_constant(h_slab), 3, [slab_v]),
+            ]
+        )
+        gmsh.model.mesh.generate(3)
+
+    return generate_mesh(comm, "ironing_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)
 
 
 # --------------------------------------------------------------------------------------------

@@ -26,3 +26,15 @@ IRONING_FORCES = {
     "Yastrebov 2011": ((2.897e8, 0.585e8), (3.595e8, 1.708e8)),
     "Fischer & Wriggers 2006": ((2.979e8, 0.621e8), (3.651e8, 1.888e8)),
 }
+
+#: The 3D ironing problem (a cylindrical die pressed 1.4 into a Neo-Hookean slab 9 x 4 x 3,
+#: then slid 4 along it; mu = 0.3): Puso & Laursen 2004 (CMAME 193, 601-629, example 2;
+#: report https://www.osti.gov/servlets/purl/15013715), whose data the LLNL Smith example
+#: ``die-on-slab`` restates. Its force histories are published as curves only; no digitised
+#: values were reachable, so there is no reference to compare with yet (TODO).
+IRONING_3D = {
+    "source": "Puso & Laursen 2004, CMAME 193:601-629, example 2 (ironing)",
+    "data_from": "LLNL Smith examples/die-on-slab (README and source)",
+    "status": "TODO: force histories published as curves only; no digitised values found",
+    "forces": {},
+}

@@ -30,6 +30,7 @@ __all__ = [
     "hertz_3d_errors",
     "hertz_3d_run",
     "history_at",
+    "ironing_3d_run",
     "ironing_run",
     "shear_error",
     "slave_point_weights",
@@ -197,6 +198,70 @@ def history_at(history: list[dict], t: float, key: str) -> float:
     """|``key``| of the records, interpolated linearly in pseudo-time at ``t``."""
     times = np.array([r["time"] for r in history])
     return float(np.interp(t, times, [abs(r[key]) for r in history]))
+
+
+def ironing_3d_run(
+    mu: float,
+    h_die: float = 0.3,
+    h_slab: float = 0.5,
+    press_steps: int = 10,
+    slide_steps: int = 40,
+    slide: float = 4.0,
+    t_end: float = 2.0,
+    verbose: bool = False,
+) -> tuple[dict, ContactProblem]:
+    """The 3D ironing problem of :func:`~contact_ufl.verification.scenes.ironing_3d`: the
+    die pressed 1.4 into the slab (t = 0 to 1), then slid ``slide`` along it (t = 1 to 2),
+    the slide stopped at ``t_end`` (in ``slide_steps`` steps); one record per converged step.
+
+    Returns ``{"mu", "history", "cutbacks", ...}`` with history records ``time``, ``Fx``,
+    ``Fy``, ``Fz`` (the force of the support on the die's top, which balances the contact
+    force), ``newton_iterations``, ``residual``, ``snes_reason``, ``converged``,
+    ``contact_normal`` and ``contact_friction`` (:func:`contact_force_parts`),
+    ``top_displacement``, ``stored_energy`` and ``dissipation``, as :func:`ironing_run`;
+    and the problem.
+    """
+    scene = scenes.ironing_3d(mu=mu, h_die=h_die, h_slab=h_slab, slide=slide)
+    problem = ContactProblem(scene, verbose=verbose, petsc_options={"snes_max_it": 40})
+    top = scene.tags["die_top"]
+    (driven,) = [d for d in scene.dirichlet if d.tag == top]
+    history = []
+
+    def record(problem, step):
+        F = problem.reaction(top)
+        normal, frictional = contact_force_parts(problem)
+        history.append(
+            {
+                "time": step.t,
+                "Fx": float(F[0]),
+                "Fy": float(F[1]),
+                "Fz": float(F[2]),
+                "newton_iterations": step.newton_iterations,
+                "residual": float(step.residual),
+                "snes_reason": step.reason,
+                "converged": step.reason.startswith("CONVERGED"),
+                "contact_normal": normal.tolist(),
+                "contact_friction": frictional.tolist(),
+                "top_displacement": evaluate(driven.value, step.t).tolist(),
+                "stored_energy": stored_energy(problem),
+                "dissipation": frictional_dissipation(problem),
+            }
+        )
+
+    problem.solve(num_steps=press_steps, t_end=1.0, callback=record)
+    if slide_steps > 0:
+        problem.solve(num_steps=slide_steps, t_end=t_end, callback=record)
+    run = {
+        "mu": mu,
+        "h_die": h_die,
+        "h_slab": h_slab,
+        "unknowns": problem.layout.global_size,
+        "history": history,
+        "cutbacks": [
+            {"time": c.t, "reason": c.reason, "why": c.why} for c in problem.history.cutbacks
+        ],
+    }
+    return run, problem
 
 
 # -- 3D Hertz -----------------------------------------------------------------------------------
