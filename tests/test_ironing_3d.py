@@ -11,12 +11,12 @@ force, and the pressing force grows with the depth.
 import numpy as np
 import pytest
 
+from contact_ufl.verification.literature import IRONING_3D
+from contact_ufl.verification.runs import ironing_3d_run
+
 # the scene is a first step of issue 13's 3D ironing (pressing only, no published numbers
 # yet): kept out of the default suite (about two minutes); run with -m slow
 pytestmark = pytest.mark.slow
-
-from contact_ufl.verification.literature import IRONING_3D
-from contact_ufl.verification.runs import ironing_3d_run
 
 QUICK = dict(h_die=0.6, h_slab=0.75)
 
