@@ -107,6 +107,7 @@ class VolumeConstraint:
         self.scale = scale
         self.block: int | None = None
         self._value = 0.0
+        self._resultant_forms = None
         self.set_time(0.0)
 
     # -- what the problem assembles -------------------------------------------------------
@@ -163,16 +164,13 @@ class VolumeConstraint:
         return self._value
 
     def load_resultant(self) -> np.ndarray:
-        """Resultant ``int p a dA`` of the pressure (all ranks)."""
-        mesh = self.P.mesh
-        forms = [
-            dolfinx.fem.form(
-                pressure_virtual_work(
-                    self.bulk.u, ufl.as_vector(np.eye(self.gdim)[i]), self.bulk.n0, self.p
-                )
-                * self.bulk.dx(self.control.tag)
-            )
-            for i in range(self.gdim)
-        ]
-        local = [dolfinx.fem.assemble_scalar(f) for f in forms]
-        return mesh.comm.allreduce(np.asarray(local), MPI.SUM)
+        """Resultant ``int p a dA`` of the pressure (all ranks; its forms compiled once)."""
+        if self._resultant_forms is None:
+            u, n0, dx = self.bulk.u, self.bulk.n0, self.bulk.dx(self.control.tag)
+            e = np.eye(self.gdim)
+            self._resultant_forms = [
+                dolfinx.fem.form(pressure_virtual_work(u, ufl.as_vector(e[i]), n0, self.p) * dx)
+                for i in range(self.gdim)
+            ]
+        local = [dolfinx.fem.assemble_scalar(f) for f in self._resultant_forms]
+        return self.P.mesh.comm.allreduce(np.asarray(local), MPI.SUM)

@@ -66,6 +66,12 @@ def _nonempty(form: ufl.Form) -> ufl.Form | None:
     return None if form.empty() else form
 
 
+def _zero_form(v: ufl.Argument, dx: ufl.Measure) -> ufl.Form:
+    """A zero linear form in ``v`` (an empty block of a blocked form)."""
+    component = v[0] if v.ufl_shape else v
+    return dolfinx.fem.Constant(v.ufl_function_space().mesh, 0.0) * component * dx
+
+
 class ContactProblem:
     """Quasi-static large-deformation contact of the bodies of a scene.
 
@@ -230,7 +236,9 @@ class ContactProblem:
     def _build_forms(self) -> None:
         tests = [ufl.TestFunction(b.V) for b in self.bulks]
         residuals = [b.residual(v) for b, v in zip(self.bulks, tests, strict=True)]
-        contact_residuals: list = [0] * len(self.bulks)
+        # the contact terms alone (a zero form where a block has none: a blocked form needs
+        # every block)
+        contact_residuals = [_zero_form(v, b.dx) for b, v in zip(self.bulks, tests, strict=True)]
         fields = [b.u for b in self.bulks]
         unknowns = list(fields)
         for control in self.controls:
@@ -247,8 +255,7 @@ class ContactProblem:
             unknowns += c.unknowns
         for control in self.controls:
             residuals += control.residuals()
-            q, mesh = ufl.TestFunction(control.P), control.P.mesh
-            contact_residuals += [dolfinx.fem.Constant(mesh, 0.0) * q * control.bulk.dx]
+            contact_residuals += [_zero_form(ufl.TestFunction(control.P), control.bulk.dx)]
             fields += control.fields
             unknowns += control.unknowns
             control.block = len(unknowns) - 1
@@ -259,14 +266,7 @@ class ContactProblem:
         ]
         entity_maps = [c.slave.entity_map for c in self.contacts]
         self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
-        zero = [  # an empty block of the blocked form: a zero form over its mesh
-            dolfinx.fem.Constant(b.V.mesh, 0.0) * v[0] * b.dx
-            for b, v in zip(self.bulks, tests, strict=True)
-        ]
-        self._contact_residual_ufl = [
-            r if r != 0 else zero[k] if k < len(zero) else r
-            for k, r in enumerate(contact_residuals)
-        ]
+        self._contact_residual_ufl = contact_residuals
         self._contact_residual_form = None
         self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
         self.full_layout = StackedLayout([f.function_space for f in fields])

@@ -87,6 +87,47 @@ def shear_error(problem, exact: CattaneoMindlin2D, pair: int = 0) -> float:
     return float(rms / (exact.mu * exact.hertz.p0))
 
 
+def _driven_run(scene, top_name: str, stages, verbose: bool) -> tuple[dict, ContactProblem]:
+    """Solve ``scene`` through the load ``stages`` (``(num_steps, t_end)`` each), recording
+    per converged step the force of the support ``top_name`` (the driven top of an
+    indenter; ``Fx, Fy[, Fz]``), the Newton data, the parts of the contact force, the top's
+    prescribed displacement, the stored energy and the step's dissipation."""
+    problem = ContactProblem(scene, verbose=verbose, petsc_options={"snes_max_it": 40})
+    top = scene.tags[top_name]
+    (driven,) = [d for d in scene.dirichlet if d.tag == top]
+    history = []
+
+    def record(problem, step):
+        F = problem.reaction(top)
+        normal, frictional = contact_force_parts(problem)
+        history.append(
+            {
+                "time": step.t,
+                **{f"F{axis}": float(f) for axis, f in zip("xyz", F, strict=False)},
+                "newton_iterations": step.newton_iterations,
+                "residual": float(step.residual),
+                "snes_reason": step.reason,
+                "converged": step.reason.startswith("CONVERGED"),
+                "contact_normal": normal.tolist(),
+                "contact_friction": frictional.tolist(),
+                "top_displacement": evaluate(driven.value, step.t).tolist(),
+                "stored_energy": stored_energy(problem),
+                "dissipation": frictional_dissipation(problem),
+            }
+        )
+
+    for num_steps, t_end in stages:
+        problem.solve(num_steps=num_steps, t_end=t_end, callback=record)
+    run = {
+        "unknowns": problem.layout.global_size,
+        "history": history,
+        "cutbacks": [
+            {"time": c.t, "reason": c.reason, "why": c.why} for c in problem.history.cutbacks
+        ],
+    }
+    return run, problem
+
+
 def ironing_run(
     mu: float,
     h_punch: float = 0.025,
@@ -109,44 +150,9 @@ def ironing_run(
     ``stored_energy`` and ``dissipation`` (of the step), and the problem.
     """
     scene = scenes.ironing(mu=mu, h_punch=h_punch, h_block=h_block)
-    problem = ContactProblem(scene, verbose=verbose, petsc_options={"snes_max_it": 40})
-    top = scene.tags["punch_top"]
-    (driven,) = [d for d in scene.dirichlet if d.tag == top]
-    history = []
-
-    def record(problem, step):
-        F = problem.reaction(top)
-        normal, frictional = contact_force_parts(problem)
-        history.append(
-            {
-                "time": step.t,
-                "Fx": float(F[0]),
-                "Fy": float(F[1]),
-                "newton_iterations": step.newton_iterations,
-                "residual": float(step.residual),
-                "snes_reason": step.reason,
-                "converged": step.reason.startswith("CONVERGED"),
-                "contact_normal": normal.tolist(),
-                "contact_friction": frictional.tolist(),
-                "top_displacement": evaluate(driven.value, step.t).tolist(),
-                "stored_energy": stored_energy(problem),
-                "dissipation": frictional_dissipation(problem),
-            }
-        )
-
-    problem.solve(num_steps=press_steps, t_end=1.0, callback=record)
-    problem.solve(num_steps=slide_steps, t_end=2.0, callback=record)
-    run = {
-        "mu": mu,
-        "h_punch": h_punch,
-        "h_block": h_block,
-        "unknowns": problem.layout.global_size,
-        "history": history,
-        "cutbacks": [
-            {"time": c.t, "reason": c.reason, "why": c.why} for c in problem.history.cutbacks
-        ],
-    }
-    return run, problem
+    stages = [(press_steps, 1.0), (slide_steps, 2.0)]
+    run, problem = _driven_run(scene, "punch_top", stages, verbose)
+    return {"mu": mu, "h_punch": h_punch, "h_block": h_block, **run}, problem
 
 
 def steady_ratio(
@@ -222,46 +228,9 @@ def ironing_3d_run(
     and the problem.
     """
     scene = scenes.ironing_3d(mu=mu, h_die=h_die, h_slab=h_slab, slide=slide)
-    problem = ContactProblem(scene, verbose=verbose, petsc_options={"snes_max_it": 40})
-    top = scene.tags["die_top"]
-    (driven,) = [d for d in scene.dirichlet if d.tag == top]
-    history = []
-
-    def record(problem, step):
-        F = problem.reaction(top)
-        normal, frictional = contact_force_parts(problem)
-        history.append(
-            {
-                "time": step.t,
-                "Fx": float(F[0]),
-                "Fy": float(F[1]),
-                "Fz": float(F[2]),
-                "newton_iterations": step.newton_iterations,
-                "residual": float(step.residual),
-                "snes_reason": step.reason,
-                "converged": step.reason.startswith("CONVERGED"),
-                "contact_normal": normal.tolist(),
-                "contact_friction": frictional.tolist(),
-                "top_displacement": evaluate(driven.value, step.t).tolist(),
-                "stored_energy": stored_energy(problem),
-                "dissipation": frictional_dissipation(problem),
-            }
-        )
-
-    problem.solve(num_steps=press_steps, t_end=1.0, callback=record)
-    if slide_steps > 0:
-        problem.solve(num_steps=slide_steps, t_end=t_end, callback=record)
-    run = {
-        "mu": mu,
-        "h_die": h_die,
-        "h_slab": h_slab,
-        "unknowns": problem.layout.global_size,
-        "history": history,
-        "cutbacks": [
-            {"time": c.t, "reason": c.reason, "why": c.why} for c in problem.history.cutbacks
-        ],
-    }
-    return run, problem
+    stages = [(press_steps, 1.0)] + ([(slide_steps, t_end)] if slide_steps > 0 else [])
+    run, problem = _driven_run(scene, "die_top", stages, verbose)
+    return {"mu": mu, "h_die": h_die, "h_slab": h_slab, **run}, problem
 
 
 # -- 3D Hertz -----------------------------------------------------------------------------------
