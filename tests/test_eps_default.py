@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from contact_ufl.materials import LinearElastic
 from contact_ufl.mpi import global_diameter
 from contact_ufl.problem import ContactProblem
 from contact_ufl.verification import scenes
@@ -51,3 +52,37 @@ def test_default_eps_gives_the_same_solution():
     ]
     assert abs(peak[1] / peak[0] - 1.0) < 2e-4
     assert np.isfinite(F1) and F1 > 0
+
+
+def linear_hertz(h_contact: float, eps_N: float | None = None):
+    """The 2D Hertz scene with a linear elastic bulk and ``eps_N`` (``None``: the default)."""
+    scene = scenes.hertz_2d(h_contact=h_contact, depth=0.02).scene
+    scene.bodies = [
+        dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
+        for b in scene.bodies
+    ]
+    scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=eps_N)
+    return solved(scene)
+
+
+@pytest.mark.serial
+def test_newton_per_step_does_not_grow_under_refinement():
+    """2D Hertz (linear elastic, one load step) with the default eps on three meshes
+    (a / h ~ 2.5, 5, 10, 3k to 26k unknowns): Newton needs 6, 9, 8 iterations (measured;
+    the scenes' eps = E / h needs 29, 7, 14: at a / h = 2.5 the full-step Newton cycles
+    through 0, 40, 16 active points until the line search takes over). The finest mesh
+    needs no more than the coarser ones, and every mesh at most 10 (issue 12's target).
+    On the finest, 10 eps and eps / 10 give the default's contact force to 2e-5 (measured
+    3.4e-6 and 3.5e-7): the result does not depend on eps."""
+    problems = [linear_hertz(h) for h in (0.02, 0.01, 0.005)]
+    its = [max(s.newton_iterations for s in p.history.steps) for p in problems]
+    assert all(len(p.history.cutbacks) == 0 for p in problems)
+    assert max(its) <= 10, its
+    assert its[-1] <= max(its[:-1]), its
+    finest = problems[-1]
+    eps = float(finest.contacts[0].normal.eps_N.value)
+    F = finest.contact_force()[1]
+    for factor in (10.0, 0.1):
+        other = linear_hertz(0.005, factor * eps)
+        assert max(s.newton_iterations for s in other.history.steps) <= 10
+        assert abs(other.contact_force()[1] / F - 1.0) < 2e-5

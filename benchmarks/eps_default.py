@@ -1,0 +1,168 @@
+"""The default augmentation parameter under refinement (issue 12, item 3).
+
+The default ``eps_N = E / L`` (E the softer body's Young's modulus, L the diameter of the
+slave surface; ``eps_T = eps_N``) is a length of the scene, not of the mesh. This benchmark
+shows on a sequence of meshes that with it
+
+* the Newton iterations per load step do not grow under refinement, and
+* the result does not depend on eps: the same scene solved with ``10 eps`` and ``eps / 10``
+  gives the contact force and the peak multiplier of the default.
+
+Scenes (small-strain :class:`~contact_ufl.materials.LinearElastic` bulk, one load step):
+
+* ``--dim 2``: the plane-strain Hertz half disc on a block
+  (:func:`contact_ufl.verification.scenes.hertz_2d`, depth 0.02), ``h_contact`` from 0.02
+  down to 0.0025 (to 0.005 with ``--quick``);
+* ``--dim 3``: the quarter ball on a block (:func:`contact_ufl.verification.scenes.hertz_3d`,
+  depth 0.01), ``h_contact`` from 0.05 down to 0.01 (to 0.025 with ``--quick``).
+
+``--degree 2`` solves with P2 displacements (``ContactProblem(degree=2)``), once the contact
+terms accept them.
+
+    python benchmarks/eps_default.py --json benchmarks/results/eps_default_2d.json
+    python benchmarks/eps_default.py --dim 3 --json benchmarks/results/eps_default_3d.json
+
+Records, one per mesh and eps: ``dim``, ``degree``, ``h_contact``, ``dofs``, ``eps_factor``
+(1 for the default, 10 or 0.1), ``eps_N``, ``newton_max``, ``newton_mean`` (iterations per
+load step), ``steps``, ``cutbacks``, ``force`` (the contact force's component along the
+approach; 3D: the quarter model's), ``p0`` (the peak of the Hertz profile fitted to the
+computed pressure), ``p0_error`` (against Hertz's peak pressure under the computed force),
+``peak`` (the largest nodal multiplier), ``force_change``, ``p0_change``, ``peak_change``
+(relative to the default's on the same mesh), ``wall_s``, ``ranks``.
+"""
+
+import argparse
+import dataclasses
+import json
+import time
+
+from mpi4py import MPI
+
+from contact_ufl.materials import LinearElastic
+from contact_ufl.problem import ContactProblem
+from contact_ufl.results import contact_samples
+from contact_ufl.verification import scenes
+from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
+from contact_ufl.verification.runs import hertz_3d_errors
+
+MESHES = {2: [0.02, 0.01, 0.005, 0.0025], 3: [0.05, 0.035, 0.025, 0.0175, 0.0125, 0.01]}
+QUICK = {2: [0.02, 0.01, 0.005], 3: [0.05, 0.035, 0.025]}
+EPS_FACTORS = (1.0, 10.0, 0.1)
+STEPS = 1
+
+
+def hertz_scene(dim: int, h: float):
+    """The Hertz scene of dimension ``dim`` with a linear elastic bulk and no ``eps_N`` given
+    (the default), and its analytic data."""
+    if dim == 2:
+        hertz = scenes.hertz_2d(h_contact=h, depth=0.02)
+        hertz.scene.bodies = [
+            dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
+            for b in hertz.scene.bodies
+        ]
+    else:
+        hertz = scenes.hertz_3d(h_contact=h, depth=0.01)
+    scene = hertz.scene
+    scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=None)
+    return hertz
+
+
+def fitted_p0(problem: ContactProblem, hertz) -> tuple[float, float]:
+    """The peak of the Hertz profile fitted to the computed pressure, and its error against
+    Hertz's peak under the computed force (2D: :func:`fit_elliptic_profile`; 3D:
+    :func:`hertz_3d_errors`)."""
+    if problem.gdim == 2:
+        samples = contact_samples(problem)
+        _, p0, _ = fit_elliptic_profile(samples.x[:, 0], samples.pressure)
+        exact = Hertz2D(problem.contact_force()[1], hertz.radius, hertz.E_star).p0
+        return p0, p0 / exact - 1.0
+    errors = hertz_3d_errors(problem, hertz)
+    return errors["p0"] * (1.0 + errors["p0_error"]), errors["p0_error"]
+
+
+def run(dim: int, h: float, degree: int, eps_factor: float, eps_default: float | None):
+    """Solve one mesh with ``eps_N = eps_factor * eps_default`` (``None``: the default)."""
+    hertz = hertz_scene(dim, h)
+    scene = hertz.scene
+    if eps_default is not None:
+        scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=eps_factor * eps_default)
+    problem = ContactProblem(scene, degree=degree, verbose=False)
+    start = time.perf_counter()
+    problem.solve(num_steps=STEPS)
+    wall = time.perf_counter() - start
+    newton = [s.newton_iterations for s in problem.history.steps]
+    c = problem.contacts[0]
+    force = float(problem.contact_force()[dim - 1])
+    peak = problem.comm.allreduce(c.normal.lambda_N.x.array.max(initial=0.0), op=MPI.MAX)
+    p0, p0_error = fitted_p0(problem, hertz)
+    return {
+        "dim": dim,
+        "degree": degree,
+        "h_contact": h,
+        "dofs": problem.layout.global_size,
+        "eps_factor": eps_factor,
+        "eps_N": float(c.normal.eps_N.value),
+        "newton_max": max(newton),
+        "newton_mean": sum(newton) / len(newton),
+        "steps": len(newton),
+        "cutbacks": len(problem.history.cutbacks),
+        "force": force,
+        "p0": p0,
+        "p0_error": p0_error,
+        "peak": peak,
+        "wall_s": wall,
+        "ranks": problem.comm.size,
+    }
+
+
+def mesh_records(dim: int, h: float, degree: int) -> list[dict]:
+    """The default and the scaled eps on one mesh, with the changes against the default."""
+    default = run(dim, h, degree, 1.0, None)
+    records = [default]
+    for factor in EPS_FACTORS[1:]:
+        records.append(run(dim, h, degree, factor, default["eps_N"]))
+    for r in records:
+        r["force_change"] = r["force"] / default["force"] - 1.0
+        r["p0_change"] = r["p0"] / default["p0"] - 1.0
+        r["peak_change"] = r["peak"] / default["peak"] - 1.0
+    return records
+
+
+HEADER = (
+    f"{'h':>7} {'dofs':>7} {'eps/def':>7} {'eps_N':>8} {'its max':>7} {'mean':>5} "
+    f"{'force':>12} {'p0':>10} {'p0 err':>8} {'dF':>9} {'dp0':>9} {'dpeak':>9} {'wall':>6}"
+)
+
+
+def row(r: dict) -> str:
+    return (
+        f"{r['h_contact']:7g} {r['dofs']:7d} {r['eps_factor']:7g} {r['eps_N']:8.3g} "
+        f"{r['newton_max']:7d} {r['newton_mean']:5.1f} {r['force']:12.6e} {r['p0']:10.4e} "
+        f"{r['p0_error']:8.1e} {r['force_change']:9.1e} {r['p0_change']:9.1e} "
+        f"{r['peak_change']:9.1e} {r['wall_s']:6.1f}"
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--json", required=True, help="output file")
+    parser.add_argument("--quick", action="store_true", help="three meshes")
+    parser.add_argument("--degree", type=int, choices=(1, 2), default=1)
+    parser.add_argument("--dim", type=int, choices=(2, 3), default=2)
+    args = parser.parse_args()
+    rank0 = MPI.COMM_WORLD.rank == 0
+    if rank0:
+        print(f"Hertz {args.dim}D, P{args.degree}, {STEPS} load step(s)\n{HEADER}", flush=True)
+    records = []
+    for h in (QUICK if args.quick else MESHES)[args.dim]:
+        for r in mesh_records(args.dim, h, args.degree):
+            records.append(r)
+            if rank0:
+                print(row(r), flush=True)
+    if rank0:
+        with open(args.json, "w") as f:
+            json.dump(records, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
