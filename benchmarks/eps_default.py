@@ -6,7 +6,10 @@ shows on a sequence of meshes that with it
 
 * the Newton iterations per load step do not grow under refinement, and
 * the result does not depend on eps: the same scene solved with ``10 eps`` and ``eps / 10``
-  gives the contact force and the peak multiplier of the default.
+  gives the contact force and the peak pressure of the default, to differences that live
+  in the elements cut by the edge of the contact zone and fall under refinement;
+
+and, for comparison, the same with the scenes' own ``eps_N = E / h_contact``.
 
 Scenes (small-strain :class:`~contact_ufl.materials.LinearElastic` bulk, one load step):
 
@@ -22,13 +25,16 @@ terms accept them.
     python benchmarks/eps_default.py --json benchmarks/results/eps_default_2d.json
     python benchmarks/eps_default.py --dim 3 --json benchmarks/results/eps_default_3d.json
 
-Records, one per mesh and eps: ``dim``, ``degree``, ``h_contact``, ``dofs``, ``eps_factor``
-(1 for the default, 10 or 0.1), ``eps_N``, ``newton_max``, ``newton_mean`` (iterations per
-load step), ``steps``, ``cutbacks``, ``force`` (the contact force's component along the
-approach; 3D: the quarter model's), ``p0`` (the peak of the Hertz profile fitted to the
-computed pressure), ``p0_error`` (against Hertz's peak pressure under the computed force),
-``peak`` (the largest nodal multiplier), ``force_change``, ``p0_change``, ``peak_change``
-(relative to the default's on the same mesh), ``wall_s``, ``ranks``.
+Records, one per mesh and eps: ``dim``, ``degree``, ``h_contact``, ``dofs``, ``eps`` (the
+case, :data:`EPS_CASES`), ``eps_factor`` (``eps_N`` over the default's), ``eps_N``,
+``newton_max``, ``newton_mean`` (iterations per load step), ``steps``, ``cutbacks``,
+``force`` (the contact force's component along the approach; 3D: the quarter model's),
+``p0`` (the peak of the Hertz profile fitted to the computed pressure), ``p0_error``
+(against Hertz's peak pressure under the computed force), ``peak`` (the largest nodal
+multiplier), ``force_change``, ``p0_change``, ``peak_change`` (relative to the default's on
+the same mesh), ``wall_s``, ``ranks``, ``iterates`` (per Newton iterate of all tries:
+iterate, residual norm, slave points in contact, points that changed status since the
+previous iterate; see :func:`trace_iterates`).
 """
 
 import argparse
@@ -36,6 +42,7 @@ import dataclasses
 import json
 import time
 
+import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.materials import LinearElastic
@@ -47,24 +54,23 @@ from contact_ufl.verification.runs import hertz_3d_errors
 
 MESHES = {2: [0.02, 0.01, 0.005, 0.0025], 3: [0.05, 0.035, 0.025, 0.0175, 0.0125, 0.01]}
 QUICK = {2: [0.02, 0.01, 0.005], 3: [0.05, 0.035, 0.025]}
-EPS_FACTORS = (1.0, 10.0, 0.1)
+EPS_CASES = ("default", "10 default", "default / 10", "E / h")
+"""The eps of the runs on each mesh: the default, ten times it, a tenth of it, and the
+scenes' own ``E / h_contact`` (for comparison: the eps that grows under refinement)."""
 STEPS = 1
 
 
 def hertz_scene(dim: int, h: float):
-    """The Hertz scene of dimension ``dim`` with a linear elastic bulk and no ``eps_N`` given
-    (the default), and its analytic data."""
+    """The Hertz scene of dimension ``dim`` with a linear elastic bulk (its ``eps_N`` the
+    scene's ``E / h_contact``), and its analytic data."""
     if dim == 2:
         hertz = scenes.hertz_2d(h_contact=h, depth=0.02)
         hertz.scene.bodies = [
             dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
             for b in hertz.scene.bodies
         ]
-    else:
-        hertz = scenes.hertz_3d(h_contact=h, depth=0.01)
-    scene = hertz.scene
-    scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=None)
-    return hertz
+        return hertz
+    return scenes.hertz_3d(h_contact=h, depth=0.01)
 
 
 def fitted_p0(problem: ContactProblem, hertz) -> tuple[float, float]:
@@ -80,18 +86,42 @@ def fitted_p0(problem: ContactProblem, hertz) -> tuple[float, float]:
     return errors["p0"] * (1.0 + errors["p0_error"]), errors["p0_error"]
 
 
-def run(dim: int, h: float, degree: int, eps_factor: float, eps_default: float | None):
-    """Solve one mesh with ``eps_N = eps_factor * eps_default`` (``None``: the default)."""
+def trace_iterates(problem: ContactProblem) -> list[list]:
+    """Record, at every Newton iterate of the problem's solves (all tries), ``[iterate,
+    residual norm, slave points in contact, points that changed status since the previous
+    iterate]`` (summed over the ranks; -1 changed at the first iterate). Returns the list
+    the records go to."""
+    trace, previous = [], []
+    c = problem.contacts[0]
+
+    def monitor(snes, its, norm):
+        active = c.active()
+        changed = int((active != previous[0]).sum()) if previous else 0
+        previous[:] = [active]
+        counts = problem.comm.allreduce(np.array([active.sum(), changed]), op=MPI.SUM)
+        trace.append([its, float(norm), int(counts[0]), int(counts[1]) if trace else -1])
+
+    problem.solver.snes.setMonitor(monitor)  # in addition to the solver's own
+    return trace
+
+
+def run(dim: int, h: float, degree: int, case: str, eps_default: float | None) -> dict:
+    """Solve one mesh with the eps of ``case`` (:data:`EPS_CASES`; ``eps_default`` the
+    default's value on this mesh, unknown for ``"default"`` itself)."""
     hertz = hertz_scene(dim, h)
     scene = hertz.scene
-    if eps_default is not None:
-        scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=eps_factor * eps_default)
+    if case != "E / h":
+        eps = {"default": None, "10 default": 10.0, "default / 10": 0.1}[case]
+        eps = eps and eps * eps_default
+        scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=eps)
     problem = ContactProblem(scene, degree=degree, verbose=False)
+    trace = trace_iterates(problem)
     start = time.perf_counter()
     problem.solve(num_steps=STEPS)
     wall = time.perf_counter() - start
     newton = [s.newton_iterations for s in problem.history.steps]
     c = problem.contacts[0]
+    eps_N = float(c.normal.eps_N.value)
     force = float(problem.contact_force()[dim - 1])
     peak = problem.comm.allreduce(c.normal.lambda_N.x.array.max(initial=0.0), op=MPI.MAX)
     p0, p0_error = fitted_p0(problem, hertz)
@@ -100,8 +130,9 @@ def run(dim: int, h: float, degree: int, eps_factor: float, eps_default: float |
         "degree": degree,
         "h_contact": h,
         "dofs": problem.layout.global_size,
-        "eps_factor": eps_factor,
-        "eps_N": float(c.normal.eps_N.value),
+        "eps": case,
+        "eps_factor": 1.0 if eps_default is None else eps_N / eps_default,
+        "eps_N": eps_N,
         "newton_max": max(newton),
         "newton_mean": sum(newton) / len(newton),
         "steps": len(newton),
@@ -112,15 +143,15 @@ def run(dim: int, h: float, degree: int, eps_factor: float, eps_default: float |
         "peak": peak,
         "wall_s": wall,
         "ranks": problem.comm.size,
+        "iterates": trace,
     }
 
 
 def mesh_records(dim: int, h: float, degree: int) -> list[dict]:
-    """The default and the scaled eps on one mesh, with the changes against the default."""
-    default = run(dim, h, degree, 1.0, None)
+    """The runs of :data:`EPS_CASES` on one mesh, with the changes against the default."""
+    default = run(dim, h, degree, "default", None)
     records = [default]
-    for factor in EPS_FACTORS[1:]:
-        records.append(run(dim, h, degree, factor, default["eps_N"]))
+    records += [run(dim, h, degree, case, default["eps_N"]) for case in EPS_CASES[1:]]
     for r in records:
         r["force_change"] = r["force"] / default["force"] - 1.0
         r["p0_change"] = r["p0"] / default["p0"] - 1.0
@@ -129,14 +160,15 @@ def mesh_records(dim: int, h: float, degree: int) -> list[dict]:
 
 
 HEADER = (
-    f"{'h':>7} {'dofs':>7} {'eps/def':>7} {'eps_N':>8} {'its max':>7} {'mean':>5} "
+    f"{'h':>7} {'dofs':>7} {'eps':>12} {'eps/def':>7} {'eps_N':>8} {'its max':>7} {'mean':>5} "
     f"{'force':>12} {'p0':>10} {'p0 err':>8} {'dF':>9} {'dp0':>9} {'dpeak':>9} {'wall':>6}"
 )
 
 
 def row(r: dict) -> str:
     return (
-        f"{r['h_contact']:7g} {r['dofs']:7d} {r['eps_factor']:7g} {r['eps_N']:8.3g} "
+        f"{r['h_contact']:7g} {r['dofs']:7d} {r['eps']:>12} {r['eps_factor']:7.3g} "
+        f"{r['eps_N']:8.3g} "
         f"{r['newton_max']:7d} {r['newton_mean']:5.1f} {r['force']:12.6e} {r['p0']:10.4e} "
         f"{r['p0_error']:8.1e} {r['force_change']:9.1e} {r['p0_change']:9.1e} "
         f"{r['peak_change']:9.1e} {r['wall_s']:6.1f}"
