@@ -32,6 +32,7 @@ CAUSES = {
     "inverted elements": "inverted elements",
     "active-set cycling": "active-set cycling",
     "limit point": "limit point",
+    "status changing in": "slow, contact state changing",
 }
 """Short names of the diagnoses of :meth:`contact_ufl.newton.NewtonSolver.diagnose`, by a
 text each contains."""

@@ -119,3 +119,39 @@ def test_inverted_cells_counts_cells_turned_inside_out():
     straddling = int(((vertices.min(axis=1) < 0.5) & (vertices.max(axis=1) > 0.5)).sum())
     count = inverted_cells(problem)
     assert inside > 0 and inside <= count <= inside + straddling
+
+
+@pytest.mark.parametrize(
+    "iterates, expected",
+    [
+        ([(1e3, 1), (1e2, 2), (50.0, 3)], "fell from 1e+03 to 50 in 2 iterates, the contact "),
+        ([(1e3, 1), (1e2, 1)], "fell from 1e+03 to 100 in 1 iterates, no change of contact"),
+        ([(1.0, 4), (1.0, 4), (1.0, 4)], "a limit point"),
+        ([(1.0, 1), (1.0, 2), (1.0, 1)], "(active-set cycling)"),
+    ],
+)
+def test_diagnosis_of_the_iterates(iterates, expected):
+    """From the residual norms and contact-state signatures of a failed solve's iterates:
+    a return to an earlier state is cycling, no change at all a limit point, otherwise how
+    far the residual fell and in how many iterates the contact state changed."""
+    from contact_ufl.problem import ContactProblem
+    from contact_ufl.verification import scenes
+
+    problem = ContactProblem(scenes.hertz_2d_driven("force", 1.0, h_contact=0.1), verbose=False)
+    problem.solver.iterates = iterates
+    assert expected in problem.solver.diagnose()
+
+
+@pytest.mark.slow
+def test_quick_suite():
+    """The whole quick suite: every case runs as expected but the deep indentation with the
+    facet normal (a known stop, by active-set cycling), and every failed try says why."""
+    records = [hard_cases.run_case(case) for case in hard_cases.cases(quick=True)]
+    known = {"deep_indentation_h0.02_facet"}
+    assert all(r["as_expected"] for r in records if r["name"] not in known)
+    assert all(
+        not r["as_expected"] and r["status"] == "stopped" for r in records if r["name"] in known
+    )
+    failures = [f for r in records for f in r["failures"]]
+    assert all(f["why"] and f["reason"].startswith("DIVERGED") for f in failures)
+    assert all(r["cutbacks"] == len(r["failures"]) for r in records)
