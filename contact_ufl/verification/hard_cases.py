@@ -1,7 +1,10 @@
 """The hard-case suite (issue 13, item 7): runs that test the numerical stability of the
 solver, each reported by its steps, cut-backs, Newton iterations and, where a step failed,
-why (the SNES reasons of the failed tries; at the failed state the inverted elements, the
-contact points in contact and those whose status differs from the last accepted step).
+why (the SNES reasons and diagnoses of the failed tries: inverted elements, active-set
+cycling, a limit point; at the failed state the inverted elements, the contact points in
+contact and those whose status differs from the last accepted step). A case meant to stop
+(load control beyond a limit point) names the diagnosis it should stop with: its stop is
+recorded as ``"expected stop"``, not as a failure.
 
 :func:`cases` lists the cases (quick or full), :func:`run_case` runs one and returns its
 record (a ``dict`` ready for JSON); ``benchmarks/hard_cases.py`` runs them all.
