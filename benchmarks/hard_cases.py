@@ -62,16 +62,16 @@ def why(record: dict) -> str:
 def print_table(records: list[dict], header: bool = True) -> None:
     if header:
         print(
-            f"{'case':32} {'status':13} {'t':>6} {'steps':>5} {'cuts':>4} {'newton':>10} "
+            f"{'case':34} {'status':13} {'t':>6} {'steps':>5} {'cuts':>4} {'newton':>10} "
             f"{'all conv':>8} {'wall s':>7}  why"
         )
     for r in records:
         if r["status"] == "not implemented":
-            print(f"{r['name']:32} not implemented: {r['description']}")
+            print(f"{r['name']:34} not implemented: {r['description']}")
             continue
         newton = f"{r['newton_max']}/{r['newton_mean']:.1f}"
         print(
-            f"{r['name']:32} {r['status']:13} {r['t_reached']:6.3f} {r['steps']:5d} "
+            f"{r['name']:34} {r['status']:13} {r['t_reached']:6.3f} {r['steps']:5d} "
             f"{r['cutbacks']:4d} {newton:>10} {str(r['all_converged']):>8} "
             f"{r['wall_s']:7.1f}  {why(r)}"
         )
