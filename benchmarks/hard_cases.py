@@ -1,12 +1,20 @@
 """The hard-case suite (issue 13, item 7): every hard case that exists today, and the
 planned ones listed as not implemented.
 
+The cases: 2D ironing (mu = 0 and 0.3), the two-beam showcase (mu = 0 and 0.3), force-driven
+contact in 2D and 3D, deep indentation in 2D (and 3D in the full suite) with the facet and
+the smoothed master normal, a ring squeezed until its hole closes on itself (self-contact),
+and a balloon past its pressure maximum (a limit point): through it under volume control,
+and under load control, which is expected to stop there with a "limit point" diagnosis
+(``expected stop``, not a failure of the suite).
+
 For each case: steps, cut-backs, Newton iterations per accepted step (max and mean), whether
 every step converged (SNES's converged reasons), wall time, and, where a step failed, why:
 the SNES reason of every failed try, with the number of inverted cells (det F < 0), of
 contact points in contact and of those whose contact status differs from the last accepted
-step, at the failed state. A case stopped by a ``ConvergenceError`` is
-recorded as ``stopped`` with the error, not raised. See
+step, at the failed state, and the diagnosis (inverted elements, active-set cycling, a
+limit point). A case stopped by a ``ConvergenceError`` is recorded as ``stopped`` (or
+``expected stop``) with the error, not raised. See
 :mod:`contact_ufl.verification.hard_cases`.
 
     python benchmarks/hard_cases.py --json benchmarks/results/hard_cases.json [--quick]
@@ -20,14 +28,31 @@ from mpi4py import MPI
 
 from contact_ufl.verification.hard_cases import NOT_IMPLEMENTED, cases, run_case
 
+CAUSES = {
+    "inverted elements": "inverted elements",
+    "active-set cycling": "active-set cycling",
+    "limit point": "limit point",
+    "status changing in": "slow, contact state changing",
+}
+"""Short names of the diagnoses of :meth:`contact_ufl.newton.NewtonSolver.diagnose`, by a
+text each contains."""
+
+
+def cause(why: str) -> str:
+    """The short name of a failed try's diagnosis (``"no convergence"`` for the others)."""
+    return next((name for key, name in CAUSES.items() if key in why), "no convergence")
+
 
 def why(record: dict) -> str:
-    """The failed tries in one line: reason (count), and the most inverted cells seen."""
+    """The failed tries in one line: the diagnoses and reasons (count), the most inverted
+    cells and contact status changes seen."""
     failures = record["failures"]
     if not failures:
         return ""
+    causes = [cause(f["why"]) for f in failures]
     reasons = [f["reason"] for f in failures]
-    counts = ", ".join(f"{r} x{reasons.count(r)}" for r in sorted(set(reasons)))
+    counts = ", ".join(f"{r} x{causes.count(r)}" for r in sorted(set(causes)))
+    counts += " (" + ", ".join(f"{r} x{reasons.count(r)}" for r in sorted(set(reasons))) + ")"
     inverted = max(f["inverted_cells"] for f in failures)
     changes = [f["status_changes"] for f in failures if f["status_changes"] is not None]
     changed = f"; status changes <= {max(changes)}" if changes else ""
@@ -37,16 +62,16 @@ def why(record: dict) -> str:
 def print_table(records: list[dict], header: bool = True) -> None:
     if header:
         print(
-            f"{'case':26} {'status':10} {'t':>6} {'steps':>5} {'cuts':>4} {'newton':>10} "
+            f"{'case':34} {'status':13} {'t':>6} {'steps':>5} {'cuts':>4} {'newton':>10} "
             f"{'all conv':>8} {'wall s':>7}  why"
         )
     for r in records:
         if r["status"] == "not implemented":
-            print(f"{r['name']:26} not implemented: {r['description']}")
+            print(f"{r['name']:34} not implemented: {r['description']}")
             continue
         newton = f"{r['newton_max']}/{r['newton_mean']:.1f}"
         print(
-            f"{r['name']:26} {r['status']:10} {r['t_reached']:6.3f} {r['steps']:5d} "
+            f"{r['name']:34} {r['status']:13} {r['t_reached']:6.3f} {r['steps']:5d} "
             f"{r['cutbacks']:4d} {newton:>10} {str(r['all_converged']):>8} "
             f"{r['wall_s']:7.1f}  {why(r)}"
         )

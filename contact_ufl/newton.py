@@ -457,9 +457,13 @@ class NewtonSolver:
             self._state = None
 
     def _monitor(self, snes, its: int, norm: float) -> None:
-        """Record the residual norm and the contact state of each Newton iterate."""
+        """Record the residual norm and the contact state of each Newton iterate (the
+        pairing, the contact status and, with friction, the stick/slip status)."""
         state = [
-            np.concatenate([c.projection.facet, c.active().astype(np.int64)])
+            np.concatenate(
+                [c.projection.facet, c.active().astype(np.int64)]
+                + ([c.stick().astype(np.int64)] if c.friction else [])
+            )
             for c in self.problem.contacts
             if c.projection is not None
         ]
@@ -469,7 +473,8 @@ class NewtonSolver:
     def diagnose(self) -> str:
         """Why the last Newton solve failed, at its last iterate (collective): inverted
         elements (and where), contact pairing or status that cycles between iterates, or a
-        residual that stalls with neither (a limit point, or a singular tangent)."""
+        residual that stalls with neither (a limit point, or a singular tangent); otherwise
+        how far the residual fell and in how many iterates the contact state changed."""
         from contact_ufl.results import inverted_cell_centres
 
         centres = inverted_cell_centres(self.problem)
@@ -488,14 +493,27 @@ class NewtonSolver:
                 "the contact pairing or status cycles: an iterate returns to the contact state "
                 "of an earlier one (active-set cycling)"
             )
-        changes = sum(a != b for a, b in zip(signatures, signatures[1:], strict=False))
-        if self.comm.allreduce(changes, MPI.SUM) == 0 and len(signatures) > 2:
+        changed = np.array([a != b for a, b in zip(signatures, signatures[1:], strict=False)])
+        changes = int(np.count_nonzero(self.comm.allreduce(changed.astype(np.int64), MPI.SUM)))
+        if changes == 0 and len(signatures) > 2:
             return (
                 "the residual stalls with no inverted element and no change of contact state: "
                 "a limit point or a singular tangent (a load beyond a maximum, a body free "
                 "to move)"
             )
-        return "the residual does not converge (no inverted element, no contact cycling)"
+        norms = [r for r, _ in self.iterates]
+        state = (
+            f"the contact pairing or status changing in {changes} of them"
+            if changes
+            else "no change of contact state"
+        )
+        fell = (
+            f": it fell from {norms[0]:.3g} to {norms[-1]:.3g} in {len(norms) - 1} iterates, "
+            + state
+            if len(norms) > 1
+            else ""
+        )
+        return f"the residual does not converge (no inverted element, no contact cycling){fell}"
 
     def _newton(self) -> tuple[int, int]:
         """One SNES solve from :attr:`x`: converged reason and iterations."""

@@ -15,6 +15,7 @@ from contact_ufl.contact.search import release_master_side
 from contact_ufl.errors import ContactInputError
 from contact_ufl.problem import ContactProblem
 from contact_ufl.taylor import taylor_test
+from contact_ufl.verification import scenes
 from contact_ufl.verification.geometries import tag_single_body
 from contact_ufl.verification.taylor_cases import sliding_direction
 
@@ -414,41 +415,9 @@ def test_slot_closes_on_itself_in_3d():
 
 
 def _ring_problem(comm: MPI.Comm, depth: float = 0.8, steps: int = 10) -> ContactProblem:
-    """The half ring r in [0.75, 1], x >= 0 (4 x 40 quadrilaterals; u_x = 0 on the cut x = 0,
-    tag 1), squeezed between two rigid plates y = +-1 moved towards each other by ``depth``
-    each (frictionless pairs of the outer surface, tag 3): the hole flattens until its upper
-    and lower arcs meet across y = 0, a self-contact of the inner surface (tag 2)."""
-    ri, ro = 0.75, 1.0
-    mesh = dolfinx.mesh.create_rectangle(
-        comm,
-        [[0.0, 0.0], [1.0, 1.0]],
-        [4, 40],
-        dolfinx.mesh.CellType.quadrilateral,
-        ghost_mode=dolfinx.mesh.GhostMode.shared_facet,
-    )
-    s, t = mesh.geometry.x[:, 0].copy(), mesh.geometry.x[:, 1].copy()
-    r, theta = ri + s * (ro - ri), np.pi * (t - 0.5)
-    mesh.geometry.x[:, 0], mesh.geometry.x[:, 1] = r * np.cos(theta), r * np.sin(theta)
-    radius = lambda x: np.hypot(x[0], x[1])  # noqa: E731
-    cells, facets = tag_single_body(
-        mesh,
-        [
-            lambda x: np.isclose(x[0], 0.0),
-            lambda x: np.isclose(radius(x), ri),
-            lambda x: np.isclose(radius(x), ro),
-        ],
-    )
-    top = cu.RigidPlane((0.0, ro), (0.0, -1.0), motion=lambda t: (0.0, -depth * t))
-    bottom = cu.RigidPlane((0.0, -ro), (0.0, 1.0), motion=lambda t: (0.0, depth * t))
-    scene = cu.Scene(
-        mesh,
-        cells,
-        facets,
-        [cu.Body(1, cu.NeoHookean(1.0, 0.3))],
-        contacts=[cu.ContactPair(3, top), cu.ContactPair(3, bottom), cu.ContactPair(2, 2)],
-        dirichlet=[cu.Dirichlet(1, 0.0, component=0)],
-    )
-    problem = ContactProblem(scene, verbose=False)
+    """The half ring of :func:`~contact_ufl.verification.scenes.squeezed_ring` squeezed
+    between the plates until its hole closes, in ``steps`` steps."""
+    problem = ContactProblem(scenes.squeezed_ring(depth, comm=comm), verbose=False)
     problem.solve(num_steps=steps)
     return problem
 

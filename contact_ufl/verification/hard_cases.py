@@ -1,7 +1,10 @@
 """The hard-case suite (issue 13, item 7): runs that test the numerical stability of the
 solver, each reported by its steps, cut-backs, Newton iterations and, where a step failed,
-why (the SNES reasons of the failed tries; at the failed state the inverted elements, the
-contact points in contact and those whose status differs from the last accepted step).
+why (the SNES reasons and diagnoses of the failed tries: inverted elements, active-set
+cycling, a limit point; at the failed state the inverted elements, the contact points in
+contact and those whose status differs from the last accepted step). A case meant to stop
+(load control beyond a limit point) names the diagnosis it should stop with: its stop is
+recorded as ``"expected stop"``, not as a failure.
 
 :func:`cases` lists the cases (quick or full), :func:`run_case` runs one and returns its
 record (a ``dict`` ready for JSON); ``benchmarks/hard_cases.py`` runs them all.
@@ -16,11 +19,15 @@ from dataclasses import dataclass
 
 from mpi4py import MPI
 
+from contact_ufl.control import VolumeControl
 from contact_ufl.errors import ConvergenceError
+from contact_ufl.loads import FollowerPressure
 from contact_ufl.materials import NeoHookean
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import inverted_cells
+from contact_ufl.scene import Scene
 from contact_ufl.verification import scenes
+from contact_ufl.verification.analytic import sphere_inflation_neo_hookean
 
 FORCE_2D = 8e7
 """Resultant of the dead traction on the force-driven Hertz half disc (N per unit
@@ -28,9 +35,6 @@ thickness; a contact half-width of about 0.07)."""
 
 NOT_IMPLEMENTED = {
     "3d_large_sliding": "3D ironing (Puso & Laursen 2004), mu = 0 and 0.3 (issue 13, item 2)",
-    "self_contact": "a ring squeezed until its inner surface closes (issue 13, item 3)",
-    "limit_point": "path following past a snap-through (issue 13, item 4)",
-    "deep_indentation_3d": "the 3D Hertz sphere pressed to half its radius (issue 13, item 6)",
 }
 """Planned cases that do not exist yet, reported as ``"not implemented"``."""
 
@@ -49,12 +53,16 @@ class Case:
         Load stepping: ``(num_steps, t_end)`` of each call of :meth:`ContactProblem.solve`.
     max_cutbacks
         Cut-backs of one step before the run stops.
+    expected_stop
+        For a case meant to stop (e.g. load control beyond a limit point): a text the
+        diagnosis of its stop must contain (``None``: the case is meant to run to the end).
     """
 
     name: str
     build: Callable[[], ContactProblem]
     stages: list[tuple[int, float]]
     max_cutbacks: int = 8
+    expected_stop: str | None = None
 
 
 def _ironing(mu: float, h_punch: float, h_block: float) -> Callable[[], ContactProblem]:
@@ -139,9 +147,62 @@ def deep_indentation_3d(
     )
 
 
+def self_contact_ring(steps: int = 10) -> Case:
+    """The ring squeezed between two plates until its hole closes on itself
+    (:func:`~contact_ufl.verification.scenes.squeezed_ring`)."""
+    return Case("self_contact_ring", _problem(scenes.squeezed_ring), [(steps, 1.0)])
+
+
+BALLOON_STRETCH = 1.6
+"""Final stretch of the volume-controlled balloon, beyond the pressure maximum at
+``7^(1/6) = 1.383``."""
+
+
+def _balloon(load: object) -> Callable[[], ContactProblem]:
+    """The sphere octant of :func:`~contact_ufl.verification.scenes.inflated_sphere`
+    (Neo-Hookean membrane, ``mu = 1``, ``t0 = 0.01``, ``R = 1``) under ``load`` instead of its
+    pressure."""
+
+    def build() -> ContactProblem:
+        (domain,) = scenes.inflated_sphere(n=32).domains
+        scene = Scene(domains=[dataclasses.replace(domain, loads=[load])])
+        return ContactProblem(scene, verbose=False)
+
+    return build
+
+
+def balloon_pressure_maximum() -> float:
+    """The pressure maximum of the balloon of :func:`_balloon` (closed form)."""
+    return sphere_inflation_neo_hookean(1.0, 0.01, 1.0, 7.0 ** (1.0 / 6.0))
+
+
+def limit_point_volume_control(steps: int = 12) -> Case:
+    """The balloon inflated by its enclosed volume (:class:`~contact_ufl.control.VolumeControl`,
+    the pressure an unknown) to the stretch :data:`BALLOON_STRETCH`: through the pressure
+    maximum, every step converged."""
+    ratio = BALLOON_STRETCH**3 - 1.0
+    control = VolumeControl("membrane", lambda t: 1.0 + ratio * t)
+    return Case("limit_point_volume_control", _balloon(control), [(steps, 1.0)])
+
+
+def limit_point_load_control(steps: int = 4, max_cutbacks: int = 3) -> Case:
+    """The same balloon under a prescribed pressure 2% above its maximum: load control
+    cannot pass the maximum, the run is expected to stop with a "limit point" diagnosis."""
+    p_max = balloon_pressure_maximum()
+    pressure = FollowerPressure("membrane", lambda t: 1.02 * p_max * t)
+    return Case(
+        "limit_point_load_control",
+        _balloon(pressure),
+        [(steps, 1.0)],
+        max_cutbacks,
+        expected_stop="limit point",
+    )
+
+
 def cases(quick: bool = False) -> list[Case]:
     """The hard cases that exist today (``quick``: the ironing on coarse meshes, with
-    larger sliding steps, and the deep indentation on the coarser mesh only)."""
+    larger sliding steps, and the 2D deep indentation on the coarser mesh only; the
+    self-contact ring and the balloon past its limit point, fast, are in both)."""
     ironing_mesh = (0.05, 0.2, 100) if quick else (0.025, 0.1, 200)
     out = [
         Case(
@@ -172,6 +233,9 @@ def cases(quick: bool = False) -> list[Case]:
         if not quick:
             out.append(deep_indentation(0.01, 20, master_normal=normal))
             out.append(deep_indentation_3d(0.1, 10, master_normal=normal))
+    out.append(self_contact_ring())
+    out.append(limit_point_volume_control())
+    out.append(limit_point_load_control())
     return out
 
 
@@ -234,7 +298,11 @@ def run_case(case: Case) -> dict:
     Returns
     -------
     dict
-        ``name``, ``status`` (``"completed"`` or ``"stopped"``), ``t_end``, ``t_reached``,
+        ``name``, ``status`` (``"completed"``, ``"stopped"``, or ``"expected stop"``: a
+        case with :attr:`Case.expected_stop` stopped with that text in its diagnosis),
+        ``expected_stop`` (:attr:`Case.expected_stop`), ``as_expected`` (the run completed
+        with every step converged, or stopped as expected), ``diagnosis`` (why the run
+        stopped: the ``why`` of its last failed try, or ``None``), ``t_end``, ``t_reached``,
         ``steps``, ``cutbacks``, ``newton_max``, ``newton_mean`` (per accepted step),
         ``all_converged`` (the run completed and every accepted step has a ``CONVERGED_*``
         SNES reason), ``step_reasons`` (the distinct reasons of the accepted steps),
@@ -261,16 +329,23 @@ def run_case(case: Case) -> dict:
     history = problem.history
     its = [r.newton_iterations for r in history.steps]
     reasons = [r.reason for r in history.steps]
+    all_converged = error is None and all(r.startswith("CONVERGED") for r in reasons)
+    diagnosis = observer.failures[-1]["why"] if error and observer.failures else None
+    expected = case.expected_stop is not None and case.expected_stop in (diagnosis or "")
+    status = ("expected stop" if expected else "stopped") if error else "completed"
     return {
         "name": case.name,
-        "status": "stopped" if error else "completed",
+        "status": status,
+        "expected_stop": case.expected_stop,
+        "as_expected": expected if case.expected_stop else all_converged,
+        "diagnosis": diagnosis,
         "t_end": case.stages[-1][1],
         "t_reached": float(problem.t),
         "steps": len(history.steps),
         "cutbacks": len(history.cutbacks),
         "newton_max": max(its, default=0),
         "newton_mean": sum(its) / len(its) if its else 0.0,
-        "all_converged": error is None and all(r.startswith("CONVERGED") for r in reasons),
+        "all_converged": all_converged,
         "step_reasons": sorted(set(reasons)),
         "failures": observer.failures,
         "error": error,

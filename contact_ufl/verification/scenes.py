@@ -873,6 +873,53 @@ def inflated_sphere(
     return Scene(domains=[domain])
 
 
+def squeezed_ring(
+    depth: float = 0.8,
+    radii: tuple[float, float] = (0.75, 1.0),
+    cells: tuple[int, int] = (4, 40),
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """A ring squeezed between two plates until its hole closes on itself (self-contact).
+
+    The half ring ``r`` in ``radii``, ``x >= 0`` (``cells``: quadrilaterals across and
+    along; ``u_x = 0`` on the cut ``x = 0``, tag 1; Neo-Hookean, ``E = 1``, ``nu = 0.3``),
+    squeezed between the rigid plates ``y = +-r_o`` moved towards each other by ``depth``
+    each at ``t = 1`` (frictionless pairs of the outer surface, tag 3): the hole flattens
+    until its upper and lower arcs meet across ``y = 0``, a self-contact of the inner
+    surface (tag 2).
+    """
+    ri, ro = radii
+    mesh = dolfinx.mesh.create_rectangle(
+        comm,
+        [[0.0, 0.0], [1.0, 1.0]],
+        list(cells),
+        dolfinx.mesh.CellType.quadrilateral,
+        ghost_mode=dolfinx.mesh.GhostMode.shared_facet,
+    )
+    s, t = mesh.geometry.x[:, 0].copy(), mesh.geometry.x[:, 1].copy()
+    r, theta = ri + s * (ro - ri), np.pi * (t - 0.5)
+    mesh.geometry.x[:, 0], mesh.geometry.x[:, 1] = r * np.cos(theta), r * np.sin(theta)
+    radius = lambda x: np.hypot(x[0], x[1])  # noqa: E731
+    cell_tags, facet_tags = geometries.tag_single_body(
+        mesh,
+        [
+            lambda x: np.isclose(x[0], 0.0),
+            lambda x: np.isclose(radius(x), ri),
+            lambda x: np.isclose(radius(x), ro),
+        ],
+    )
+    top = RigidPlane((0.0, ro), (0.0, -1.0), motion=lambda t: (0.0, -depth * t))
+    bottom = RigidPlane((0.0, -ro), (0.0, 1.0), motion=lambda t: (0.0, depth * t))
+    return Scene(
+        mesh,
+        cell_tags,
+        facet_tags,
+        [Body(1, NeoHookean(1.0, 0.3))],
+        contacts=[ContactPair(3, top), ContactPair(3, bottom), ContactPair(2, 2)],
+        dirichlet=[Dirichlet(1, 0.0, component=0)],
+    )
+
+
 def surface_as_membrane(
     scene: Scene, facet_tag: int, body_tag: int, law, direction, name: str = "membrane"
 ) -> Domain:
