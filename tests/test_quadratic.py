@@ -1,0 +1,141 @@
+"""Quadratic elements in contact: degree-2 displacement on straight and curved geometry.
+
+The master facets are then quadratic (3-node segments in 2D, 6-node triangles in 3D): the
+closest point on them is found by Newton (:mod:`contact_ufl.contact.curved`), its
+linearisation has the facet's curvature, and the tangent stays the derivative of the
+residual (Taylor remainders of order 2), frictionless and in slip.
+"""
+
+import numpy as np
+import pytest
+
+from contact_ufl.contact.projection import closest_points, shape_functions
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification.taylor_cases import curved_case
+
+RNG_SEED = 7
+
+
+def random_segments(rng, n):
+    """Curved 3-node segments (ends, midpoint) of length about 1, bent both ways."""
+    a = rng.uniform(-1, 1, (n, 2))
+    angle = rng.uniform(0, 2 * np.pi, n)
+    b = a + np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    normal = np.stack([np.sin(angle), -np.cos(angle)], axis=1)
+    mid = 0.5 * (a + b) + rng.uniform(-0.15, 0.15, (n, 1)) * normal
+    mid += rng.uniform(-0.1, 0.1, (n, 1)) * (b - a)  # not at the middle of the arc
+    return np.stack([a, b, mid], axis=1)
+
+
+def random_triangles(rng, n):
+    """Curved 6-node triangles (vertices, then midpoints of edges 01, 12, 02)."""
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    v = v + rng.uniform(-0.2, 0.2, (n, 3, 3))
+    mids = [0.5 * (v[:, i] + v[:, j]) for i, j in ((0, 1), (1, 2), (0, 2))]
+    mids = np.stack(mids, axis=1) + rng.uniform(-0.12, 0.12, (n, 3, 3))
+    return np.concatenate([v, mids], axis=1)
+
+
+def sampled_distance(points, nodes, xi):
+    """The smallest distance of each point to its facet over the samples ``xi`` (brute
+    force)."""
+    N = shape_functions(nodes.shape[1], nodes.shape[2], xi)[0]
+    y = np.einsum("sn,fnd->fsd", N, nodes)
+    return np.linalg.norm(points[:, None, :] - y, axis=2).min(axis=1)
+
+
+@pytest.mark.parametrize("gdim", [2, 3])
+def test_closest_point_on_quadratic_facets(gdim):
+    """One facet per point: the distance found is never above the sampled minimum (no
+    wrong local minimum), and below it by at most the sampling's resolution; ``y`` is on
+    the facet at ``xi``, and ``xi`` is inside."""
+    rng = np.random.default_rng(RNG_SEED)
+    n = 400
+    if gdim == 2:
+        nodes = random_segments(rng, n)
+        xi = np.linspace(0, 1, 4001)[:, None]
+        resolution = 2.0 / 4000  # sample spacing times the largest |dy/dxi|
+    else:
+        nodes = random_triangles(rng, n)
+        s, t = np.meshgrid(np.linspace(0, 1, 301), np.linspace(0, 1, 301))
+        xi = np.stack([s.ravel(), t.ravel()], axis=1)
+        xi = xi[xi.sum(axis=1) <= 1.0]
+        resolution = 2.0 / 300
+    centre = nodes.mean(axis=1)
+    points = centre + rng.uniform(-0.6, 0.6, (n, gdim))
+    brute = sampled_distance(points, nodes, xi)
+    for f in range(0, n, 50):  # one facet at a time: each point pairs with its own facet
+        rows = slice(f, f + 50)
+        proj = [closest_points(points[k : k + 1], nodes[k : k + 1]) for k in range(f, f + 50)]
+        dist = np.array([p.distance[0] for p in proj])
+        assert np.all(dist <= brute[rows] + 1e-12)
+        assert np.all(dist >= brute[rows] - resolution)
+        xis = np.array([p.xi[0] for p in proj])
+        assert np.all(xis >= 0.0) and np.all(xis.sum(axis=1) <= 1.0 if gdim == 3 else xis <= 1.0)
+        N = shape_functions(nodes.shape[1], gdim, xis)[0]
+        y = np.einsum("pn,pnd->pd", N, nodes[rows])
+        assert np.allclose(y, np.array([p.y[0] for p in proj]), atol=1e-14)
+
+
+@pytest.mark.parametrize("gdim", [2, 3])
+def test_sliding_matrix_is_the_derivative_of_xi(gdim):
+    """``M b`` is the derivative of the closest point's ``xi`` along a move of the slave
+    point (curved facet: ``A`` has the curvature term): finite differences agree."""
+    rng = np.random.default_rng(RNG_SEED + gdim)
+    nodes = random_segments(rng, 1) if gdim == 2 else random_triangles(rng, 1)
+    centroid_xi = np.full((1, gdim - 1), 1.0 / gdim)
+    N, dN, _ = shape_functions(nodes.shape[1], gdim, centroid_xi)
+    y = N @ nodes[0]
+    a = np.einsum("pna,nd->pad", dN, nodes[0])[0]
+    normal = np.cross(a[0], a[1]) if gdim == 3 else np.array([a[0, 1], -a[0, 0]])
+    x = y[0] + 0.3 * normal / np.linalg.norm(normal)
+    proj = closest_points(x[None], nodes)
+    assert proj.xi[0].min() > 0.05  # interior
+    dx = rng.normal(size=gdim)
+    h = 1e-6
+    xi_h = closest_points((x + h * dx)[None], nodes).xi[0]
+    xi_m = closest_points((x - h * dx)[None], nodes).xi[0]
+    _, dN, _ = shape_functions(nodes.shape[1], gdim, proj.xi)
+    a = np.einsum("pna,nd->pad", dN, nodes[0])[0]
+    b = a @ dx  # b_alpha = a_alpha . dx (the master fixed)
+    predicted = proj.sliding[0] @ b
+    assert np.allclose((xi_h - xi_m) / (2 * h), predicted, rtol=1e-6, atol=1e-9)
+    # the metric alone (a flat facet's M) is off: the curvature matters
+    assert not np.allclose(np.linalg.solve(a @ a.T, b), predicted, rtol=1e-3)
+
+
+def check_taylor(problem, dz, steps):
+    assert problem.active_points() > 10
+    result = taylor_test(problem, dz, steps)
+    assert not result.facets_changed and not result.active_changed
+    zeroth_slopes = np.diff(np.log(result.zeroth)) / np.diff(np.log(result.h))
+    assert np.all(np.abs(zeroth_slopes - 1.0) < 0.05)
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_taylor_quadratic_2d(order):
+    """P2 displacement on straight (order 1) and curved (order 2) triangles: 3-node master
+    segments, the tangent exact."""
+    problem, dz, steps = curved_case(2, degree=2, order=order)
+    assert problem.contacts[0].kinematics.nn == 3
+    check_taylor(problem, dz, steps)
+
+
+@pytest.mark.parametrize("dim, order", [(2, 2), (3, 1)])
+def test_taylor_quadratic_slip(dim, order):
+    """With friction, every contact point in slip on the quadratic master (2D: curved
+    geometry): the slip reference ``y_n`` on the last step's quadratic facet, chained
+    through its gathered nodes; the tangent exact."""
+    problem, dz, steps = curved_case(dim, mu=0.05, degree=2, order=order)
+    c = problem.contacts[0]
+    active = problem.comm.allreduce(int(c.active().sum()))
+    assert active > 10 and problem.comm.allreduce(int(c.stick().sum())) == 0
+    check_taylor(problem, dz, steps)
+
+
+def test_taylor_quadratic_3d():
+    """P2 tetrahedra: 6-node triangles as master facets, frictionless."""
+    problem, dz, steps = curved_case(3, degree=2)
+    assert problem.contacts[0].kinematics.nn == 6
+    check_taylor(problem, dz, steps)
