@@ -4,9 +4,12 @@ Prints a table and writes one JSON record per mesh: dofs, degree, h, p0_error, a
 pressure_l2_error (2D: of the fitted elliptic profile against the samples, weighted by the
 slave points' reference lengths), newton_iterations, newton_per_step, wall_s (solve time),
 assembly_s (residual and Jacobian assembly), search_s (the closest-point projection),
-solver_s (factorisation and solves), ranks, material.
+solver_s (factorisation and solves), ranks, material; geometry_order (2D: ``--degree 2``
+runs P2 on the curved, degree-2, mesh unless ``--order 1``).
 
     python benchmarks/hertz.py --json benchmarks/results/hertz.json [--quick] [--material linear]
+    python benchmarks/hertz.py --json ... --degree 2 [--order 1] [--h 0.02 0.01] [--steps 1]
+        [--subdivisions 4] [--multiplier-degree 2]
     mpirun -n 2 python benchmarks/hertz.py --json ...
     python benchmarks/hertz.py --plot benchmarks/results/hertz.png RESULTS.json [...]
 
@@ -46,15 +49,32 @@ FULL_3D = [(0.025, None), (0.0125, None), (0.0125, 0.004), (0.0125, 0.003)]
 QUICK_3D = FULL_3D[:3]
 
 
-def run(h: float, depth: float, steps: int, material: str = "neo-hookean") -> dict:
-    hertz = scenes.hertz_2d(h_contact=h, depth=depth)
+def run(
+    h: float,
+    depth: float,
+    steps: int,
+    material: str = "neo-hookean",
+    degree: int = 1,
+    order: int | None = None,
+    subdivisions: int = 1,
+    multiplier_degree: int = 1,
+) -> dict:
+    """One 2D run; ``order``: the geometry's (default: the displacement's ``degree``);
+    ``subdivisions``, ``multiplier_degree``: those of the contact pair."""
+    order = degree if order is None else order
+    hertz = scenes.hertz_2d(h_contact=h, depth=depth, order=order)
     scene = hertz.scene
+    scene.contacts[0] = dataclasses.replace(
+        scene.contacts[0],
+        quadrature_subdivisions=subdivisions,
+        multiplier_degree=multiplier_degree,
+    )
     if material == "linear":
         scene.bodies = [
             dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
             for b in scene.bodies
         ]
-    problem = ContactProblem(scene, verbose=False)
+    problem = ContactProblem(scene, degree=degree, verbose=False)
     start = time.perf_counter()
     problem.solve(num_steps=steps)
     wall = time.perf_counter() - start
@@ -65,7 +85,10 @@ def run(h: float, depth: float, steps: int, material: str = "neo-hookean") -> di
     newton = sum(r.newton_iterations for r in problem.history.steps)
     return {
         "dofs": problem.layout.global_size,
-        "degree": 1,
+        "degree": degree,
+        "geometry_order": order,
+        "subdivisions": subdivisions,
+        "multiplier_degree": multiplier_degree,
         "material": material,
         "h": h,
         "a_over_h": exact.a / h,
@@ -161,6 +184,13 @@ def main() -> None:
     parser.add_argument("--depth", type=float, default=None, help="2D: 0.005, 3D: 0.01")
     parser.add_argument("--steps", type=int, default=None, help="2D: 4, 3D: 2")
     parser.add_argument("--flat", choices=("elastic", "rigid"), default="elastic", help="3D")
+    parser.add_argument("--degree", type=int, choices=(1, 2), default=1, help="2D: of u")
+    parser.add_argument(
+        "--order", type=int, choices=(1, 2), default=None, help="2D: of the geometry (= degree)"
+    )
+    parser.add_argument("--h", type=float, nargs="+", default=None, help="2D: h_contact list")
+    parser.add_argument("--subdivisions", type=int, default=1, help="2D: contact quadrature")
+    parser.add_argument("--multiplier-degree", type=int, choices=(1, 2), default=1, help="2D")
     args = parser.parse_args()
     if args.dim == 3:
         args.depth = 0.01 if args.depth is None else args.depth
@@ -177,8 +207,17 @@ def main() -> None:
     )
     if comm.rank == 0:
         print(header)
-    for h in QUICK if args.quick else FULL:
-        r = run(h, args.depth, args.steps, args.material)
+    for h in args.h or (QUICK if args.quick else FULL):
+        r = run(
+            h,
+            args.depth,
+            args.steps,
+            args.material,
+            args.degree,
+            args.order,
+            args.subdivisions,
+            args.multiplier_degree,
+        )
         records.append(r)
         if comm.rank == 0:
             print(

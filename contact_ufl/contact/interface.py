@@ -112,8 +112,20 @@ class ContactInterface:
                 "needs one displacement degree on both sides",
             )
         qdeg = pair.quadrature_degree or 2 * degree + 1
+        collective_check(
+            comm,
+            pair.multiplier_degree <= degree,
+            f"multiplier_degree={pair.multiplier_degree} of the pair with slave surface (tag "
+            f"{pair.slave}) needs a displacement of that degree (got degree {degree})",
+        )
         self.slave = SlaveSurface(
-            V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions, pair.quadrature_rule
+            V,
+            facet_tags,
+            pair.slave,
+            qdeg,
+            pair.quadrature_subdivisions,
+            pair.quadrature_rule,
+            pair.multiplier_degree,
         )
         #: the master side as the laws see it (gap, normal, projected point, master fields)
         if pair.on_obstacle:

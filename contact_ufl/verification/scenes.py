@@ -55,6 +55,7 @@ def hertz_2d(
     rotation: float = 0.0,
     gap: float = 0.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
+    order: int = 1,
 ) -> HertzScene:
     """Plane-strain Hertz problem: an elastic half disc (R = 1) pressed onto an elastic block.
 
@@ -87,9 +88,12 @@ def hertz_2d(
         (radians) about the origin: a frame-indifferent model gives rotated results.
     gap
         Initial gap between the disc and the block (``depth`` includes it).
+    order
+        Geometry order of the mesh (2: the disc's arc is curved, for a degree-2
+        displacement).
     """
     E_flat = E if E_flat is None else E_flat
-    sm = geometries.hertz_2d(h_contact=h_contact, h_far=h_far, gap=gap, comm=comm)
+    sm = geometries.hertz_2d(h_contact=h_contact, h_far=h_far, gap=gap, order=order, comm=comm)
     tags = sm.tags
     R = rotation_2d(rotation)
     sm.mesh.geometry.x[:, :2] = sm.mesh.geometry.x[:, :2] @ R.T
