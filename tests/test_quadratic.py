@@ -6,11 +6,19 @@ linearisation has the facet's curvature, and the tangent stays the derivative of
 residual (Taylor remainders of order 2), frictionless and in slip.
 """
 
+import dataclasses
+
+import dolfinx
 import numpy as np
 import pytest
 
+from contact_ufl.contact.interface import ContactInterface
 from contact_ufl.contact.projection import closest_points, shape_functions
+from contact_ufl.errors import ContactInputError
+from contact_ufl.membranes import MembraneNeoHookean
+from contact_ufl.problem import ContactProblem
 from contact_ufl.taylor import taylor_test
+from contact_ufl.verification.scenes import curved_pair, with_membrane
 from contact_ufl.verification.taylor_cases import curved_case
 
 RNG_SEED = 7
@@ -40,8 +48,11 @@ def sampled_distance(points, nodes, xi):
     """The smallest distance of each point to its facet over the samples ``xi`` (brute
     force)."""
     N = shape_functions(nodes.shape[1], nodes.shape[2], xi)[0]
-    y = np.einsum("sn,fnd->fsd", N, nodes)
-    return np.linalg.norm(points[:, None, :] - y, axis=2).min(axis=1)
+    out = []
+    for k in range(0, len(points), 20):  # in chunks: (points, samples, gdim) arrays
+        y = np.einsum("sn,fnd->fsd", N, nodes[k : k + 20])
+        out.append(np.linalg.norm(points[k : k + 20, None, :] - y, axis=2).min(axis=1))
+    return np.concatenate(out)
 
 
 @pytest.mark.parametrize("gdim", [2, 3])
@@ -50,17 +61,17 @@ def test_closest_point_on_quadratic_facets(gdim):
     wrong local minimum), and below it by at most the sampling's resolution; ``y`` is on
     the facet at ``xi``, and ``xi`` is inside."""
     rng = np.random.default_rng(RNG_SEED)
-    n = 400
+    n = 200
     if gdim == 2:
         nodes = random_segments(rng, n)
         xi = np.linspace(0, 1, 4001)[:, None]
         resolution = 2.0 / 4000  # sample spacing times the largest |dy/dxi|
     else:
         nodes = random_triangles(rng, n)
-        s, t = np.meshgrid(np.linspace(0, 1, 301), np.linspace(0, 1, 301))
+        s, t = np.meshgrid(np.linspace(0, 1, 201), np.linspace(0, 1, 201))
         xi = np.stack([s.ravel(), t.ravel()], axis=1)
         xi = xi[xi.sum(axis=1) <= 1.0]
-        resolution = 2.0 / 300
+        resolution = 2.0 / 200
     centre = nodes.mean(axis=1)
     points = centre + rng.uniform(-0.6, 0.6, (n, gdim))
     brute = sampled_distance(points, nodes, xi)
@@ -139,3 +150,57 @@ def test_taylor_quadratic_3d():
     problem, dz, steps = curved_case(3, degree=2)
     assert problem.contacts[0].kinematics.nn == 6
     check_taylor(problem, dz, steps)
+
+
+# -- bad input: a clear error naming what is supported, on every rank ----------------------
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return curved_pair(2)
+
+
+def with_pair(scene, **changes):
+    return dataclasses.replace(scene, contacts=[dataclasses.replace(scene.contacts[0], **changes)])
+
+
+@pytest.mark.parametrize(
+    "degree, changes, message",
+    [
+        (3, {}, "degree-3 displacement on a degree-1 geometry: contact supports a degree-1"),
+        (2, dict(master_normal="smoothed"), 'master_normal="smoothed".*needs a degree-1'),
+        (1, dict(multiplier_degree=2), "multiplier_degree=2 .* needs a displacement of that"),
+        (2, dict(multiplier_degree=3), "multiplier_degree must be 1 or 2"),
+    ],
+)
+def test_unsupported_pairs(scene, degree, changes, message):
+    with pytest.raises(ContactInputError, match=message):
+        ContactProblem(with_pair(scene, **changes), degree=degree, verbose=False)
+
+
+def test_linear_displacement_on_curved_geometry_is_rejected():
+    """A degree-1 displacement on a degree-2 (curved) mesh: its facets are not given by
+    displacement dofs."""
+    with pytest.raises(ContactInputError, match="degree-1 displacement on a degree-2 geometry"):
+        ContactProblem(curved_pair(2, order=2), degree=1, verbose=False)
+
+
+def test_quadratic_hexahedra_are_rejected():
+    with pytest.raises(ContactInputError, match="not for hexahedron cells of degree 2"):
+        ContactProblem(curved_pair(3, cell="hexahedron"), degree=2, verbose=False)
+
+
+def test_quadratic_membrane_is_rejected(scene):
+    membrane = with_membrane(scene, "master", MembraneNeoHookean(1.0, 0.05), np.array([0, 1.0]))
+    with pytest.raises(ContactInputError, match="membranes in contact need a degree-1"):
+        ContactProblem(membrane, degree=2, verbose=False)
+
+
+def test_mixed_degrees_are_rejected(scene):
+    """A pair whose slave and master displacements differ in degree."""
+    mesh = scene.parts[0].mesh
+    u1 = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,))))
+    u2 = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 2, (2,))))
+    tags = scene.parts[0].surface_tags
+    with pytest.raises(ContactInputError, match="degree-1 displacement and the master body"):
+        ContactInterface(u1, tags, scene.contacts[0], 1.0, master_u=u2)
