@@ -58,7 +58,8 @@ class MeshMaster:
 
     Facet nodes are the vertices of the facets (linear segments, triangles, bilinear
     quadrilaterals), ordered so that the normal of :mod:`.projection` points out of
-    the master body.
+    the master body; with a degree-2 displacement followed by the dofs of the facet's edge
+    midpoints (3-node segments, 6-node triangles of :mod:`.curved`).
 
     Parameters
     ----------
@@ -79,6 +80,9 @@ class MeshMaster:
     ----------
     nodes
         Local block index (displacement dof block) of each facet node, ``(nf, nn)``.
+    nv
+        Vertices of a facet (``nn`` for linear facets): the keys and boundary edges are
+        those of the vertices.
     X_nodes
         Reference positions of the nodes, ``(nf, nn, gdim)``.
     global_nodes
