@@ -49,6 +49,17 @@ def random_triangles(rng, n):
     return np.concatenate([v, mids], axis=1)
 
 
+def random_quadrilaterals(rng, n):
+    """Curved 9-node quadrilaterals (basix vertices, midpoints of edges 01, 13, 23, 02,
+    centre)."""
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]])
+    v = v + rng.uniform(-0.2, 0.2, (n, 4, 3))
+    mids = [0.5 * (v[:, i] + v[:, j]) for i, j in ((0, 1), (1, 3), (2, 3), (0, 2))]
+    mids.append(v.mean(axis=1))
+    mids = np.stack(mids, axis=1) + rng.uniform(-0.12, 0.12, (n, 5, 3))
+    return np.concatenate([v, mids], axis=1)
+
+
 def sampled_distance(points, nodes, xi):
     """The smallest distance of each point to its facet over the samples ``xi`` (brute
     force)."""
@@ -60,22 +71,24 @@ def sampled_distance(points, nodes, xi):
     return np.concatenate(out)
 
 
-@pytest.mark.parametrize("gdim", [2, 3])
-def test_closest_point_on_quadratic_facets(gdim):
+@pytest.mark.parametrize("kind", ["segment3", "triangle6", "quadrilateral9"])
+def test_closest_point_on_quadratic_facets(kind):
     """One facet per point: the distance found is never above the sampled minimum (no
     wrong local minimum), and below it by at most the sampling's resolution; ``y`` is on
     the facet at ``xi``, and ``xi`` is inside."""
     rng = np.random.default_rng(RNG_SEED)
-    n = 200
+    gdim = 2 if kind == "segment3" else 3
+    n = 200 if gdim == 2 else 100
     if gdim == 2:
         nodes = random_segments(rng, n)
         xi = np.linspace(0, 1, 4001)[:, None]
         resolution = 2.0 / 4000  # sample spacing times the largest |dy/dxi|
     else:
-        nodes = random_triangles(rng, n)
+        make = random_triangles if kind == "triangle6" else random_quadrilaterals
+        nodes = make(rng, n)
         s, t = np.meshgrid(np.linspace(0, 1, 201), np.linspace(0, 1, 201))
         xi = np.stack([s.ravel(), t.ravel()], axis=1)
-        xi = xi[xi.sum(axis=1) <= 1.0]
+        xi = xi[xi.sum(axis=1) <= 1.0] if kind == "triangle6" else xi
         resolution = 2.0 / 200
     centre = nodes.mean(axis=1)
     points = centre + rng.uniform(-0.6, 0.6, (n, gdim))
@@ -87,19 +100,26 @@ def test_closest_point_on_quadratic_facets(gdim):
         assert np.all(dist <= brute[rows] + 1e-12)
         assert np.all(dist >= brute[rows] - resolution)
         xis = np.array([p.xi[0] for p in proj])
-        assert np.all(xis >= 0.0) and np.all(xis.sum(axis=1) <= 1.0 if gdim == 3 else xis <= 1.0)
+        assert np.all(xis >= 0.0)
+        assert np.all(xis.sum(axis=1) <= 1.0 if kind == "triangle6" else xis <= 1.0)
         N = shape_functions(nodes.shape[1], gdim, xis)[0]
         y = np.einsum("pn,pnd->pd", N, nodes[rows])
         assert np.allclose(y, np.array([p.y[0] for p in proj]), atol=1e-14)
 
 
-@pytest.mark.parametrize("gdim", [2, 3])
-def test_sliding_matrix_is_the_derivative_of_xi(gdim):
+@pytest.mark.parametrize("kind", ["segment3", "triangle6", "quadrilateral9"])
+def test_sliding_matrix_is_the_derivative_of_xi(kind):
     """``M b`` is the derivative of the closest point's ``xi`` along a move of the slave
     point (curved facet: ``A`` has the curvature term): finite differences agree."""
-    rng = np.random.default_rng(RNG_SEED + gdim)
-    nodes = random_segments(rng, 1) if gdim == 2 else random_triangles(rng, 1)
-    centroid_xi = np.full((1, gdim - 1), 1.0 / gdim)
+    rng = np.random.default_rng(RNG_SEED + len(kind))
+    make = {
+        "segment3": random_segments,
+        "triangle6": random_triangles,
+        "quadrilateral9": random_quadrilaterals,
+    }
+    nodes = make[kind](rng, 1)
+    gdim = nodes.shape[2]
+    centroid_xi = np.full((1, gdim - 1), 0.5 if kind == "quadrilateral9" else 1.0 / gdim)
     N, dN, _ = shape_functions(nodes.shape[1], gdim, centroid_xi)
     y = N @ nodes[0]
     a = np.einsum("pna,nd->pad", dN, nodes[0])[0]
@@ -138,22 +158,32 @@ def test_taylor_quadratic_2d(order):
     check_taylor(problem, dz, steps)
 
 
-@pytest.mark.parametrize("dim, order", [(2, 2), (3, 1)])
-def test_taylor_quadratic_slip(dim, order):
+@pytest.mark.parametrize(
+    "dim, order, cell",
+    [
+        (2, 2, "triangle"),
+        (3, 1, "tetrahedron"),
+        pytest.param(3, 1, "hexahedron", marks=pytest.mark.slow),
+    ],
+)
+def test_taylor_quadratic_slip(dim, order, cell):
     """With friction, every contact point in slip on the quadratic master (2D: curved
     geometry): the slip reference ``y_n`` on the last step's quadratic facet, chained
     through its gathered nodes; the tangent exact."""
-    problem, dz, steps = curved_case(dim, mu=0.05, degree=2, order=order)
+    problem, dz, steps = curved_case(dim, mu=0.05, degree=2, order=order, cell=cell)
     c = problem.contacts[0]
     active = problem.comm.allreduce(int(c.active().sum()))
     assert active > 10 and problem.comm.allreduce(int(c.stick().sum())) == 0
     check_taylor(problem, dz, steps)
 
 
-def test_taylor_quadratic_3d():
-    """P2 tetrahedra: 6-node triangles as master facets, frictionless."""
-    problem, dz, steps = curved_case(3, degree=2)
-    assert problem.contacts[0].kinematics.nn == 6
+@pytest.mark.parametrize("cell, nn", [("tetrahedron", 6), ("hexahedron", 9)])
+def test_taylor_quadratic_3d(cell, nn):
+    """P2 tetrahedra (6-node triangles as master facets) and Q2 hexahedra (9-node
+    quadrilaterals, on the saddle of :func:`~contact_ufl.verification.scenes.warp_saddle`),
+    frictionless."""
+    problem, dz, steps = curved_case(3, degree=2, cell=cell)
+    assert problem.contacts[0].kinematics.nn == nn
     check_taylor(problem, dz, steps)
 
 
@@ -188,11 +218,6 @@ def test_linear_displacement_on_curved_geometry_is_rejected():
     displacement dofs."""
     with pytest.raises(ContactInputError, match="degree-1 displacement on a degree-2 geometry"):
         ContactProblem(curved_pair(2, order=2), degree=1, verbose=False)
-
-
-def test_quadratic_hexahedra_are_rejected():
-    with pytest.raises(ContactInputError, match="not for hexahedron cells of degree 2"):
-        ContactProblem(curved_pair(3, cell="hexahedron"), degree=2, verbose=False)
 
 
 def test_quadratic_membrane_is_rejected(scene):

@@ -1,4 +1,5 @@
-"""Closest points on quadratic (curved) master facets: 3-node segments and 6-node triangles.
+"""Closest points on quadratic (curved) master facets: 3-node segments, 6-node triangles
+and 9-node quadrilaterals.
 
 A degree-2 displacement makes every master facet a quadratic one once deformed (and a
 degree-2 geometry makes it curved from the start): its current shape is
@@ -13,6 +14,8 @@ them for the quadratic kinds:
 * :func:`triangle_interior`: an interior stationary point of ``|x - y(xi)|^2`` on a 6-node
   triangle (Newton from the projection on the plane of the vertices, restarted from the
   centroid), to be compared with the closest points on the three curved edges;
+  :func:`quadrilateral_interior` likewise on a 9-node quadrilateral (the facet of a
+  quadratic hexahedron; Newton from the centre, restarted from four other points);
 * :func:`bernstein_hull`: the Bernstein control points of a quadratic facet: the facet lies
   in their convex hull (the Bernstein weights are non-negative and sum to one), which is what
   the distance bounds of the candidate search need (a quadratic facet is *not* in the convex
@@ -37,6 +40,17 @@ _TOL = 1e-13  # on the reference-coordinate step
 #: ``v0, v1, v2, m01, m12, m02``), in the order of the straight triangle's edges.
 TRIANGLE6_EDGES = ((0, 1, 3), (1, 2, 4), (0, 2, 5))
 
+#: The edges of a 9-node quadrilateral (node order: the basix vertices ``v0 (0, 0), v1 (1,
+#: 0), v2 (0, 1), v3 (1, 1)``, the midpoints of the edges 01, 13, 23, 02, then the centre),
+#: in the order of the bilinear quadrilateral's edges.
+QUADRILATERAL9_EDGES = ((0, 1, 4), (1, 3, 5), (2, 3, 6), (0, 2, 7))
+
+#: The edges of each quadratic facet kind of two reference dimensions.
+CURVED_EDGES = {"triangle6": TRIANGLE6_EDGES, "quadrilateral9": QUADRILATERAL9_EDGES}
+
+#: The 1D index (0: start, 1: end, 2: middle) of the nodes of a 9-node quadrilateral in s and t.
+_Q9 = ((0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (1, 2), (2, 1), (0, 2), (2, 2))
+
 
 def quadratic_shape_functions(
     kind: str, xi: FloatArray
@@ -46,9 +60,13 @@ def quadratic_shape_functions(
     ``kind``: ``"segment3"`` (nodes: the two ends, then the midpoint; ``xi`` in ``[0, 1]``)
     or ``"triangle6"`` (the vertices, then the midpoints of the edges 01, 12 and 02; with the
     barycentric ``L = (1 - xi1 - xi2, xi1, xi2)``: ``N_i = L_i (2 L_i - 1)``,
-    ``N_ij = 4 L_i L_j``). Shapes as :func:`.projection.shape_functions`.
+    ``N_ij = 4 L_i L_j``) or ``"quadrilateral9"`` (the tensor product of the 1D functions;
+    node order of :data:`QUADRILATERAL9_EDGES`). Shapes as
+    :func:`.projection.shape_functions`.
     """
     npts = xi.shape[0]
+    if kind == "quadrilateral9":
+        return _quadrilateral9(xi)
     if kind == "segment3":
         u = xi[:, 0]
         N = np.stack([(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)], axis=1)
@@ -72,14 +90,41 @@ def quadratic_shape_functions(
     return N, dN, d2N
 
 
+def _line(u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """1D quadratic Lagrange functions (start, end, middle) at ``u`` and their derivatives,
+    ``(3, n)`` each."""
+    one = np.ones_like(u)
+    l = np.stack([(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)])
+    dl = np.stack([4 * u - 3, 4 * u - 1, 4 - 8 * u])
+    d2l = np.stack([4 * one, 4 * one, -8 * one])
+    return l, dl, d2l
+
+
+def _quadrilateral9(xi: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Tensor-product quadratic functions of the 9-node quadrilateral (node order of
+    :data:`QUADRILATERAL9_EDGES`)."""
+    (ls, dls, d2ls), (lt, dlt, d2lt) = _line(xi[:, 0]), _line(xi[:, 1])
+    i, j = np.array(_Q9).T
+    N = (ls[i] * lt[j]).T
+    dN = np.stack([(dls[i] * lt[j]).T, (ls[i] * dlt[j]).T], axis=2)
+    st = (dls[i] * dlt[j]).T
+    d2N = np.stack(
+        [np.stack([(d2ls[i] * lt[j]).T, st], 2), np.stack([st, (ls[i] * d2lt[j]).T], 2)], 2
+    )
+    return N, dN, d2N
+
+
 def bernstein_hull(kind: str, nodes: FloatArray) -> FloatArray:
     """The Bernstein control points of quadratic facets ``nodes (nf, nn, gdim)``: the
     vertices, and for an edge ``ij`` of midpoint node ``m`` the point ``2 m - (x_i + x_j)/2``.
     Every point of the facet is a convex combination of them."""
     hull = nodes.copy()
-    edges = ((0, 1, 2),) if kind == "segment3" else TRIANGLE6_EDGES
+    edges = ((0, 1, 2),) if kind == "segment3" else CURVED_EDGES[kind]
     for i, j, m in edges:
         hull[:, m] = 2.0 * nodes[:, m] - 0.5 * (nodes[:, i] + nodes[:, j])
+    if kind == "quadrilateral9":  # the centre: the 1D transform along s, then along t
+        along_s = 2.0 * nodes[:, 8] - 0.5 * (nodes[:, 7] + nodes[:, 5])  # at t = 1/2
+        hull[:, 8] = 2.0 * along_s - 0.5 * (hull[:, 4] + hull[:, 6])
     return hull
 
 
@@ -140,6 +185,24 @@ def curve_closest(
     return u, dist
 
 
+def quadrilateral_interior(
+    x: FloatArray, nodes: FloatArray
+) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]:
+    """Interior local minima of ``|x - y(xi)|^2`` on 9-node quadrilaterals ``nodes (P, 9,
+    3)``, as :func:`triangle_interior`: Newton from the centre, restarted from four other
+    points where it does not converge inside."""
+    kind = "quadrilateral9"
+    xi, dist, good = _newton(kind, x, nodes, np.full((len(x), 2), 0.5))
+    for start in ((0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)):
+        redo = np.flatnonzero(~good)
+        if redo.size == 0:
+            break
+        xi_r, dist_r, good_r = _newton(kind, x[redo], nodes[redo], np.tile(start, (redo.size, 1)))
+        take = redo[good_r]
+        xi[take], dist[take], good[take] = xi_r[good_r], dist_r[good_r], True
+    return xi, dist, good
+
+
 def triangle_interior(
     x: FloatArray, nodes: FloatArray
 ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]:
@@ -164,26 +227,27 @@ def triangle_interior(
         start[ok] = np.linalg.solve(G[ok], rhs[ok][:, :, None])[:, :, 0]
     start = np.clip(start, 0.0, 1.0)
     start /= np.maximum(start.sum(axis=1), 1.0)[:, None]
-    xi, dist, good = _triangle_newton(x, nodes, start)
+    xi, dist, good = _newton("triangle6", x, nodes, start)
     redo = np.flatnonzero(~good)
     if redo.size:
-        xi_r, dist_r, good_r = _triangle_newton(
-            x[redo], nodes[redo], np.full((redo.size, 2), 1.0 / 3.0)
+        xi_r, dist_r, good_r = _newton(
+            "triangle6", x[redo], nodes[redo], np.full((redo.size, 2), 1.0 / 3.0)
         )
         take = redo[good_r]
         xi[take], dist[take], good[take] = xi_r[good_r], dist_r[good_r], True
     return xi, dist, good
 
 
-def _triangle_newton(x, nodes, xi):
-    """Newton iterations of :func:`triangle_interior` from ``xi``."""
+def _newton(kind, x, nodes, xi):
+    """Newton iterations of :func:`triangle_interior` (:func:`quadrilateral_interior`)
+    from ``xi``."""
     xi = xi.copy()
     conv = np.zeros(len(x), dtype=bool)
     act = np.arange(len(x))
     for _ in range(_ITERATIONS):
         if act.size == 0:
             break
-        r, a, H, gn = _triangle_state(x[act], nodes[act], xi[act])
+        r, a, H, gn = _state(kind, x[act], nodes[act], xi[act])
         grad = -np.einsum("pg,pag->pa", r, a)
         det = H[:, 0, 0] * H[:, 1, 1] - H[:, 0, 1] * H[:, 1, 0]
         indefinite = (det <= 1e-12 * H[:, 0, 0] * H[:, 1, 1]) | (H[:, 0, 0] <= 0)
@@ -206,7 +270,7 @@ def _triangle_newton(x, nodes, xi):
         new = xi[act] + step
         for _ in range(3):
             rn = x[act] - np.einsum(
-                "pn,png->pg", quadratic_shape_functions("triangle6", new)[0], nodes[act]
+                "pn,png->pg", quadratic_shape_functions(kind, new)[0], nodes[act]
             )
             worse = _dot(rn, rn) > f0 * (1 + 1e-10)
             if not worse.any():
@@ -217,16 +281,17 @@ def _triangle_newton(x, nodes, xi):
         xi[act] = new
         conv[act[done]] = True
         act = act[~done]
-    r, _, H, _ = _triangle_state(x, nodes, xi)
-    inside = (xi[:, 0] > 0.0) & (xi[:, 1] > 0.0) & (xi.sum(axis=1) < 1.0)
+    r, _, H, _ = _state(kind, x, nodes, xi)
+    inside = (xi[:, 0] > 0.0) & (xi[:, 1] > 0.0)
+    inside &= (xi.sum(axis=1) < 1.0) if kind == "triangle6" else np.all(xi < 1.0, axis=1)
     pd = (H[:, 0, 0] > 0) & (H[:, 0, 0] * H[:, 1, 1] - H[:, 0, 1] * H[:, 1, 0] > 0)
     return xi, np.sqrt(_dot(r, r)), conv & inside & pd
 
 
-def _triangle_state(x, nodes, xi):
+def _state(kind, x, nodes, xi):
     """``x - y``, the tangents ``a (P, 2, 3)``, the Hessian of ``|x - y|^2 / 2`` and the
     metric at ``xi``."""
-    N, dN, d2N = quadratic_shape_functions("triangle6", xi)
+    N, dN, d2N = quadratic_shape_functions(kind, xi)
     r = x - np.einsum("pn,png->pg", N, nodes)
     a = np.einsum("pna,png->pag", dN, nodes)
     gn = np.einsum("pag,pbg->pab", a, a)

@@ -366,8 +366,8 @@ def check_degrees(
     """Raise (on every rank) unless the displacement ``u`` of one side of ``pair`` and its
     mesh are of a supported degree (:data:`SUPPORTED_DEGREES`): linear facets of a degree-1
     displacement, or the quadratic (3-node segment, 6-node triangle) facets of a degree-2
-    displacement on a straight or curved (degree-2) geometry. The quadratic facets are
-    not implemented for quadrilaterals in 3D (hexahedra of degree 2), membranes and the
+    displacement on a straight or curved (degree-2) geometry, also 9-node quadrilaterals
+    of quadratic hexahedra. The quadratic facets are not implemented for membranes and the
     smoothed master normal."""
     mesh = u.function_space.mesh
     comm = mesh.comm
@@ -387,14 +387,6 @@ def check_degrees(
     if degree == 1:
         return
     tdim = mesh.topology.dim
-    hexahedral = tdim == 3 and mesh.topology.cell_type != dolfinx.mesh.CellType.tetrahedron
-    collective_check(
-        comm,
-        not hexahedral,
-        f"the {side} body (tag {tag}): quadratic contact facets are implemented for "
-        "tetrahedra (6-node triangles) in 3D and for triangles and quadrilaterals (3-node "
-        f"segments) in 2D, not for {mesh.topology.cell_type.name} cells of degree 2",
-    )
     collective_check(
         comm,
         surface_tags.dim == tdim - 1,

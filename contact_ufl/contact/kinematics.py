@@ -41,7 +41,7 @@ def master_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]
     quadrilateral (4 nodes, basix vertex order); quadratic segment (3 nodes, ``xi`` of one
     coordinate) and triangle (6 nodes) of :mod:`.curved`.
     """
-    if nn == 3 and xi.ufl_shape == (1,) or nn == 6:
+    if nn == 3 and xi.ufl_shape == (1,) or nn in (6, 9):
         return quadratic_shape_functions(nn, xi)
     if nn == 2:
         s = xi[0]
@@ -57,16 +57,28 @@ def master_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]
     raise ValueError(f"no master facet with {nn} nodes")
 
 
+def _line(u) -> tuple[list, list]:
+    """1D quadratic Lagrange functions (start, end, middle) of ``u`` and their derivatives."""
+    return [(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)], [
+        4 * u - 3,
+        4 * u - 1,
+        4 - 8 * u,
+    ]
+
+
 def quadratic_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
     """UFL twin of :func:`.curved.quadratic_shape_functions`: the 3-node segment (ends, then
-    midpoint) and the 6-node triangle (vertices, then the midpoints of edges 01, 12, 02)."""
+    midpoint), the 6-node triangle (vertices, then the midpoints of edges 01, 12, 02) and the
+    9-node quadrilateral (:data:`.curved.QUADRILATERAL9_EDGES`)."""
     if nn == 3:
-        u = xi[0]
-        return [(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)], [
-            [4 * u - 3],
-            [4 * u - 1],
-            [4 - 8 * u],
-        ]
+        line, dline = _line(xi[0])
+        return line, [[d] for d in dline]
+    if nn == 9:
+        (ls, dls), (lt, dlt) = _line(xi[0]), _line(xi[1])
+        index = ((0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (1, 2), (2, 1), (0, 2), (2, 2))
+        N = [ls[i] * lt[j] for i, j in index]
+        dN = [[dls[i] * lt[j], ls[i] * dlt[j]] for i, j in index]
+        return N, dN
     L = [1 - xi[0] - xi[1], xi[0], xi[1]]
     dL = [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]
     N = [L[i] * (2 * L[i] - 1) for i in range(3)]

@@ -178,14 +178,15 @@ class MeshMaster:
                 vertices[flip, swap[0]],
             )
             nodes = np.hstack(
-                [nodes, cell_dofs[np.arange(len(cells))[:, None], self._midpoints(vertices)]]
+                [nodes, cell_dofs[np.arange(len(cells))[:, None], self._midpoints(vertices, local)]]
             )
         self._finish(nodes, geometry_nodes, flip, swap)
 
-    def _midpoints(self, vertices: np.ndarray) -> np.ndarray:
+    def _midpoints(self, vertices: np.ndarray, local: np.ndarray) -> np.ndarray:
         """The cell-local dofs of the edge midpoints of quadratic facets of the oriented
-        cell-local ``vertices`` ``(nf, nv)``: of the segment's edge (2D); of the edges 01, 12
-        and 02 of a triangle (the node order of :mod:`.projection`'s ``"triangle6"``)."""
+        cell-local ``vertices`` ``(nf, nv)`` (local facets ``local``): of the segment's edge
+        (2D); of the edges 01, 12 and 02 of a triangle; of the edges 01, 13, 23 and 02 of a
+        quadrilateral, then its centre (the node orders of :mod:`.curved`)."""
         mesh = self.V.mesh
         layout = self.V.dofmap.dof_layout
         edges = basix.topology(basix_cell(mesh, mesh.topology.dim))[1]
@@ -194,8 +195,15 @@ class MeshMaster:
         for e, (i, j) in enumerate(edges):
             edge_of[i, j] = edge_of[j, i] = e
         edge_dof = np.array([layout.entity_dofs(1, e)[0] for e in range(len(edges))])
-        pairs = ((0, 1),) if vertices.shape[1] == 2 else ((0, 1), (1, 2), (0, 2))
-        return np.stack([edge_dof[edge_of[vertices[:, i], vertices[:, j]]] for i, j in pairs], 1)
+        nv = vertices.shape[1]
+        pairs = {2: ((0, 1),), 3: ((0, 1), (1, 2), (0, 2)), 4: ((0, 1), (1, 3), (2, 3), (0, 2))}
+        mids = [edge_dof[edge_of[vertices[:, i], vertices[:, j]]] for i, j in pairs[nv]]
+        if nv == 4:  # the centre dof of the quadrilateral facet
+            fdim = mesh.topology.dim - 1
+            faces = basix.topology(basix_cell(mesh, mesh.topology.dim))[fdim]
+            face_dof = np.array([layout.entity_dofs(fdim, f)[0] for f in range(len(faces))])
+            mids.append(face_dof[local])
+        return np.stack(mids, axis=1)
 
     def _finish(self, nodes, geometry_nodes, flip, swap) -> None:
         """Positions, global numbers, keys and boundary edges of the oriented facets of

@@ -20,7 +20,9 @@ positions, already oriented by the caller. The kind follows from ``(nn, gdim)``:
   ``a2 = dy/dt``, ``nu = a1 x a2 / |a1 x a2|`` (not constant on a warped quadrilateral).
 * quadratic segment, ``nn = 3, gdim = 2`` (``"segment3"``): the two ends, then the
   midpoint node; quadratic triangle, ``nn = 6, gdim = 3`` (``"triangle6"``): the vertices,
-  then the midpoint nodes of the edges 01, 12, 02. Quadratic Lagrange shape functions
+  then the midpoint nodes of the edges 01, 12, 02; quadratic quadrilateral, ``nn = 9, gdim =
+  3`` (``"quadrilateral9"``): the basix vertices, the midpoint nodes of the edges 01, 13, 23,
+  02, then the centre node. Quadratic Lagrange shape functions
   (:func:`.curved.quadratic_shape_functions`), the normal as above from the tangents at
   ``xi``: the facets of a degree-2 displacement (curved once deformed, or from the start on
   a degree-2 geometry), projected by the kernels of :mod:`.curved`.
@@ -57,10 +59,11 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from contact_ufl.contact.curved import (
-    TRIANGLE6_EDGES,
+    CURVED_EDGES,
     bernstein_hull,
     curve_closest,
     quadratic_shape_functions,
+    quadrilateral_interior,
     triangle_interior,
 )
 
@@ -84,10 +87,11 @@ _KINDS = {
     (4, 3): "quadrilateral",
     (3, 2): "segment3",
     (6, 3): "triangle6",
+    (9, 3): "quadrilateral9",
 }
 
 #: The quadratic (curved) kinds, projected by the kernels of :mod:`.curved`.
-QUADRATIC = ("segment3", "triangle6")
+QUADRATIC = ("segment3", "triangle6", "quadrilateral9")
 
 #: Straight edges of each 2D facet kind: (start node, end node, xi at start, xi at end).
 #: Along an edge ``xi = xi_start + u (xi_end - xi_start)``, ``y = x_start + u (x_end - x_start)``.
@@ -107,6 +111,7 @@ _EDGES = {
 #: the 6-node triangle has the straight triangle's edges in reference space (its nodes
 #: there are the vertices; the midpoint nodes are in :data:`.curved.TRIANGLE6_EDGES`)
 _EDGES["triangle6"] = _EDGES["triangle"]
+_EDGES["quadrilateral9"] = _EDGES["quadrilateral"]
 
 _K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
@@ -450,14 +455,14 @@ class _Master:
     def _project_quadratic(self, x: FloatArray, nodes: FloatArray) -> _Pairs:
         """Project the points ``x`` (P, gdim) on the quadratic facets ``nodes`` (P, nn, gdim):
         the closest point on the (curved) edges, replaced by an interior minimum of a
-        6-node triangle where that is closer (:mod:`.curved`)."""
+        6-node triangle or 9-node quadrilateral where that is closer (:mod:`.curved`)."""
         if self.kind == "segment3":
             u, dist = curve_closest(x, nodes[:, 0], nodes[:, 1], nodes[:, 2])
             edge = np.full(len(u), -1, dtype=np.int64)
             return _Pairs(xi=u[:, None], dist=dist, edge=edge, vertex=(u == 0.0) | (u == 1.0))
         best_d = best_u = None
         best_k = np.zeros(len(x), dtype=np.int64)
-        for n, (i, j, m) in enumerate(TRIANGLE6_EDGES):
+        for n, (i, j, m) in enumerate(CURVED_EDGES[self.kind]):
             u, d = curve_closest(x, nodes[:, i], nodes[:, j], nodes[:, m])
             if best_d is None:
                 best_d, best_u = d, u
@@ -465,11 +470,12 @@ class _Master:
             better = d < best_d
             best_d, best_u = np.where(better, d, best_d), np.where(better, u, best_u)
             best_k = np.where(better, n, best_k)
-        starts = np.array([s for _, _, s, _ in _EDGES["triangle"]])
-        ends = np.array([e for _, _, _, e in _EDGES["triangle"]])
+        starts = np.array([s for _, _, s, _ in _EDGES[self.kind]])
+        ends = np.array([e for _, _, _, e in _EDGES[self.kind]])
         xi = starts[best_k] + best_u[:, None] * (ends[best_k] - starts[best_k])
         pairs = _Pairs(xi=xi, dist=best_d, edge=best_k, vertex=(best_u == 0.0) | (best_u == 1.0))
-        xi_in, dist_in, inner = triangle_interior(x, nodes)
+        interior = triangle_interior if self.kind == "triangle6" else quadrilateral_interior
+        xi_in, dist_in, inner = interior(x, nodes)
         take = np.flatnonzero(inner & (dist_in < pairs.dist))
         pairs.xi[take] = xi_in[take]
         pairs.dist[take] = dist_in[take]
