@@ -226,6 +226,16 @@ def test_quadratic_membrane_is_rejected(scene):
         ContactProblem(membrane, degree=2, verbose=False)
 
 
+def test_serendipity_is_rejected():
+    """8-node serendipity quadrilateral facets are not implemented: the family is named."""
+    scene = curved_pair(3, cell="hexahedron")
+    mesh = scene.parts[0].mesh
+    u = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("S", 2, (3,))))
+    tags = scene.parts[0].surface_tags
+    with pytest.raises(ContactInputError, match="serendipity family: contact supports Lagrange"):
+        ContactInterface(u, tags, scene.contacts[0], 1.0)
+
+
 def test_mixed_degrees_are_rejected(scene):
     """A pair whose slave and master displacements differ in degree."""
     mesh = scene.parts[0].mesh

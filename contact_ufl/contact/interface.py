@@ -24,12 +24,14 @@ the problem maps them to the unknowns through the chain operator (:mod:`contact_
 
 from __future__ import annotations
 
+import basix
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
 
 from contact_ufl.contact.coulomb import CoulombLaw
+from contact_ufl.contact.facets import scalar_element
 from contact_ufl.contact.kinematics import MeshKinematics
 from contact_ufl.contact.master import MeshMaster
 from contact_ufl.contact.normal import NormalLaw
@@ -365,13 +367,21 @@ def check_degrees(
 ) -> None:
     """Raise (on every rank) unless the displacement ``u`` of one side of ``pair`` and its
     mesh are of a supported degree (:data:`SUPPORTED_DEGREES`): linear facets of a degree-1
-    displacement, or the quadratic (3-node segment, 6-node triangle) facets of a degree-2
-    displacement on a straight or curved (degree-2) geometry, also 9-node quadrilaterals
-    of quadratic hexahedra. The quadratic facets are not implemented for membranes and the
-    smoothed master normal."""
+    displacement, or the quadratic facets of a degree-2 Lagrange displacement (3-node
+    segments, 6-node triangles, 9-node quadrilaterals of quadratic hexahedra) on a straight
+    or curved (degree-2) geometry. The quadratic facets are not implemented for membranes,
+    the smoothed master normal and serendipity (8-node) quadrilaterals."""
     mesh = u.function_space.mesh
     comm = mesh.comm
     degree = u.function_space.ufl_element().embedded_superdegree
+    family = scalar_element(u.function_space).family
+    collective_check(
+        comm,
+        family == basix.ElementFamily.P,
+        f"the {side} body's displacement is of the {family.name} family: contact supports "
+        "Lagrange displacements (of degree 1 or 2; 8-node serendipity facets are not "
+        "implemented)",
+    )
     geometry_degree = mesh.geometry.cmaps[0].degree
     tag = pair.slave if side == "slave" else pair.master
     supported = (
