@@ -12,7 +12,7 @@ the curved, degree-2, mesh unless ``--order 1``).
 
     python benchmarks/hertz.py --json benchmarks/results/hertz.json [--quick] [--material linear]
     python benchmarks/hertz.py --json ... --degree 2 [--order 1] [--h 0.02 0.01] [--steps 1]
-        [--subdivisions 4] [--multiplier-degree 2]
+        [--subdivisions 4] [--multiplier-degree 2] [--refine-radius 0.1]
     mpirun -n 2 python benchmarks/hertz.py --json ...
     python benchmarks/hertz.py --plot benchmarks/results/hertz.png RESULTS.json [...]
 
@@ -61,11 +61,13 @@ def run(
     order: int | None = None,
     subdivisions: int = 1,
     multiplier_degree: int = 1,
+    refine_radius: float = 0.3,
 ) -> dict:
     """One 2D run; ``order``: the geometry's (default: the displacement's ``degree``);
-    ``subdivisions``, ``multiplier_degree``: those of the contact pair."""
+    ``subdivisions``, ``multiplier_degree``: those of the contact pair; ``refine_radius``:
+    that of the mesh's zone of size ``h`` (in units of the disc's radius)."""
     order = degree if order is None else order
-    hertz = scenes.hertz_2d(h_contact=h, depth=depth, order=order)
+    hertz = scenes.hertz_2d(h_contact=h, depth=depth, order=order, refine_radius=refine_radius)
     scene = hertz.scene
     scene.contacts[0] = dataclasses.replace(
         scene.contacts[0],
@@ -96,6 +98,7 @@ def run(
         "geometry_order": order,
         "subdivisions": subdivisions,
         "multiplier_degree": multiplier_degree,
+        "refine_radius": refine_radius,
         "material": material,
         "h": h,
         "a_over_h": exact.a / h,
@@ -200,6 +203,9 @@ def main() -> None:
     parser.add_argument("--h", type=float, nargs="+", default=None, help="2D: h_contact list")
     parser.add_argument("--subdivisions", type=int, default=1, help="2D: contact quadrature")
     parser.add_argument("--multiplier-degree", type=int, choices=(1, 2), default=1, help="2D")
+    parser.add_argument(
+        "--refine-radius", type=float, default=0.3, help="2D: zone of size h, in units of R"
+    )
     args = parser.parse_args()
     if args.dim == 3:
         args.depth = 0.01 if args.depth is None else args.depth
@@ -226,6 +232,7 @@ def main() -> None:
             args.order,
             args.subdivisions,
             args.multiplier_degree,
+            args.refine_radius,
         )
         records.append(r)
         if comm.rank == 0:

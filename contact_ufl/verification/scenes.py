@@ -56,6 +56,7 @@ def hertz_2d(
     gap: float = 0.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
     order: int = 1,
+    refine_radius: float = 0.3,
 ) -> HertzScene:
     """Plane-strain Hertz problem: an elastic half disc (R = 1) pressed onto an elastic block.
 
@@ -91,9 +92,18 @@ def hertz_2d(
     order
         Geometry order of the mesh (2: the disc's arc is curved, for a degree-2
         displacement).
+    refine_radius
+        Radius of the zone of size ``h_contact``, in units of the disc's radius.
     """
     E_flat = E if E_flat is None else E_flat
-    sm = geometries.hertz_2d(h_contact=h_contact, h_far=h_far, gap=gap, order=order, comm=comm)
+    sm = geometries.hertz_2d(
+        h_contact=h_contact,
+        h_far=h_far,
+        gap=gap,
+        order=order,
+        refine_radius=refine_radius,
+        comm=comm,
+    )
     tags = sm.tags
     R = rotation_2d(rotation)
     sm.mesh.geometry.x[:, :2] = sm.mesh.geometry.x[:, :2] @ R.T
