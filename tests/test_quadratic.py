@@ -12,6 +12,7 @@ import dolfinx
 import numpy as np
 import pytest
 from mpi4py import MPI
+from test_self_contact import _slot_scene
 
 from contact_ufl.contact.interface import ContactInterface
 from contact_ufl.contact.projection import closest_points, shape_functions
@@ -327,3 +328,18 @@ def test_hertz_quadratic_2d():
     assert np.abs(lam[inside] - hertz_profile).max() < 0.05
     # no oscillation: the second differences of a concave profile are all negative
     assert np.all(np.diff(lam[inside], 2) < 0.0)
+
+
+def test_self_contact_quadratic():
+    """The slot of tests/test_self_contact.py pressed shut with Q2: self-contact of its
+    surface (3-node segments, keyed by their vertices) gives the classical pair's
+    reaction (to 1e-5) and Newton iterations."""
+    results = []
+    for self_contact in (True, False):
+        problem = ContactProblem(_slot_scene(MPI.COMM_WORLD, self_contact), degree=2, verbose=False)
+        problem.solve(num_steps=4)
+        assert problem.contacts[0].kinematics.nn == 3 and problem.active_points() >= 12
+        results.append((problem.reaction(2), [s.newton_iterations for s in problem.history.steps]))
+    (a, steps_a), (b, steps_b) = results
+    assert steps_a == steps_b and a[1] < -0.2
+    assert np.linalg.norm(a - b) < 1e-5 * np.linalg.norm(b)
