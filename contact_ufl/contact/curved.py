@@ -94,10 +94,10 @@ def _line(u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """1D quadratic Lagrange functions (start, end, middle) at ``u`` and their derivatives,
     ``(3, n)`` each."""
     one = np.ones_like(u)
-    l = np.stack([(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)])
+    values = np.stack([(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)])
     dl = np.stack([4 * u - 3, 4 * u - 1, 4 - 8 * u])
     d2l = np.stack([4 * one, 4 * one, -8 * one])
-    return l, dl, d2l
+    return values, dl, d2l
 
 
 def _quadrilateral9(xi: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
