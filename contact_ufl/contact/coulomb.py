@@ -81,7 +81,9 @@ class CoulombLaw:
         self.slave: SlaveSurface = k.slave
         self.gdim = k.gdim
         mesh = k.u.function_space.mesh
-        self.L_T = dolfinx.fem.functionspace(self.slave.submesh, ("Lagrange", 1, (self.gdim,)))
+        self.L_T = dolfinx.fem.functionspace(
+            self.slave.submesh, ("Lagrange", self.slave.multiplier_degree, (self.gdim,))
+        )
         self.lambda_T = dolfinx.fem.Function(self.L_T, name="lambda_T")
         self.mu = dolfinx.fem.Constant(mesh, float(mu))
         self.eps_T = dolfinx.fem.Constant(mesh, float(eps_T))

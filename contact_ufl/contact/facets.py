@@ -2,7 +2,8 @@
 
 Conventions shared by the slave and the master side (and by :mod:`.projection`): a facet of
 ``nn`` nodes is a segment (2 nodes, 2D), a triangle (3 nodes) or a bilinear quadrilateral
-(4 nodes, basix vertex order) in 3D.
+(4 nodes, basix vertex order) in 3D; a quadratic facet (:mod:`.curved`) has these as its
+vertices, and its edges (:data:`FACET_EDGES`, :func:`on_edges`) are those of its vertices.
 """
 
 from __future__ import annotations

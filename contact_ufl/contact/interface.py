@@ -24,12 +24,14 @@ the problem maps them to the unknowns through the chain operator (:mod:`contact_
 
 from __future__ import annotations
 
+import basix
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
 
 from contact_ufl.contact.coulomb import CoulombLaw
+from contact_ufl.contact.facets import scalar_element
 from contact_ufl.contact.kinematics import MeshKinematics
 from contact_ufl.contact.master import MeshMaster
 from contact_ufl.contact.normal import NormalLaw
@@ -98,17 +100,34 @@ class ContactInterface:
         self.u, self.V, self.pair = u, V, pair
         self.gdim = mesh.geometry.dim
         degree = V.ufl_element().embedded_superdegree
-        # the master surface is interpolated from its vertices: exact for P1/Q1 only
-        geometry_degree = mesh.geometry.cmaps[0].degree
+        check_degrees(u, pair, facet_tags, "slave")
+        if not pair.on_obstacle:
+            other = u if master_u is None else master_u
+            other_tags = facet_tags if master_facet_tags is None else master_facet_tags
+            check_degrees(other, pair, other_tags, "master")
+            master_degree = other.function_space.ufl_element().embedded_superdegree
+            collective_check(
+                comm,
+                master_degree == degree,
+                f"the slave body (tag {pair.slave}) has a degree-{degree} displacement and the "
+                f"master body (tag {pair.master}) a degree-{master_degree} one: a contact pair "
+                "needs one displacement degree on both sides",
+            )
+        qdeg = pair.quadrature_degree or 2 * degree + 1
         collective_check(
             comm,
-            degree == 1 and geometry_degree == 1,
-            f"contact needs degree-1 displacement and geometry (got {degree} and "
-            f"{geometry_degree}): higher-order master surfaces are not implemented",
+            pair.multiplier_degree <= degree,
+            f"multiplier_degree={pair.multiplier_degree} of the pair with slave surface (tag "
+            f"{pair.slave}) needs a displacement of that degree (got degree {degree})",
         )
-        qdeg = pair.quadrature_degree or 2 * degree + 1
         self.slave = SlaveSurface(
-            V, facet_tags, pair.slave, qdeg, pair.quadrature_subdivisions, pair.quadrature_rule
+            V,
+            facet_tags,
+            pair.slave,
+            qdeg,
+            pair.quadrature_subdivisions,
+            pair.quadrature_rule,
+            pair.multiplier_degree,
         )
         #: the master side as the laws see it (gap, normal, projected point, master fields)
         if pair.on_obstacle:
@@ -337,6 +356,60 @@ class ContactInterface:
     def stick(self) -> np.ndarray:
         """Mask of the owned points in stick (with friction; see :meth:`.CoulombLaw.stick`)."""
         return self.friction.stick(self.normal_traction_at_points())
+
+
+#: What contact supports: (displacement degree, geometry degree) of a body's mesh.
+SUPPORTED_DEGREES = ((1, 1), (2, 1), (2, 2))
+
+
+def check_degrees(
+    u: dolfinx.fem.Function, pair: ContactPair, surface_tags: dolfinx.mesh.MeshTags, side: str
+) -> None:
+    """Raise (on every rank) unless the displacement ``u`` of one side of ``pair`` and its
+    mesh are of a supported degree (:data:`SUPPORTED_DEGREES`): linear facets of a degree-1
+    displacement, or the quadratic facets of a degree-2 Lagrange displacement (3-node
+    segments, 6-node triangles, 9-node quadrilaterals of quadratic hexahedra) on a straight
+    or curved (degree-2) geometry. The quadratic facets are not implemented for membranes,
+    the smoothed master normal and serendipity (8-node) quadrilaterals."""
+    mesh = u.function_space.mesh
+    comm = mesh.comm
+    degree = u.function_space.ufl_element().embedded_superdegree
+    family = scalar_element(u.function_space).family
+    collective_check(
+        comm,
+        family == basix.ElementFamily.P,
+        f"the {side} body's displacement is of the {family.name} family: contact supports "
+        "Lagrange displacements (of degree 1 or 2; 8-node serendipity facets are not "
+        "implemented)",
+    )
+    geometry_degree = mesh.geometry.cmaps[0].degree
+    tag = pair.slave if side == "slave" else pair.master
+    supported = (
+        "contact supports a degree-1 displacement on a degree-1 geometry, or a degree-2 "
+        "displacement on a degree-1 or degree-2 geometry"
+    )
+    collective_check(
+        comm,
+        (degree, geometry_degree) in SUPPORTED_DEGREES,
+        f"the {side} body (tag {tag}) has a degree-{degree} displacement on a "
+        f"degree-{geometry_degree} geometry: {supported}",
+    )
+    if degree == 1:
+        return
+    tdim = mesh.topology.dim
+    collective_check(
+        comm,
+        surface_tags.dim == tdim - 1,
+        f"the {side} surface (tag {tag}) is a membrane's: membranes in contact need a "
+        "degree-1 displacement",
+    )
+    collective_check(
+        comm,
+        side == "slave" or pair.master_normal == "facet",
+        f'master_normal="{pair.master_normal}" of the pair with master surface (tag {tag}) '
+        "needs a degree-1 displacement: with degree 2 the master normal is that of the "
+        'quadratic facet (master_normal="facet")',
+    )
 
 
 def default_eps(slave: SlaveSurface, modulus: float | None) -> float:

@@ -38,8 +38,11 @@ def master_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]
     """UFL shape functions of a master facet and their xi-derivatives.
 
     Conventions as in :mod:`.projection`: segment (2 nodes), triangle (3 nodes), bilinear
-    quadrilateral (4 nodes, basix vertex order).
+    quadrilateral (4 nodes, basix vertex order); quadratic segment (3 nodes, ``xi`` of one
+    coordinate) and triangle (6 nodes) of :mod:`.curved`.
     """
+    if nn == 3 and xi.ufl_shape == (1,) or nn in (6, 9):
+        return quadratic_shape_functions(nn, xi)
     if nn == 2:
         s = xi[0]
         return [1 - s, s], [[-1.0], [1.0]]
@@ -52,6 +55,38 @@ def master_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]
         dN = [[-(1 - t), -(1 - s)], [1 - t, -s], [-t, 1 - s], [t, s]]
         return N, dN
     raise ValueError(f"no master facet with {nn} nodes")
+
+
+def _line(u) -> tuple[list, list]:
+    """1D quadratic Lagrange functions (start, end, middle) of ``u`` and their derivatives."""
+    return [(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)], [
+        4 * u - 3,
+        4 * u - 1,
+        4 - 8 * u,
+    ]
+
+
+def quadratic_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
+    """UFL twin of :func:`.curved.quadratic_shape_functions`: the 3-node segment (ends, then
+    midpoint), the 6-node triangle (vertices, then the midpoints of edges 01, 12, 02) and the
+    9-node quadrilateral (:data:`.curved.QUADRILATERAL9_EDGES`)."""
+    if nn == 3:
+        line, dline = _line(xi[0])
+        return line, [[d] for d in dline]
+    if nn == 9:
+        (ls, dls), (lt, dlt) = _line(xi[0]), _line(xi[1])
+        index = ((0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (1, 2), (2, 1), (0, 2), (2, 2))
+        N = [ls[i] * lt[j] for i, j in index]
+        dN = [[dls[i] * lt[j], ls[i] * dlt[j]] for i, j in index]
+        return N, dN
+    L = [1 - xi[0] - xi[1], xi[0], xi[1]]
+    dL = [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]
+    N = [L[i] * (2 * L[i] - 1) for i in range(3)]
+    dN = [[(4 * L[i] - 1) * dL[i][al] for al in range(2)] for i in range(3)]
+    for i, j in ((0, 1), (1, 2), (0, 2)):
+        N.append(4 * L[i] * L[j])
+        dN.append([4 * (L[j] * dL[i][al] + L[i] * dL[j][al]) for al in range(2)])
+    return N, dN
 
 
 def interpolate(coeffs, nodes, gdim: int) -> ufl.core.expr.Expr:

@@ -58,7 +58,8 @@ class MeshMaster:
 
     Facet nodes are the vertices of the facets (linear segments, triangles, bilinear
     quadrilaterals), ordered so that the normal of :mod:`.projection` points out of
-    the master body.
+    the master body; with a degree-2 displacement followed by the dofs of the facet's edge
+    midpoints (3-node segments, 6-node triangles of :mod:`.curved`).
 
     Parameters
     ----------
@@ -79,6 +80,9 @@ class MeshMaster:
     ----------
     nodes
         Local block index (displacement dof block) of each facet node, ``(nf, nn)``.
+    nv
+        Vertices of a facet (``nn`` for linear facets): the keys and boundary edges are
+        those of the vertices.
     X_nodes
         Reference positions of the nodes, ``(nf, nn, gdim)``.
     global_nodes
@@ -167,7 +171,39 @@ class MeshMaster:
         geometry_nodes = np.take_along_axis(
             mesh.geometry.dofmaps[0][cells], np.array(reference_facets)[local], axis=1
         )
+        if layout.num_dofs > len(basix.topology(basix_cell(mesh, tdim))[0]):
+            vertices = np.array(reference_facets)[local]  # cell-local vertex numbers
+            vertices[flip, swap[0]], vertices[flip, swap[1]] = (
+                vertices[flip, swap[1]],
+                vertices[flip, swap[0]],
+            )
+            nodes = np.hstack(
+                [nodes, cell_dofs[np.arange(len(cells))[:, None], self._midpoints(vertices, local)]]
+            )
         self._finish(nodes, geometry_nodes, flip, swap)
+
+    def _midpoints(self, vertices: np.ndarray, local: np.ndarray) -> np.ndarray:
+        """The cell-local dofs of the edge midpoints of quadratic facets of the oriented
+        cell-local ``vertices`` ``(nf, nv)`` (local facets ``local``): of the segment's edge
+        (2D); of the edges 01, 12 and 02 of a triangle; of the edges 01, 13, 23 and 02 of a
+        quadrilateral, then its centre (the node orders of :mod:`.curved`)."""
+        mesh = self.V.mesh
+        layout = self.V.dofmap.dof_layout
+        edges = basix.topology(basix_cell(mesh, mesh.topology.dim))[1]
+        nvc = len(basix.topology(basix_cell(mesh, mesh.topology.dim))[0])
+        edge_of = np.full((nvc, nvc), -1, dtype=np.int64)
+        for e, (i, j) in enumerate(edges):
+            edge_of[i, j] = edge_of[j, i] = e
+        edge_dof = np.array([layout.entity_dofs(1, e)[0] for e in range(len(edges))])
+        nv = vertices.shape[1]
+        pairs = {2: ((0, 1),), 3: ((0, 1), (1, 2), (0, 2)), 4: ((0, 1), (1, 3), (2, 3), (0, 2))}
+        mids = [edge_dof[edge_of[vertices[:, i], vertices[:, j]]] for i, j in pairs[nv]]
+        if nv == 4:  # the centre dof of the quadrilateral facet
+            fdim = mesh.topology.dim - 1
+            faces = basix.topology(basix_cell(mesh, mesh.topology.dim))[fdim]
+            face_dof = np.array([layout.entity_dofs(fdim, f)[0] for f in range(len(faces))])
+            mids.append(face_dof[local])
+        return np.stack(mids, axis=1)
 
     def _finish(self, nodes, geometry_nodes, flip, swap) -> None:
         """Positions, global numbers, keys and boundary edges of the oriented facets of
@@ -179,6 +215,9 @@ class MeshMaster:
         self.global_nodes = imap.local_to_global(nodes.ravel().astype(np.int32)).reshape(
             nodes.shape
         )
+        #: vertices of a facet (its first nodes; a quadratic facet's midpoint nodes follow)
+        self.nv = geometry_nodes.shape[1]
+        nodes = nodes[:, : self.nv]
         # a key of each facet independent of the partition and of rigid motions: the sorted
         # input (file) indices of its vertices, to break ties between equidistant facets
         node_keys = self.V.mesh.geometry.input_global_indices[geometry_nodes]

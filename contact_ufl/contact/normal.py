@@ -7,7 +7,9 @@ Discrete multiplier: ``lambda_N`` is continuous piecewise linear on the slave su
 It interpolates a continuous contact pressure with the same resolution as the slave trace
 of a P1 displacement, so the active set and the gap condition are imposed in the weak
 (mortar) sense at the contact quadrature points, and the multiplier *is* the nodal pressure
-(property (c) of ``formulation.md``). The slave side should be the finer mesh, as usual
+(property (c) of ``formulation.md``). With a degree-2 displacement it stays P1 by default
+(``ContactPair.multiplier_degree``; the evidence is in ``docs/quadratic-contact.md``).
+The slave side should be the finer mesh, as usual
 with standard mortar multipliers.
 """
 

@@ -67,6 +67,11 @@ class ContactPair:
         :attr:`Scene.parts <contact_ufl.scene.Scene.parts>` or a domain's name. Needed only
         to tell apart integer tags in a scene of several meshes; by default a surface is
         found by its group name. The scene sets both to indices when it is made.
+    multiplier_degree
+        Degree of the continuous Lagrange multipliers on the slave surface: 1 (default, also
+        with a degree-2 displacement: smooth and non-negative nodal pressures on 3-node
+        segments and 6-node triangles) or 2 (with a degree-2 displacement only; see
+        ``docs/quadratic-contact.md`` for the comparison).
     """
 
     slave: int | str
@@ -81,6 +86,7 @@ class ContactPair:
     master_normal: str = "facet"
     slave_domain: int | str | None = None
     master_domain: int | str | None = None
+    multiplier_degree: int = 1
 
     @property
     def frictional(self) -> bool:
@@ -131,6 +137,11 @@ class ContactPair:
             comm,
             self.master_normal in ("facet", "smoothed"),
             f"master_normal must be 'facet' or 'smoothed', got {self.master_normal!r}",
+        )
+        collective_check(
+            comm,
+            self.multiplier_degree in (1, 2),
+            f"multiplier_degree must be 1 or 2, got {self.multiplier_degree!r}",
         )
         collective_check(
             comm,

@@ -18,6 +18,14 @@ positions, already oriented by the caller. The kind follows from ``(nn, gdim)``:
 * quadrilateral, ``nn = 4, gdim = 3``, bilinear in the basix vertex order:
   ``N = [(1-s)(1-t), s(1-t), (1-s)t, st]``, ``(s, t)`` in ``[0, 1]^2``, ``a1 = dy/ds``,
   ``a2 = dy/dt``, ``nu = a1 x a2 / |a1 x a2|`` (not constant on a warped quadrilateral).
+* quadratic segment, ``nn = 3, gdim = 2`` (``"segment3"``): the two ends, then the
+  midpoint node; quadratic triangle, ``nn = 6, gdim = 3`` (``"triangle6"``): the vertices,
+  then the midpoint nodes of the edges 01, 12, 02; quadratic quadrilateral, ``nn = 9, gdim =
+  3`` (``"quadrilateral9"``): the basix vertices, the midpoint nodes of the edges 01, 13, 23,
+  02, then the centre node. Quadratic Lagrange shape functions
+  (:func:`.curved.quadratic_shape_functions`), the normal as above from the tangents at
+  ``xi``: the facets of a degree-2 displacement (curved once deformed, or from the start on
+  a degree-2 geometry), projected by the kernels of :mod:`.curved`.
 
 With these conventions the proximity ``g = -nu . (x - y)`` is positive when the slave point
 ``x`` lies behind the master surface (penetration) and negative when it is in front of it.
@@ -50,6 +58,15 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
+from contact_ufl.contact.curved import (
+    CURVED_EDGES,
+    bernstein_hull,
+    curve_closest,
+    quadratic_shape_functions,
+    quadrilateral_interior,
+    triangle_interior,
+)
+
 __all__ = [
     "Projection",
     "SelfContact",
@@ -64,7 +81,17 @@ IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
 
 #: Facet kind of each supported ``(nn, gdim)``.
-_KINDS = {(2, 2): "segment", (3, 3): "triangle", (4, 3): "quadrilateral"}
+_KINDS = {
+    (2, 2): "segment",
+    (3, 3): "triangle",
+    (4, 3): "quadrilateral",
+    (3, 2): "segment3",
+    (6, 3): "triangle6",
+    (9, 3): "quadrilateral9",
+}
+
+#: The quadratic (curved) kinds, projected by the kernels of :mod:`.curved`.
+QUADRATIC = ("segment3", "triangle6", "quadrilateral9")
 
 #: Straight edges of each 2D facet kind: (start node, end node, xi at start, xi at end).
 #: Along an edge ``xi = xi_start + u (xi_end - xi_start)``, ``y = x_start + u (x_end - x_start)``.
@@ -81,6 +108,10 @@ _EDGES = {
         (0, 2, (0.0, 0.0), (0.0, 1.0)),  # s = 0
     ),
 }
+#: the 6-node triangle has the straight triangle's edges in reference space (its nodes
+#: there are the vertices; the midpoint nodes are in :data:`.curved.TRIANGLE6_EDGES`)
+_EDGES["triangle6"] = _EDGES["triangle"]
+_EDGES["quadrilateral9"] = _EDGES["quadrilateral"]
 
 _K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
@@ -229,6 +260,8 @@ def shape_functions(
     kind = facet_kind(nn, gdim)
     fdim = gdim - 1
     xi = np.asarray(xi, dtype=np.float64).reshape(-1, fdim)
+    if kind in QUADRATIC:
+        return quadratic_shape_functions(kind, xi)
     npts = xi.shape[0]
     dN = np.zeros((npts, nn, fdim))
     d2N = np.zeros((npts, nn, fdim, fdim))
@@ -295,9 +328,15 @@ class _Master:
         self.fdim = self.gdim - 1
         self.kind = facet_kind(self.nn, self.gdim)
         g = self.gdim
+        # the points whose convex hull holds the facet: its nodes, or the Bernstein control
+        # points of a quadratic facet (which is not in the convex hull of its nodes)
+        hull = bernstein_hull(self.kind, nodes) if self.kind in QUADRATIC else nodes
         # per-facet data from the coordinate columns of the nodes (a loop over the few nodes
         # and coordinates of a facet: reductions over such short axes are slow in NumPy)
         X = [[np.ascontiguousarray(nodes[:, a, k]) for k in range(g)] for a in range(self.nn)]
+        if hull is not nodes:
+            X_nodes = X
+            X = [[np.ascontiguousarray(hull[:, a, k]) for k in range(g)] for a in range(self.nn)]
         c = []
         for k in range(g):
             ck = X[0][k] + X[1][k]
@@ -305,8 +344,8 @@ class _Master:
                 ck += X[a][k]
             c.append(ck / self.nn)
         self.centroid = np.stack(c, axis=1)
-        # every point of a facet is a convex combination of its nodes (also for the bilinear
-        # quadrilateral), so it lies within this radius of the centroid, which is on the facet
+        # every point of a facet is a convex combination of its hull points (also for the
+        # bilinear quadrilateral), so it lies within this radius of the centroid
         offsets = [[Xa[k] - c[k] for k in range(g)] for Xa in X]
         radius2 = sum(dk * dk for dk in offsets[0])
         for d in offsets[1:]:
@@ -314,9 +353,9 @@ class _Master:
         self.size = np.sqrt(radius2)
         self.R_max = float(self.size.max()) if self.nf else 0.0
         trees = trees if trees is not None else TreeCache()
-        self.tree, self.slack = trees.tree(nodes, self.centroid, self.R_max)
-        # slab of the facet: unit normal at the centre, largest node offset along it
-        n = _normalise(self._centre_normal(X))
+        self.tree, self.slack = trees.tree(hull, self.centroid, self.R_max)
+        # slab of the facet: unit normal at the centre, largest hull offset along it
+        n = _normalise(self._centre_normal(X if hull is nodes else X_nodes))
         self.axis = np.stack(n, axis=1)
         thickness = np.abs(sum(offsets[0][k] * n[k] for k in range(g)))
         for d in offsets[1:]:
@@ -347,7 +386,8 @@ class _Master:
         """Columns of the normal ``a1 x a2`` (2D: ``(a1[1], -a1[0])``) at the centre of each
         facet, from the coordinate columns ``X[a][k]`` of its nodes."""
         g = self.gdim
-        _, dN, _ = shape_functions(self.nn, g, np.full((1, self.fdim), 0.5))
+        centre = 1.0 / 3.0 if self.kind == "triangle6" else 0.5
+        _, dN, _ = shape_functions(self.nn, g, np.full((1, self.fdim), centre))
         a = [
             [
                 sum(dN[0, n, alpha] * X[n][k] for n in range(self.nn) if dN[0, n, alpha] != 0)
@@ -368,9 +408,10 @@ class _Master:
         """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``
         (of the points ``x[pid]`` if ``pid`` is given).
 
-        Every facet point ``p`` lies in the convex hull of the nodes, so within ``R_f`` of the
-        centroid ``c`` and within ``T_f`` of it along the normal ``n`` at the centre: with
-        ``d = x - c``, ``|x - p|^2 >= (|n . d| - T_f)_+^2 + (|d - (n . d) n| - R_f)_+^2``.
+        Every facet point ``p`` lies in the convex hull of the nodes (of a quadratic facet, of
+        its Bernstein control points), so within ``R_f`` of the centroid ``c`` and within
+        ``T_f`` of it along the normal ``n`` at the centre: with ``d = x - c``,
+        ``|x - p|^2 >= (|n . d| - T_f)_+^2 + (|d - (n . d) n| - R_f)_+^2``.
         """
         g, slab = self.gdim, self.slab
         if pid is None:
@@ -397,6 +438,8 @@ class _Master:
         projection uses it to skip the facets that cannot hold the closest point.
         """
         # coordinate columns of the pairs' nodes and points (cheaper than rows of 2 or 3)
+        if self.kind in QUADRATIC:
+            return self._project_quadratic(x, self.nodes[f])
         g = self.gdim
         X = [[self.nodes[:, a, k][f] for k in range(g)] for a in range(self.nn)]
         xs = [x[:, k] for k in range(g)]
@@ -407,6 +450,37 @@ class _Master:
             self._triangle_interior(xs, X, f, pairs)
         else:
             self._quadrilateral_interior(x, f, pid, npts, pairs)
+        return pairs
+
+    def _project_quadratic(self, x: FloatArray, nodes: FloatArray) -> _Pairs:
+        """Project the points ``x`` (P, gdim) on the quadratic facets ``nodes`` (P, nn, gdim):
+        the closest point on the (curved) edges, replaced by an interior minimum of a
+        6-node triangle or 9-node quadrilateral where that is closer (:mod:`.curved`)."""
+        if self.kind == "segment3":
+            u, dist = curve_closest(x, nodes[:, 0], nodes[:, 1], nodes[:, 2])
+            edge = np.full(len(u), -1, dtype=np.int64)
+            return _Pairs(xi=u[:, None], dist=dist, edge=edge, vertex=(u == 0.0) | (u == 1.0))
+        best_d = best_u = None
+        best_k = np.zeros(len(x), dtype=np.int64)
+        for n, (i, j, m) in enumerate(CURVED_EDGES[self.kind]):
+            u, d = curve_closest(x, nodes[:, i], nodes[:, j], nodes[:, m])
+            if best_d is None:
+                best_d, best_u = d, u
+                continue
+            better = d < best_d
+            best_d, best_u = np.where(better, d, best_d), np.where(better, u, best_u)
+            best_k = np.where(better, n, best_k)
+        starts = np.array([s for _, _, s, _ in _EDGES[self.kind]])
+        ends = np.array([e for _, _, _, e in _EDGES[self.kind]])
+        xi = starts[best_k] + best_u[:, None] * (ends[best_k] - starts[best_k])
+        pairs = _Pairs(xi=xi, dist=best_d, edge=best_k, vertex=(best_u == 0.0) | (best_u == 1.0))
+        interior = triangle_interior if self.kind == "triangle6" else quadrilateral_interior
+        xi_in, dist_in, inner = interior(x, nodes)
+        take = np.flatnonzero(inner & (dist_in < pairs.dist))
+        pairs.xi[take] = xi_in[take]
+        pairs.dist[take] = dist_in[take]
+        pairs.edge[take] = -1
+        pairs.vertex[take] = False
         return pairs
 
     def _edges(self, xs: list[FloatArray], X: list[list[FloatArray]]) -> _Pairs:
@@ -889,20 +963,22 @@ def closest_points(
 
     Notes
     -----
-    Candidate search: a KD-tree of the facet centroids. The centroid of a facet lies on the
-    facet and every facet point is within ``R_f`` (largest node distance from the centroid) of
-    it, ``R_max = max R_f``. With ``d1 <= d0`` the exact distance of ``x`` to the facet of its
-    nearest centroid (``d0`` away, a query bounded by ``radius + R_max``), the closest point
-    is within ``r = min(d1, radius)`` of ``x``, so its facet has its centroid within ``r +
-    R_max`` (one ball query per point, with the point's own ``r``: the work follows ``r``,
-    not the search radius). The facets whose distance lower bound (node sphere and slab along
-    the normal at the centre) exceeds ``r`` are dropped, the others projected exactly. Points
-    with ``d0 > radius + R_max`` get ``facet = -1`` at once. The KD-tree is reused from one
-    call to the next while the master nodes (same array shape) have moved less than ``0.25
-    R_max``, the bounds being widened by that movement. On a master of over ``2^14`` facets
-    the points are searched in the order of the cells of a ``64^gdim`` grid over them (the
-    results are returned in the order given): neighbouring points query the same branches of
-    the tree and gather the same facets' data while they are in cache.
+    Candidate search: a KD-tree of the facet centroids (the mean of the nodes; of a
+    quadratic facet, of its Bernstein control points, whose convex hull holds it); every
+    facet point is within ``R_f`` (the largest node, or control point, distance from the
+    centroid) of it, ``R_max = max R_f``. With ``d1 <= d0`` the exact distance of ``x`` to
+    the facet of its nearest centroid (``d0`` away, a query bounded by ``radius + R_max``),
+    the closest point is within ``r = min(d1, radius)`` of ``x``, so its facet has its
+    centroid within ``r + R_max`` (one ball query per point, with the point's own ``r``: the
+    work follows ``r``, not the search radius). The facets whose distance lower bound (node
+    sphere and slab along the normal at the centre) exceeds ``r`` are dropped, the others
+    projected exactly. Points with ``d0 > radius + R_max`` get ``facet = -1`` at once. The
+    KD-tree is reused from one call to the next while the master nodes (same array shape)
+    have moved less than ``0.25 R_max``, the bounds being widened by that movement. On a
+    master of over ``2^14`` facets the points are searched in the order of the cells of a
+    ``64^gdim`` grid over them (the results are returned in the order given): neighbouring
+    points query the same branches of the tree and gather the same facets' data while they
+    are in cache.
 
     The work of a point grows with its distance ``D`` from the master surface, not with the
     search radius: its candidates are the facets with a centroid within ``min(D, radius) +

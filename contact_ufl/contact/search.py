@@ -174,17 +174,18 @@ class ClosestPointSearch:
         """
         start = time.perf_counter()
         gdim, nn, nx = self.gdim, self.master.nn, self.master.nx
+        nk = self.master.nv  # the keys of a facet: its vertices
         points = self.slave.positions(u).reshape(-1, gdim)
         mine = self.master.candidates(layout)
         ne = mine.boundary.shape[1]
         payload = np.hstack([mine.columns, mine.keys, mine.boundary.astype(np.int64), mine.flags])
         nodes, payload = self.exchange(mine.nodes, points, payload)
         # candidates in a rank-independent order: ties between facets break the same way
-        order = np.lexsort(payload[:, nx : nx + nn].T[::-1])
+        order = np.lexsort(payload[:, nx : nx + nk].T[::-1])
         nodes, payload = nodes[order], payload[order]
         columns = payload[:, :nx]
-        boundary = payload[:, nx + nn : nx + nn + ne].astype(bool)
-        rule = self._self_contact(payload[:, nx : nx + nn], self.slave.current_normals(u))
+        boundary = payload[:, nx + nk : nx + nk + ne].astype(bool)
+        rule = self._self_contact(payload[:, nx : nx + nk], self.slave.current_normals(u))
         proj = closest_points(points, nodes[:, :nn], self.radius, self.trees, rule)
         if rule is not None:
             release_beside_own_facet(proj, points, rule, self.touching)
@@ -195,7 +196,7 @@ class ClosestPointSearch:
         if self.master.smoothed:
             facet_nodes = nodes[proj.facet[paired]]
             if gdim == 2:
-                facet_flags = payload[proj.facet[paired], nx + nn + ne :].astype(bool)
+                facet_flags = payload[proj.facet[paired], nx + nk + ne :].astype(bool)
                 normal = smoothed_normals(proj.xi[paired], facet_nodes, facet_flags)
                 flags = np.zeros((len(points), 2))
                 flags[paired] = facet_flags

@@ -26,6 +26,7 @@ import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from scipy.spatial import cKDTree
 
 from contact_ufl.contact.facets import (
     basix_cell,
@@ -37,6 +38,7 @@ from contact_ufl.contact.facets import (
     tagged_facets,
 )
 from contact_ufl.contact.quadrature import composite_quadrature
+from contact_ufl.errors import collective_check
 
 
 @dataclass
@@ -57,6 +59,8 @@ class SlaveSurface:
         Repeat that rule on a uniform split of each facet into this many parts per edge.
     rule
         ``"gauss"`` or ``"lobatto"`` (:data:`QUADRATURE_RULES`).
+    multiplier_degree
+        Degree of the continuous Lagrange multiplier space on the submesh (1 or 2).
 
     Attributes
     ----------
@@ -79,6 +83,7 @@ class SlaveSurface:
     quadrature_degree: int
     subdivisions: int = 1
     rule: str = "gauss"
+    multiplier_degree: int = 1
     submesh: dolfinx.mesh.Mesh = field(init=False)
     entity_map: dolfinx.mesh.EntityMap = field(init=False)
 
@@ -156,9 +161,12 @@ class SlaveSurface:
             subdomain_id=self.tag,
             metadata={"quadrature_degree": self.quadrature_degree},
         )
-        #: the space of the multiplier nodes: continuous P1 on the slave submesh
-        self.P1 = dolfinx.fem.functionspace(self.submesh, ("Lagrange", 1))
-        p1 = self.P1.ufl_element().basix_element
+        #: the space of the multiplier nodes: continuous Lagrange on the slave submesh, of
+        #: degree 1 (default) or 2
+        self.multiplier_space = dolfinx.fem.functionspace(
+            self.submesh, ("Lagrange", self.multiplier_degree)
+        )
+        p1 = self.multiplier_space.ufl_element().basix_element
         self._phi_p1 = p1.tabulate(0, self.points_ref)[0, :, :, 0]  # (nq, nv)
 
     def _parent_reference_points(self, sub_cell, local_vertices, tdim) -> np.ndarray:
@@ -185,6 +193,12 @@ class SlaveSurface:
         p1 = basix.create_element(basix.ElementFamily.P, sub_cell, 1)
         phi = p1.tabulate(0, self.points_ref)[0, :, :, 0]  # (nq, nv)
         return np.einsum("qv,cvd->cqd", phi, vert_ref)
+
+    @property
+    def P1(self) -> dolfinx.fem.FunctionSpace:
+        """The multiplier space (:attr:`multiplier_space`; by the name of its default degree
+        1)."""
+        return self.multiplier_space
 
     @property
     def num_cells(self) -> int:
@@ -304,6 +318,8 @@ class SlaveSurface:
     def node_blocks(self) -> np.ndarray:
         """For each owned multiplier node, the local dof block (node) of the parent
         displacement at the same vertex, ``(n,)``."""
+        if self.multiplier_degree > 1:
+            return self._node_blocks_by_position()
         mesh, sdim = self.V.mesh, self.submesh.topology.dim
         tdim = mesh.topology.dim
         nv = self._phi_p1.shape[1]
@@ -324,12 +340,37 @@ class SlaveSurface:
         block_of_vertex[cell_vertices.ravel()] = self.V.dofmap.list[:, :nvc].ravel()
         return block_of_vertex[parent_vertex]
 
+    def _node_blocks_by_position(self) -> np.ndarray:
+        """:meth:`node_blocks` of a degree-2 multiplier (degree-2 displacement): the
+        displacement dof block of the slave cells at the position of each owned multiplier
+        node (vertices and edge midpoints coincide); raises (collective) if a node has no
+        slave cell on this rank."""
+        owned = self.multiplier_space.dofmap.index_map.size_local
+        gdim = self.V.mesh.geometry.dim
+        nodes = self.multiplier_space.tabulate_dof_coordinates()[:owned, :gdim]
+        blocks = np.unique(self._cell_dofs)
+        coords = self.V.tabulate_dof_coordinates()[blocks, :gdim]
+        scale = self.facet_size  # (collective)
+        found = np.full(owned, -1, dtype=np.int64)
+        if len(blocks) and owned:
+            distance, index = cKDTree(coords).query(nodes)
+            found = np.where(distance <= 1e-10 * scale, blocks[index], -1)
+        collective_check(
+            self.V.mesh.comm,
+            bool(np.all(found >= 0)),
+            "degree-2 multipliers: a multiplier node has no slave facet on its rank (the "
+            "held multipliers need one): use multiplier_degree=1",
+        )
+        return found
+
     def nodal_normal_projectors(self) -> np.ndarray:
         """``N N^T`` of the reference normals ``N`` of the slave cells around each owned
         multiplier node, averaged, ``(n, gdim, gdim)`` (the sign of ``N`` does not matter:
         a membrane's vertex-order normals may point either way)."""
         gdim = self.normals.shape[1]
-        space = dolfinx.fem.functionspace(self.submesh, ("Lagrange", 1, (gdim * gdim + 1,)))
+        space = dolfinx.fem.functionspace(
+            self.submesh, ("Lagrange", self.multiplier_degree, (gdim * gdim + 1,))
+        )
         f = dolfinx.fem.Function(space)
         values = f.x.array.reshape(-1, gdim * gdim + 1)
         outer = np.einsum("ci,cj->cij", self.normals, self.normals).reshape(-1, gdim * gdim)

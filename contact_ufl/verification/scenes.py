@@ -55,6 +55,8 @@ def hertz_2d(
     rotation: float = 0.0,
     gap: float = 0.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
+    order: int = 1,
+    refine_radius: float = 0.3,
 ) -> HertzScene:
     """Plane-strain Hertz problem: an elastic half disc (R = 1) pressed onto an elastic block.
 
@@ -87,9 +89,21 @@ def hertz_2d(
         (radians) about the origin: a frame-indifferent model gives rotated results.
     gap
         Initial gap between the disc and the block (``depth`` includes it).
+    order
+        Geometry order of the mesh (2: the disc's arc is curved, for a degree-2
+        displacement).
+    refine_radius
+        Radius of the zone of size ``h_contact``, in units of the disc's radius.
     """
     E_flat = E if E_flat is None else E_flat
-    sm = geometries.hertz_2d(h_contact=h_contact, h_far=h_far, gap=gap, comm=comm)
+    sm = geometries.hertz_2d(
+        h_contact=h_contact,
+        h_far=h_far,
+        gap=gap,
+        order=order,
+        refine_radius=refine_radius,
+        comm=comm,
+    )
     tags = sm.tags
     R = rotation_2d(rotation)
     sm.mesh.geometry.x[:, :2] = sm.mesh.geometry.x[:, :2] @ R.T
@@ -394,6 +408,7 @@ def curved_pair(
     nu: float = 0.3,
     eps_N: float = 10.0,
     cell: str = "tetrahedron",
+    order: int = 1,
 ) -> Scene:
     """Two bodies with curved contact surfaces and no supports (for Taylor tests).
 
@@ -402,17 +417,17 @@ def curved_pair(
     hexahedral stacked boxes of :func:`~contact_ufl.verification.geometries.patch_3d` warped
     (:func:`warp_saddle`) so that their common surface is a saddle; the lower body is the
     finer (element size 0.1 against 1/6), so a partition into two ranks splits it and its
-    master surface.
+    master surface. ``order``: that of the geometry of the gmsh meshes (2: curved cells).
     """
     if dim == 3 and cell == "hexahedron":
         sm = geometries.patch_3d(cell=cell, h_lower=0.1, comm=comm)
         warp_saddle(sm.mesh)
         names = ("upper", "lower", "upper_contact", "lower_contact")
     elif dim == 2:
-        sm = geometries.curved_2d(h_contact=0.05, h_far=0.3, comm=comm)
+        sm = geometries.curved_2d(h_contact=0.05, h_far=0.3, order=order, comm=comm)
         names = ("cylinder", "block", "cylinder_contact", "block_contact")
     else:
-        sm = geometries.cylinders_3d(h_contact=0.15, h_far=0.4, comm=comm)
+        sm = geometries.cylinders_3d(h_contact=0.15, h_far=0.4, order=order, comm=comm)
         names = ("upper", "lower", "upper_contact", "lower_contact")
     tags = sm.tags
     return Scene(

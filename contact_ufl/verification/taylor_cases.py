@@ -117,6 +117,8 @@ def curved_case(
     membrane: str | None = None,
     direction: float = 1.0,
     cell: str = "tetrahedron",
+    degree: int = 1,
+    order: int = 1,
 ):
     """The Taylor test case on curved surfaces: problem at its state, direction, steps.
 
@@ -129,16 +131,17 @@ def curved_case(
     ``membrane="master"`` (``"slave"``) the lower (upper) body is replaced by a Neo-Hookean
     membrane made of its contact surface (:func:`~contact_ufl.verification.scenes.with_membrane`),
     its normal up (``direction = 1``) or down (``-1``); ``cell`` (3D) that of
-    :func:`~contact_ufl.verification.scenes.curved_pair`.
+    :func:`~contact_ufl.verification.scenes.curved_pair`. ``degree``: that of the
+    displacement; ``order``: that of the geometry (2: curved cells).
     """
-    scene = curved_pair(dim, cell=cell)
+    scene = curved_pair(dim, cell=cell, order=order)
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu, master_normal=master_normal)
     if own_meshes:
         scene = on_meshes_of_their_own(scene)
     if membrane:
         up = direction * np.eye(dim)[dim - 1]
         scene = with_membrane(scene, membrane, MembraneNeoHookean(1.0, 0.05), up)
-    problem = ContactProblem(scene, verbose=False)
+    problem = ContactProblem(scene, degree=degree, verbose=False)
     solver = problem.solver  # made at the reference state, the converged state of step 0
     state = CURVED_STATES[dim]
     tag = problem.bulks[0].bodies[0].tag

@@ -1,0 +1,345 @@
+"""Quadratic elements in contact: degree-2 displacement on straight and curved geometry.
+
+The master facets are then quadratic (3-node segments in 2D, 6-node triangles in 3D): the
+closest point on them is found by Newton (:mod:`contact_ufl.contact.curved`), its
+linearisation has the facet's curvature, and the tangent stays the derivative of the
+residual (Taylor remainders of order 2), frictionless and in slip.
+"""
+
+import dataclasses
+
+import dolfinx
+import numpy as np
+import pytest
+from mpi4py import MPI
+from test_self_contact import _slot_scene
+
+from contact_ufl.contact.interface import ContactInterface
+from contact_ufl.contact.projection import closest_points, shape_functions
+from contact_ufl.errors import ContactInputError
+from contact_ufl.materials import LinearElastic
+from contact_ufl.membranes import MembraneNeoHookean
+from contact_ufl.problem import ContactProblem
+from contact_ufl.results import contact_samples
+from contact_ufl.taylor import taylor_test
+from contact_ufl.verification import scenes
+from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
+from contact_ufl.verification.scenes import curved_pair, patch, with_membrane
+from contact_ufl.verification.taylor_cases import curved_case
+
+RNG_SEED = 7
+
+
+def random_segments(rng, n):
+    """Curved 3-node segments (ends, midpoint) of length about 1, bent both ways."""
+    a = rng.uniform(-1, 1, (n, 2))
+    angle = rng.uniform(0, 2 * np.pi, n)
+    b = a + np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    normal = np.stack([np.sin(angle), -np.cos(angle)], axis=1)
+    mid = 0.5 * (a + b) + rng.uniform(-0.15, 0.15, (n, 1)) * normal
+    mid += rng.uniform(-0.1, 0.1, (n, 1)) * (b - a)  # not at the middle of the arc
+    return np.stack([a, b, mid], axis=1)
+
+
+def random_triangles(rng, n):
+    """Curved 6-node triangles (vertices, then midpoints of edges 01, 12, 02)."""
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    v = v + rng.uniform(-0.2, 0.2, (n, 3, 3))
+    mids = [0.5 * (v[:, i] + v[:, j]) for i, j in ((0, 1), (1, 2), (0, 2))]
+    mids = np.stack(mids, axis=1) + rng.uniform(-0.12, 0.12, (n, 3, 3))
+    return np.concatenate([v, mids], axis=1)
+
+
+def random_quadrilaterals(rng, n):
+    """Curved 9-node quadrilaterals (basix vertices, midpoints of edges 01, 13, 23, 02,
+    centre)."""
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]])
+    v = v + rng.uniform(-0.2, 0.2, (n, 4, 3))
+    mids = [0.5 * (v[:, i] + v[:, j]) for i, j in ((0, 1), (1, 3), (2, 3), (0, 2))]
+    mids.append(v.mean(axis=1))
+    mids = np.stack(mids, axis=1) + rng.uniform(-0.12, 0.12, (n, 5, 3))
+    return np.concatenate([v, mids], axis=1)
+
+
+def sampled_distance(points, nodes, xi):
+    """The smallest distance of each point to its facet over the samples ``xi`` (brute
+    force)."""
+    N = shape_functions(nodes.shape[1], nodes.shape[2], xi)[0]
+    out = []
+    for k in range(0, len(points), 20):  # in chunks: (points, samples, gdim) arrays
+        y = np.einsum("sn,fnd->fsd", N, nodes[k : k + 20])
+        out.append(np.linalg.norm(points[k : k + 20, None, :] - y, axis=2).min(axis=1))
+    return np.concatenate(out)
+
+
+@pytest.mark.parametrize("kind", ["segment3", "triangle6", "quadrilateral9"])
+def test_closest_point_on_quadratic_facets(kind):
+    """One facet per point: the distance found is never above the sampled minimum (no
+    wrong local minimum), and below it by at most the sampling's resolution; ``y`` is on
+    the facet at ``xi``, and ``xi`` is inside."""
+    rng = np.random.default_rng(RNG_SEED)
+    gdim = 2 if kind == "segment3" else 3
+    n = 200 if gdim == 2 else 100
+    if gdim == 2:
+        nodes = random_segments(rng, n)
+        xi = np.linspace(0, 1, 4001)[:, None]
+        resolution = 2.0 / 4000  # sample spacing times the largest |dy/dxi|
+    else:
+        make = random_triangles if kind == "triangle6" else random_quadrilaterals
+        nodes = make(rng, n)
+        s, t = np.meshgrid(np.linspace(0, 1, 201), np.linspace(0, 1, 201))
+        xi = np.stack([s.ravel(), t.ravel()], axis=1)
+        xi = xi[xi.sum(axis=1) <= 1.0] if kind == "triangle6" else xi
+        resolution = 2.0 / 200
+    centre = nodes.mean(axis=1)
+    points = centre + rng.uniform(-0.6, 0.6, (n, gdim))
+    brute = sampled_distance(points, nodes, xi)
+    for f in range(0, n, 50):  # one facet at a time: each point pairs with its own facet
+        rows = slice(f, f + 50)
+        proj = [closest_points(points[k : k + 1], nodes[k : k + 1]) for k in range(f, f + 50)]
+        dist = np.array([p.distance[0] for p in proj])
+        assert np.all(dist <= brute[rows] + 1e-12)
+        assert np.all(dist >= brute[rows] - resolution)
+        xis = np.array([p.xi[0] for p in proj])
+        assert np.all(xis >= 0.0)
+        assert np.all(xis.sum(axis=1) <= 1.0 if kind == "triangle6" else xis <= 1.0)
+        N = shape_functions(nodes.shape[1], gdim, xis)[0]
+        y = np.einsum("pn,pnd->pd", N, nodes[rows])
+        assert np.allclose(y, np.array([p.y[0] for p in proj]), atol=1e-14)
+
+
+@pytest.mark.parametrize("kind", ["segment3", "triangle6", "quadrilateral9"])
+def test_sliding_matrix_is_the_derivative_of_xi(kind):
+    """``M b`` is the derivative of the closest point's ``xi`` along a move of the slave
+    point (curved facet: ``A`` has the curvature term): finite differences agree."""
+    rng = np.random.default_rng(RNG_SEED + len(kind))
+    make = {
+        "segment3": random_segments,
+        "triangle6": random_triangles,
+        "quadrilateral9": random_quadrilaterals,
+    }
+    nodes = make[kind](rng, 1)
+    gdim = nodes.shape[2]
+    centroid_xi = np.full((1, gdim - 1), 0.5 if kind == "quadrilateral9" else 1.0 / gdim)
+    N, dN, _ = shape_functions(nodes.shape[1], gdim, centroid_xi)
+    y = N @ nodes[0]
+    a = np.einsum("pna,nd->pad", dN, nodes[0])[0]
+    normal = np.cross(a[0], a[1]) if gdim == 3 else np.array([a[0, 1], -a[0, 0]])
+    x = y[0] + 0.3 * normal / np.linalg.norm(normal)
+    proj = closest_points(x[None], nodes)
+    assert proj.xi[0].min() > 0.05  # interior
+    dx = rng.normal(size=gdim)
+    h = 1e-6
+    xi_h = closest_points((x + h * dx)[None], nodes).xi[0]
+    xi_m = closest_points((x - h * dx)[None], nodes).xi[0]
+    _, dN, _ = shape_functions(nodes.shape[1], gdim, proj.xi)
+    a = np.einsum("pna,nd->pad", dN, nodes[0])[0]
+    b = a @ dx  # b_alpha = a_alpha . dx (the master fixed)
+    predicted = proj.sliding[0] @ b
+    assert np.allclose((xi_h - xi_m) / (2 * h), predicted, rtol=1e-6, atol=1e-9)
+    # the metric alone (a flat facet's M) is off: the curvature matters
+    assert not np.allclose(np.linalg.solve(a @ a.T, b), predicted, rtol=1e-3)
+
+
+def check_taylor(problem, dz, steps):
+    assert problem.active_points() > 10
+    result = taylor_test(problem, dz, steps)
+    assert not result.facets_changed and not result.active_changed
+    zeroth_slopes = np.diff(np.log(result.zeroth)) / np.diff(np.log(result.h))
+    assert np.all(np.abs(zeroth_slopes - 1.0) < 0.05)
+    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_taylor_quadratic_2d(order):
+    """P2 displacement on straight (order 1) and curved (order 2) triangles: 3-node master
+    segments, the tangent exact."""
+    problem, dz, steps = curved_case(2, degree=2, order=order)
+    assert problem.contacts[0].kinematics.nn == 3
+    check_taylor(problem, dz, steps)
+
+
+@pytest.mark.parametrize(
+    "dim, order, cell",
+    [
+        (2, 2, "triangle"),
+        (3, 1, "tetrahedron"),
+        pytest.param(3, 1, "hexahedron", marks=pytest.mark.slow),
+    ],
+)
+def test_taylor_quadratic_slip(dim, order, cell):
+    """With friction, every contact point in slip on the quadratic master (2D: curved
+    geometry): the slip reference ``y_n`` on the last step's quadratic facet, chained
+    through its gathered nodes; the tangent exact."""
+    problem, dz, steps = curved_case(dim, mu=0.05, degree=2, order=order, cell=cell)
+    c = problem.contacts[0]
+    active = problem.comm.allreduce(int(c.active().sum()))
+    assert active > 10 and problem.comm.allreduce(int(c.stick().sum())) == 0
+    check_taylor(problem, dz, steps)
+
+
+@pytest.mark.parametrize("cell, nn", [("tetrahedron", 6), ("hexahedron", 9)])
+def test_taylor_quadratic_3d(cell, nn):
+    """P2 tetrahedra (6-node triangles as master facets) and Q2 hexahedra (9-node
+    quadrilaterals, on the saddle of :func:`~contact_ufl.verification.scenes.warp_saddle`),
+    frictionless."""
+    problem, dz, steps = curved_case(3, degree=2, cell=cell)
+    assert problem.contacts[0].kinematics.nn == nn
+    check_taylor(problem, dz, steps)
+
+
+# -- bad input: a clear error naming what is supported, on every rank ----------------------
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return curved_pair(2)
+
+
+def with_pair(scene, **changes):
+    return dataclasses.replace(scene, contacts=[dataclasses.replace(scene.contacts[0], **changes)])
+
+
+@pytest.mark.parametrize(
+    "degree, changes, message",
+    [
+        (3, {}, "degree-3 displacement on a degree-1 geometry: contact supports a degree-1"),
+        (2, dict(master_normal="smoothed"), 'master_normal="smoothed".*needs a degree-1'),
+        (1, dict(multiplier_degree=2), "multiplier_degree=2 .* needs a displacement of that"),
+        (2, dict(multiplier_degree=3), "multiplier_degree must be 1 or 2"),
+    ],
+)
+def test_unsupported_pairs(scene, degree, changes, message):
+    with pytest.raises(ContactInputError, match=message):
+        ContactProblem(with_pair(scene, **changes), degree=degree, verbose=False)
+
+
+def test_linear_displacement_on_curved_geometry_is_rejected():
+    """A degree-1 displacement on a degree-2 (curved) mesh: its facets are not given by
+    displacement dofs."""
+    with pytest.raises(ContactInputError, match="degree-1 displacement on a degree-2 geometry"):
+        ContactProblem(curved_pair(2, order=2), degree=1, verbose=False)
+
+
+def test_quadratic_membrane_is_rejected(scene):
+    membrane = with_membrane(scene, "master", MembraneNeoHookean(1.0, 0.05), np.array([0, 1.0]))
+    with pytest.raises(ContactInputError, match="membranes in contact need a degree-1"):
+        ContactProblem(membrane, degree=2, verbose=False)
+
+
+def test_serendipity_is_rejected():
+    """8-node serendipity quadrilateral facets are not implemented: the family is named."""
+    scene = curved_pair(3, cell="hexahedron")
+    mesh = scene.parts[0].mesh
+    u = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("S", 2, (3,))))
+    tags = scene.parts[0].surface_tags
+    with pytest.raises(ContactInputError, match="serendipity family: contact supports Lagrange"):
+        ContactInterface(u, tags, scene.contacts[0], 1.0)
+
+
+def test_mixed_degrees_are_rejected(scene):
+    """A pair whose slave and master displacements differ in degree."""
+    mesh = scene.parts[0].mesh
+    u1 = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,))))
+    u2 = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 2, (2,))))
+    tags = scene.parts[0].surface_tags
+    with pytest.raises(ContactInputError, match="degree-1 displacement and the master body"):
+        ContactInterface(u1, tags, scene.contacts[0], 1.0, master_u=u2)
+
+
+# -- the multipliers with a degree-2 displacement: patch test and Hertz --------------------
+
+PRESSURE = 0.01
+TIGHT = {"snes_rtol": 1e-13, "snes_atol": 1e-15}
+
+
+def solve_patch(dim, multiplier_degree, quadrature_degree, subdivisions, cell=None):
+    scene = patch(
+        dim, PRESSURE, quadrature_degree=quadrature_degree, subdivisions=subdivisions, cell=cell
+    )
+    scene = with_pair(scene, multiplier_degree=multiplier_degree)
+    problem = ContactProblem(scene, degree=2, verbose=False, petsc_options=TIGHT)
+    problem.solve(num_steps=1)
+    lam = problem.contacts[0].lambda_N.x.array
+    deviation = problem.comm.allreduce(np.abs(lam / PRESSURE - 1.0).max(initial=0.0), MPI.MAX)
+    return problem, deviation
+
+
+@pytest.mark.parametrize("cell", ["triangle", "quadrilateral"])
+def test_patch_quadratic_2d(cell):
+    """P2 (Q2) displacement, P1 multipliers (the default), the composite rule of the P1
+    patch test: the pressure uniform to 3.4e-4 (3.8e-4 on Q2; P1 displacement: 4.8e-4),
+    the force exact."""
+    problem, deviation = solve_patch(2, 1, 5, 8, cell)
+    assert deviation < 1e-3
+    assert abs(problem.contact_force()[1] / PRESSURE - 1.0) < 1e-12
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "dim, multiplier_degree, quadrature_degree, subdivisions, low, high",
+    [
+        (2, 2, 5, 8, 1e-3, 2e-3),  # measured 1.24e-3 (P1 multipliers: 3.4e-4)
+        (3, 1, 4, 2, 5e-3, 1e-2),  # measured 7.0e-3
+        (3, 2, 4, 2, 3e-2, 1e-1),  # measured 5.0e-2: the P2 multipliers oscillate
+    ],
+)
+def test_patch_quadratic_multipliers(
+    dim, multiplier_degree, quadrature_degree, subdivisions, low, high
+):
+    """The evidence for P1 multipliers with a P2 displacement: P2 multipliers make the patch
+    test's pressure 4 (2D) to 7 (3D: the vertex functions of a 6-node triangle integrate to
+    zero) times less uniform. Both bounds are asserted, so that a change shows."""
+    _, deviation = solve_patch(dim, multiplier_degree, quadrature_degree, subdivisions)
+    assert low < deviation < high
+
+
+def test_hertz_quadratic_2d():
+    """P2 on the curved (degree-2) mesh, P1 multipliers, linear elastic, one load step,
+    h = 0.02 (12,613 unknowns, a / h = 2.5), the default contact rule: p0 of the nominal
+    pressure at the reference positions within 0.5% of Hertz (+0.01% measured; the Cauchy
+    pressure's +0.65% is within 1%: it has a floor of about +0.7%, see
+    docs/quadratic-contact.md) and a smooth multiplier: within 5% of the Hertz profile
+    inside 0.8 a (4.4%), no zig-zag between neighbouring nodes."""
+    hertz = scenes.hertz_2d(h_contact=0.02, depth=0.005, order=2)
+    scene = hertz.scene
+    scene.bodies = [
+        dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
+        for b in scene.bodies
+    ]
+    problem = ContactProblem(scene, degree=2, verbose=False)
+    problem.solve(num_steps=1)
+    samples = contact_samples(problem)
+    exact = Hertz2D(problem.contact_force()[1], hertz.radius, hertz.E_star)
+    c = problem.contacts[0]
+    X = np.concatenate(problem.comm.allgather(c.slave.X.reshape(-1, 2)))
+    _, p0_nominal, _ = fit_elliptic_profile(X[:, 0], samples.lambda_N)
+    assert abs(p0_nominal / exact.p0 - 1.0) < 0.005
+    _, p0, _ = fit_elliptic_profile(samples.x[:, 0], samples.pressure)
+    assert abs(p0 / exact.p0 - 1.0) < 0.01
+    x = np.concatenate(
+        problem.comm.allgather(c.lambda_N.function_space.tabulate_dof_coordinates()[:, 0])
+    )
+    lam = np.concatenate(problem.comm.allgather(c.lambda_N.x.array))
+    x, index = np.unique(x, return_index=True)
+    lam = lam[index] / exact.p0
+    inside = np.abs(x) < 0.8 * exact.a
+    hertz_profile = np.sqrt(1.0 - (x[inside] / exact.a) ** 2)
+    assert np.abs(lam[inside] - hertz_profile).max() < 0.05
+    # no oscillation: the second differences of a concave profile are all negative
+    assert np.all(np.diff(lam[inside], 2) < 0.0)
+
+
+def test_self_contact_quadratic():
+    """The slot of tests/test_self_contact.py pressed shut with Q2: self-contact of its
+    surface (3-node segments, keyed by their vertices) gives the classical pair's
+    reaction (to 1e-5) and Newton iterations."""
+    results = []
+    for self_contact in (True, False):
+        problem = ContactProblem(_slot_scene(MPI.COMM_WORLD, self_contact), degree=2, verbose=False)
+        problem.solve(num_steps=4)
+        assert problem.contacts[0].kinematics.nn == 3 and problem.active_points() >= 12
+        results.append((problem.reaction(2), [s.newton_iterations for s in problem.history.steps]))
+    (a, steps_a), (b, steps_b) = results
+    assert steps_a == steps_b and a[1] < -0.2
+    assert np.linalg.norm(a - b) < 1e-5 * np.linalg.norm(b)
