@@ -19,11 +19,13 @@ Scenes (small-strain :class:`~contact_ufl.materials.LinearElastic` bulk, one loa
 * ``--dim 3``: the quarter ball on a block (:func:`contact_ufl.verification.scenes.hertz_3d`,
   depth 0.01), ``h_contact`` from 0.05 down to 0.01 (to 0.025 with ``--quick``).
 
-``--degree 2`` solves with P2 displacements (``ContactProblem(degree=2)``), once the contact
-terms accept them.
+``--degree 2`` solves with P2 displacements (``ContactProblem(degree=2)``; in 2D on the
+curved, degree-2, mesh and on :data:`MESHES_P2`, twice the P1 sizes); ``--h`` gives the
+meshes.
 
     python benchmarks/eps_default.py --json benchmarks/results/eps_default_2d.json
     python benchmarks/eps_default.py --dim 3 --json benchmarks/results/eps_default_3d.json
+    python benchmarks/eps_default.py --degree 2 --json benchmarks/results/eps_default_2d_p2.json
 
 Records, one per mesh and eps: ``dim``, ``degree``, ``h_contact``, ``dofs``, ``eps`` (the
 case, :data:`EPS_CASES`), ``eps_factor`` (``eps_N`` over the default's), ``eps_N``,
@@ -53,6 +55,8 @@ from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
 from contact_ufl.verification.runs import hertz_3d_errors
 
 MESHES = {2: [0.02, 0.01, 0.005, 0.0025], 3: [0.05, 0.035, 0.025, 0.0175, 0.0125, 0.01]}
+#: 2D P2: twice the P1 sizes (about the P1 meshes' unknowns), on the curved mesh
+MESHES_P2 = {2: [0.04, 0.02, 0.01, 0.005]}
 QUICK = {2: [0.02, 0.01, 0.005], 3: [0.05, 0.035, 0.025]}
 EPS_CASES = ("default", "10 default", "default / 10", "E / h")
 """The eps of the runs on each mesh: the default, ten times it, a tenth of it, and the
@@ -60,11 +64,12 @@ scenes' own ``E / h_contact`` (for comparison: the eps that grows under refineme
 STEPS = 1
 
 
-def hertz_scene(dim: int, h: float):
+def hertz_scene(dim: int, h: float, degree: int = 1):
     """The Hertz scene of dimension ``dim`` with a linear elastic bulk (its ``eps_N`` the
-    scene's ``E / h_contact``), and its analytic data."""
+    scene's ``E / h_contact``), and its analytic data; in 2D on the curved (degree-2) mesh
+    when the displacement's ``degree`` is 2."""
     if dim == 2:
-        hertz = scenes.hertz_2d(h_contact=h, depth=0.02)
+        hertz = scenes.hertz_2d(h_contact=h, depth=0.02, order=degree)
         hertz.scene.bodies = [
             dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
             for b in hertz.scene.bodies
@@ -108,7 +113,7 @@ def trace_iterates(problem: ContactProblem) -> list[list]:
 def run(dim: int, h: float, degree: int, case: str, eps_default: float | None) -> dict:
     """Solve one mesh with the eps of ``case`` (:data:`EPS_CASES`; ``eps_default`` the
     default's value on this mesh, unknown for ``"default"`` itself)."""
-    hertz = hertz_scene(dim, h)
+    hertz = hertz_scene(dim, h, degree)
     scene = hertz.scene
     if case != "E / h":
         eps = {"default": None, "10 default": 10.0, "default / 10": 0.1}[case]
@@ -181,12 +186,16 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="three meshes")
     parser.add_argument("--degree", type=int, choices=(1, 2), default=1)
     parser.add_argument("--dim", type=int, choices=(2, 3), default=2)
+    parser.add_argument("--h", type=float, nargs="+", default=None, help="h_contact list")
     args = parser.parse_args()
     rank0 = MPI.COMM_WORLD.rank == 0
     if rank0:
         print(f"Hertz {args.dim}D, P{args.degree}, {STEPS} load step(s)\n{HEADER}", flush=True)
     records = []
-    for h in (QUICK if args.quick else MESHES)[args.dim]:
+    meshes = (QUICK if args.quick else MESHES)[args.dim]
+    if args.degree == 2 and args.dim == 2 and not args.quick:
+        meshes = MESHES_P2[2]
+    for h in args.h or meshes:
         for r in mesh_records(args.dim, h, args.degree):
             records.append(r)
             if rank0:

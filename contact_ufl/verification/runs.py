@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -314,25 +315,33 @@ def _in_contact(problem, pair: int = 0) -> np.ndarray:
     return np.concatenate(problem.comm.allgather(problem.contacts[pair].active()))
 
 
-def hertz_3d_run(h_contact: float, steps: int = 2, **options) -> tuple[dict, ContactProblem]:
+def hertz_3d_run(
+    h_contact: float, steps: int = 2, degree: int = 1, default_eps: bool = False, **options
+) -> tuple[dict, ContactProblem]:
     """Solve :func:`~contact_ufl.verification.scenes.hertz_3d` (``options`` passed to it) in
-    ``steps`` load steps; return the record of :func:`hertz_3d_errors` with ``dofs``,
-    ``h_contact``, ``slave_points``, ``newton_iterations``, ``newton_per_step``, ``wall_s``
-    (the solve), ``search_s`` (its closest-point search) and ``ranks``, and the problem."""
+    ``steps`` load steps with displacements of ``degree`` (``default_eps``: with the
+    library's default ``eps_N`` instead of the scene's ``E / h``); return the record of
+    :func:`hertz_3d_errors` with ``dofs``, ``degree``, ``h_contact``, ``slave_points``,
+    ``newton_iterations``, ``newton_per_step``, ``wall_s`` (the solve), ``cpu_s`` (its CPU
+    time), ``search_s`` (its closest-point search) and ``ranks``, and the problem."""
     hertz = scenes.hertz_3d(h_contact=h_contact, **options)
-    problem = ContactProblem(hertz.scene, verbose=False)
-    start = time.perf_counter()
+    if default_eps:
+        hertz.scene.contacts[0] = dataclasses.replace(hertz.scene.contacts[0], eps_N=None)
+    problem = ContactProblem(hertz.scene, degree=degree, verbose=False)
+    start, cpu = time.perf_counter(), time.process_time()
     problem.solve(num_steps=steps)
-    wall = time.perf_counter() - start
+    wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     newton = sum(s.newton_iterations for s in problem.history.steps)
     record = {
         "dofs": problem.layout.global_size,
+        "degree": degree,
         "h_contact": h_contact,
         "slave_points": len(contact_samples(problem).pressure),
         **hertz_3d_errors(problem, hertz),
         "newton_iterations": newton,
         "newton_per_step": newton / len(problem.history.steps),
         "wall_s": wall,
+        "cpu_s": cpu,
         "search_s": problem.search_time,
         "ranks": problem.comm.size,
     }
