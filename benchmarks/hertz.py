@@ -24,8 +24,11 @@ speed-against-error picture of the README.
 :func:`contact_ufl.verification.runs.hertz_3d_errors`), on graded meshes given by
 ``(h_contact, h_edge)``; the records add pressure_l2_error, newton_per_step, the cruder
 measures of a and p0 and the errors of the elastic sphere on a rigid flat (``--flat rigid``).
+``--degree 2``: P2 displacements on the curved (degree-2) mesh, contact rule of degree 4,
+on coarser meshes (:data:`FULL_3D_P2`).
 
     python benchmarks/hertz.py --dim 3 --json benchmarks/results/hertz_3d.json
+    python benchmarks/hertz.py --dim 3 --degree 2 --json benchmarks/results/hertz_3d_p2.json
 """
 
 import argparse
@@ -50,6 +53,9 @@ QUICK = [0.02, 0.01, 0.005]
 #: 3D meshes: (h_contact, h_edge), a ~ 0.103 (a / h_contact ~ 4, 8, 8, 8)
 FULL_3D = [(0.025, None), (0.0125, None), (0.0125, 0.004), (0.0125, 0.003)]
 QUICK_3D = FULL_3D[:3]
+#: 3D P2 (on the curved, degree-2, mesh): a / h_contact ~ 2, 3, 4, and 4 with the edge ring
+FULL_3D_P2 = [(0.05, None), (0.035, None), (0.025, None), (0.025, 0.01)]
+QUICK_3D_P2 = FULL_3D_P2[:2]
 
 
 def run(
@@ -156,8 +162,10 @@ def plot(path: str, files: list[str]) -> None:
     fig.savefig(path, dpi=120)
 
 
-def run_3d(h: float, h_edge: float | None, depth: float, steps: int, flat: str) -> dict:
-    record, _ = hertz_3d_run(h, steps=steps, depth=depth, h_edge=h_edge, flat=flat)
+def run_3d(
+    h: float, h_edge: float | None, depth: float, steps: int, flat: str, degree: int = 1
+) -> dict:
+    record, _ = hertz_3d_run(h, steps=steps, degree=degree, depth=depth, h_edge=h_edge, flat=flat)
     return {"flat": flat, "h_edge": h_edge, **record}
 
 
@@ -169,8 +177,12 @@ def main_3d(args) -> None:
             f"{'h':>7} {'h_edge':>7} {'dofs':>7} {'a err':>8} {'p0 err':>8} {'L2 err':>7} "
             f"{'nwt/st':>6} {'wall s':>7} {'search s':>8}"
         )
-    for h, h_edge in QUICK_3D if args.quick else FULL_3D:
-        r = run_3d(h, h_edge, args.depth, args.steps, args.flat)
+    if args.degree == 1:
+        meshes = QUICK_3D if args.quick else FULL_3D
+    else:
+        meshes = QUICK_3D_P2 if args.quick else FULL_3D_P2
+    for h, h_edge in meshes:
+        r = run_3d(h, h_edge, args.depth, args.steps, args.flat, args.degree)
         records.append(r)
         if comm.rank == 0:
             print(
@@ -196,7 +208,7 @@ def main() -> None:
     parser.add_argument("--depth", type=float, default=None, help="2D: 0.005, 3D: 0.01")
     parser.add_argument("--steps", type=int, default=None, help="2D: 4, 3D: 2")
     parser.add_argument("--flat", choices=("elastic", "rigid"), default="elastic", help="3D")
-    parser.add_argument("--degree", type=int, choices=(1, 2), default=1, help="2D: of u")
+    parser.add_argument("--degree", type=int, choices=(1, 2), default=1, help="of u")
     parser.add_argument(
         "--order", type=int, choices=(1, 2), default=None, help="2D: of the geometry (= degree)"
     )

@@ -314,18 +314,24 @@ def _in_contact(problem, pair: int = 0) -> np.ndarray:
     return np.concatenate(problem.comm.allgather(problem.contacts[pair].active()))
 
 
-def hertz_3d_run(h_contact: float, steps: int = 2, **options) -> tuple[dict, ContactProblem]:
-    """Solve :func:`~contact_ufl.verification.scenes.hertz_3d` (``options`` passed to it) in
-    ``steps`` load steps; return the record of :func:`hertz_3d_errors` with ``dofs``,
+def hertz_3d_run(
+    h_contact: float, steps: int = 2, degree: int = 1, **options
+) -> tuple[dict, ContactProblem]:
+    """Solve :func:`~contact_ufl.verification.scenes.hertz_3d` (``options`` passed to it;
+    its geometry ``order`` by default the displacement's ``degree``) in ``steps`` load
+    steps; return the record of :func:`hertz_3d_errors` with ``degree``, ``dofs``,
     ``h_contact``, ``slave_points``, ``newton_iterations``, ``newton_per_step``, ``wall_s``
     (the solve), ``search_s`` (its closest-point search) and ``ranks``, and the problem."""
+    options.setdefault("order", degree)
     hertz = scenes.hertz_3d(h_contact=h_contact, **options)
-    problem = ContactProblem(hertz.scene, verbose=False)
+    problem = ContactProblem(hertz.scene, degree=degree, verbose=False)
     start = time.perf_counter()
     problem.solve(num_steps=steps)
     wall = time.perf_counter() - start
     newton = sum(s.newton_iterations for s in problem.history.steps)
     record = {
+        "degree": degree,
+        "geometry_order": options["order"],
         "dofs": problem.layout.global_size,
         "h_contact": h_contact,
         "slave_points": len(contact_samples(problem).pressure),
