@@ -154,7 +154,9 @@ def test_curved_mesh_puts_the_edge_nodes_on_the_sphere():
     nodes = np.unique(dolfinx.mesh.entities_to_geometry(mesh, 2, facets))
     x = mesh.geometry.x[nodes]
     distance = np.abs(np.linalg.norm(x - (0.0, 0.0, 1.0), axis=1) - 1.0)
-    assert len(nodes) > 0 and np.all(distance < 1e-8), distance.max()
+    count = mesh.comm.allreduce(len(nodes), MPI.SUM)
+    largest = mesh.comm.allreduce(float(distance.max(initial=0.0)), MPI.MAX)
+    assert count > 0 and largest < 1e-8, (count, largest)
 
 
 @pytest.fixture(scope="module")
@@ -164,13 +166,13 @@ def p2_on_block_sequence():
     return [solve(degree=2, h_contact=h) for h in (0.05, 0.035)]
 
 
-@pytest.mark.slow
 def test_p2_on_block_within_2_percent(p2_on_block_sequence):
     """Elastic on elastic with P2: a and p0 within 2% on both meshes (a -1.6%, -0.2%; p0
     +0.6%, -0.3% measured; P1 needs a / h ~ 8 and the edge ring, 17,000 unknowns, for -1.1%
     and +1.9%); the errors of a, p0 and the pressure's L2 error fall from the first mesh to
-    the second; the largest nodal multiplier within 5% of Hertz's p0 (P1: 13-20% above, the
-    node-to-node scatter); Newton converges in at most 6 iterations per step."""
+    the second; the largest nodal multiplier within 5% of Hertz's p0 (+2.8%, +2.2%; P1:
+    13-20% above, the node-to-node scatter); Newton converges in at most 6 iterations per
+    step (4-5)."""
     errors = np.array(
         [
             [abs(e["a_error"]), abs(e["p0_error"]), e["pressure_l2_error"]]
@@ -184,34 +186,11 @@ def test_p2_on_block_within_2_percent(p2_on_block_sequence):
         assert max(s.newton_iterations for s in problem.history.steps) <= 6
 
 
-@pytest.fixture(scope="module")
-def p2_on_rigid_flat_sequence():
-    """P2 on the curved mesh, the half ball on a rigid flat: a / h ~ 2 and 3."""
-    return [solve(degree=2, flat="rigid", h_contact=h) for h in (0.05, 0.035)]
-
-
-def test_p2_on_rigid_flat_within_2_percent(p2_on_rigid_flat_sequence):
-    """P2 on a rigid flat (Hertz's linear problem): a and p0 within 2% on both meshes,
-    the errors of a and p0 and the pressure's L2 error falling from the first to the
-    second, no nodal multiplier more than 5% above p0 (no oscillation)."""
-    errors = np.array(
-        [
-            [abs(e["a_error"]), abs(e["p0_error"]), e["pressure_l2_error"]]
-            for _, e in p2_on_rigid_flat_sequence
-        ]
-    )
-    assert np.all(errors[:, :2] < 0.02), errors
-    assert np.all(np.diff(errors, axis=0) < 0), errors
-    for _, e in p2_on_rigid_flat_sequence:
-        assert abs(e["p0_node_error"]) < 0.05, e
-
-
-def test_p2_same_answer_on_any_number_of_ranks():
-    """P2 on the curved mesh, the elastic pair (6-node master facets, a coarse far field):
-    all ranks give the answer of one rank to solver tolerance."""
-    options = {"degree": 2, "h_contact": 0.05, "h_far": 0.5}
-    problem, e = solve(**options)
-    alone = e if problem.comm.size == 1 else solve(MPI.COMM_SELF, **options)[1]
+def test_p2_same_answer_on_any_number_of_ranks(p2_on_block_sequence):
+    """P2 on the curved mesh, the elastic pair (6-node master facets), a / h ~ 2: all ranks
+    give the answer of one rank to solver tolerance."""
+    problem, e = p2_on_block_sequence[0]
+    alone = e if problem.comm.size == 1 else solve(MPI.COMM_SELF, degree=2, h_contact=0.05)[1]
     for key in ("P", "a_error", "p0_error", "pressure_l2_error", "p0_node_error"):
         assert abs(e[key] - alone[key]) < 1e-8 * max(1.0, abs(alone[key])), (key, e, alone)
     assert abs(e["p0_error"]) < 0.05, e
