@@ -19,13 +19,16 @@ Scenes (small-strain :class:`~contact_ufl.materials.LinearElastic` bulk, one loa
 * ``--dim 3``: the quarter ball on a block (:func:`contact_ufl.verification.scenes.hertz_3d`,
   depth 0.01), ``h_contact`` from 0.05 down to 0.01 (to 0.025 with ``--quick``).
 
-``--degree 2`` solves with P2 displacements (``ContactProblem(degree=2)``; in 2D on the
-curved, degree-2, mesh and on :data:`MESHES_P2`, twice the P1 sizes); ``--h`` gives the
+``--degree 2`` solves with P2 displacements (``ContactProblem(degree=2)``) on the
+curved (degree-2) mesh: in 2D on :data:`MESHES_P2` (twice the P1 sizes), in 3D with the
+contact rule of degree 4 on the coarser meshes :data:`MESHES_3D_P2`; ``--h`` gives the
 meshes.
 
     python benchmarks/eps_default.py --json benchmarks/results/eps_default_2d.json
     python benchmarks/eps_default.py --dim 3 --json benchmarks/results/eps_default_3d.json
     python benchmarks/eps_default.py --degree 2 --json benchmarks/results/eps_default_2d_p2.json
+    python benchmarks/eps_default.py --dim 3 --degree 2 --json \
+        benchmarks/results/eps_default_3d_p2.json
 
 Records, one per mesh and eps: ``dim``, ``degree``, ``h_contact``, ``dofs``, ``eps`` (the
 case, :data:`EPS_CASES`), ``eps_factor`` (``eps_N`` over the default's), ``eps_N``,
@@ -58,6 +61,9 @@ MESHES = {2: [0.02, 0.01, 0.005, 0.0025], 3: [0.05, 0.035, 0.025, 0.0175, 0.0125
 #: 2D P2: twice the P1 sizes (about the P1 meshes' unknowns), on the curved mesh
 MESHES_P2 = {2: [0.04, 0.02, 0.01, 0.005]}
 QUICK = {2: [0.02, 0.01, 0.005], 3: [0.05, 0.035, 0.025]}
+MESHES_3D_P2 = [0.07, 0.05, 0.035, 0.025]
+"""3D with ``--degree 2``: coarser meshes (a / h_contact ~ 1.5 to 4; 8,000 to 25,000
+unknowns); with ``--quick`` the first three."""
 EPS_CASES = ("default", "10 default", "default / 10", "E / h")
 """The eps of the runs on each mesh: the default, ten times it, a tenth of it, and the
 scenes' own ``E / h_contact`` (for comparison: the eps that grows under refinement)."""
@@ -66,8 +72,8 @@ STEPS = 1
 
 def hertz_scene(dim: int, h: float, degree: int = 1):
     """The Hertz scene of dimension ``dim`` with a linear elastic bulk (its ``eps_N`` the
-    scene's ``E / h_contact``), and its analytic data; in 2D on the curved (degree-2) mesh
-    when the displacement's ``degree`` is 2."""
+    scene's ``E / h_contact``), and its analytic data; on the curved (degree-2) mesh when
+    the displacement's ``degree`` is 2."""
     if dim == 2:
         hertz = scenes.hertz_2d(h_contact=h, depth=0.02, order=degree)
         hertz.scene.bodies = [
@@ -75,7 +81,7 @@ def hertz_scene(dim: int, h: float, degree: int = 1):
             for b in hertz.scene.bodies
         ]
         return hertz
-    return scenes.hertz_3d(h_contact=h, depth=0.01)
+    return scenes.hertz_3d(h_contact=h, depth=0.01, order=degree)
 
 
 def fitted_p0(problem: ContactProblem, hertz) -> tuple[float, float]:
@@ -195,6 +201,8 @@ def main() -> None:
     meshes = (QUICK if args.quick else MESHES)[args.dim]
     if args.degree == 2 and args.dim == 2 and not args.quick:
         meshes = MESHES_P2[2]
+    if args.degree == 2 and args.dim == 3:
+        meshes = MESHES_3D_P2[:3] if args.quick else MESHES_3D_P2
     for h in args.h or meshes:
         for r in mesh_records(args.dim, h, args.degree):
             records.append(r)

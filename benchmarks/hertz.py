@@ -29,10 +29,12 @@ the speed-against-error picture of the README.
 (:func:`contact_ufl.verification.scenes.hertz_3d`, errors of
 :func:`contact_ufl.verification.runs.hertz_3d_errors`), on graded meshes given by
 ``(h_contact, h_edge)``; the records add pressure_l2_error, newton_per_step, the cruder
-measures of a and p0 and the errors of the elastic sphere on a rigid flat (``--flat rigid``);
-``--h`` replaces the meshes by ``(h, None)`` (``--degree 2``: P2 on the straight mesh).
+measures of a and p0 and the errors of the elastic sphere on a rigid flat (``--flat rigid``).
+``--degree 2``: P2 displacements on the curved (degree-2) mesh, contact rule of degree 4,
+on coarser meshes (:data:`FULL_3D_P2`); ``--h`` replaces the meshes by ``(h, None)``.
 
     python benchmarks/hertz.py --dim 3 --json benchmarks/results/hertz_3d.json
+    python benchmarks/hertz.py --dim 3 --degree 2 --json benchmarks/results/hertz_3d_p2.json
 """
 
 import argparse
@@ -56,6 +58,9 @@ QUICK = [0.02, 0.01, 0.005]
 #: 3D meshes: (h_contact, h_edge), a ~ 0.103 (a / h_contact ~ 4, 8, 8, 8)
 FULL_3D = [(0.025, None), (0.0125, None), (0.0125, 0.004), (0.0125, 0.003)]
 QUICK_3D = FULL_3D[:3]
+#: 3D P2 (on the curved, degree-2, mesh): a / h_contact ~ 2, 3, 4, and 4 with the edge ring
+FULL_3D_P2 = [(0.05, None), (0.035, None), (0.025, None), (0.025, 0.01)]
+QUICK_3D_P2 = FULL_3D_P2[:2]
 
 
 def run(
@@ -228,7 +233,10 @@ def main_3d(args) -> None:
             f"{'h':>7} {'h_edge':>7} {'dofs':>7} {'a err':>8} {'p0 err':>8} {'L2 err':>7} "
             f"{'nwt/st':>6} {'wall s':>7} {'search s':>8}"
         )
-    meshes = QUICK_3D if args.quick else FULL_3D
+    if args.degree == 1:
+        meshes = QUICK_3D if args.quick else FULL_3D
+    else:
+        meshes = QUICK_3D_P2 if args.quick else FULL_3D_P2
     if args.h:
         meshes = [(h, None) for h in args.h]
     for h, h_edge in meshes:

@@ -1334,6 +1334,7 @@ def sphere_on_block_3d(
     growth: float = 0.3,
     contact_zone: float = 0.3,
     edge: tuple[float, float, float] | None = None,
+    order: int = 1,
     comm: MPI.Comm = MPI.COMM_WORLD,
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
@@ -1377,6 +1378,8 @@ def sphere_on_block_3d(
         ``(r_edge, h_edge, width)``: also size ``h_edge`` (the block ``master_ratio`` times
         coarser) within ``width`` of the circle of radius ``r_edge`` about the axis in the
         plane of first contact (the edge of the contact zone), growing by ``growth`` beyond.
+    order
+        Geometry order, 1 or 2 (2: 10-node tetrahedra, the edge nodes on the sphere).
     comm, msh_file, ghost_mode
         As in :func:`hertz_2d`.
 
@@ -1409,7 +1412,7 @@ def sphere_on_block_3d(
         _check_positive(width=block[0], height=block[1])
         if not contact_zone * R < min(block):
             raise ValueError(f"contact_zone * radius must be less than the block {block}")
-    _check_common(gap, 1)
+    _check_common(gap, order)
     tol = 1e-6 * R
     zone = contact_zone * R
 
@@ -1454,7 +1457,9 @@ def sphere_on_block_3d(
         _add_groups(groups, tdim=3)
         _set_background(fields)
         gmsh.model.mesh.generate(3)
+        if order > 1:
+            gmsh.model.mesh.setOrder(order)
 
     return generate_mesh(
-        comm, "sphere_on_block_3d", build, 3, _mesh_options(1), msh_file, ghost_mode
+        comm, "sphere_on_block_3d", build, 3, _mesh_options(order), msh_file, ghost_mode
     )

@@ -318,12 +318,14 @@ def _in_contact(problem, pair: int = 0) -> np.ndarray:
 def hertz_3d_run(
     h_contact: float, steps: int = 2, degree: int = 1, default_eps: bool = False, **options
 ) -> tuple[dict, ContactProblem]:
-    """Solve :func:`~contact_ufl.verification.scenes.hertz_3d` (``options`` passed to it) in
-    ``steps`` load steps with displacements of ``degree`` (``default_eps``: with the
-    library's default ``eps_N`` instead of the scene's ``E / h``); return the record of
-    :func:`hertz_3d_errors` with ``dofs``, ``degree``, ``h_contact``, ``slave_points``,
-    ``newton_iterations``, ``newton_per_step``, ``wall_s`` (the solve), ``cpu_s`` (its CPU
-    time), ``search_s`` (its closest-point search) and ``ranks``, and the problem."""
+    """Solve :func:`~contact_ufl.verification.scenes.hertz_3d` (``options`` passed to it;
+    its geometry ``order`` by default the displacement's ``degree``) in ``steps`` load
+    steps (``default_eps``: with the library's default ``eps_N`` instead of the scene's
+    ``E / h``); return the record of :func:`hertz_3d_errors` with ``degree``,
+    ``geometry_order``, ``dofs``, ``h_contact``, ``slave_points``, ``newton_iterations``,
+    ``newton_per_step``, ``wall_s`` (the solve), ``cpu_s`` (its CPU time), ``search_s`` (its
+    closest-point search) and ``ranks``, and the problem."""
+    options.setdefault("order", degree)
     hertz = scenes.hertz_3d(h_contact=h_contact, **options)
     if default_eps:
         hertz.scene.contacts[0] = dataclasses.replace(hertz.scene.contacts[0], eps_N=None)
@@ -333,8 +335,9 @@ def hertz_3d_run(
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     newton = sum(s.newton_iterations for s in problem.history.steps)
     record = {
-        "dofs": problem.layout.global_size,
         "degree": degree,
+        "geometry_order": options["order"],
+        "dofs": problem.layout.global_size,
         "h_contact": h_contact,
         "slave_points": len(contact_samples(problem).pressure),
         **hertz_3d_errors(problem, hertz),
