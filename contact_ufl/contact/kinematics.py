@@ -355,9 +355,10 @@ class MeshSlipReference:
 
     def _facet_part(self, values: np.ndarray) -> np.ndarray:
         """The facet's own nodes (the dofs of ``xhat_n``) of an array over the dofs of
-        ``xhat`` (unrolled, ``nx * gdim`` per point)."""
+        ``xhat`` (unrolled, ``nx * gdim`` per point): a copy (with the facet normal,
+        ``nx = nn``, a view would follow the later searches)."""
         k = self.kinematics
-        return values.reshape(-1, k.nx * k.gdim)[:, : self._facet_dofs].ravel()
+        return values.reshape(-1, k.nx * k.gdim)[:, : self._facet_dofs].flatten()
 
     @property
     def fields(self) -> list[dolfinx.fem.Function]:
