@@ -358,6 +358,9 @@ class MeshSlipReference:
     current positions ``xhat_n`` of the nodes of that step's master facet, gathered from the
     displacement like ``xhat``). ``xhat_n`` is a field of the assembled system (with a zero
     residual, so that its derivatives are assembled and chained onto the displacement).
+    It holds the ``nn`` nodes of the facet only, not the neighbours that ``xhat`` carries
+    for the smoothed normal (``y_n`` does not depend on them): with the smoothed 3D normal
+    its blocks of the tangent are ``(nn / nx)^2``, about a hundredth, of ``xhat``'s.
 
     Parameters
     ----------
@@ -367,7 +370,10 @@ class MeshSlipReference:
 
     def __init__(self, kinematics: MeshKinematics):
         self.kinematics = k = kinematics
-        self.xhat_n = dolfinx.fem.Function(k.Qx, name="master_nodes_last_step")
+        #: the facet's own nodes of a point of ``xhat`` (the first ``nn`` of its ``nx``)
+        self._facet_dofs = k.nn * k.gdim
+        self.Qn = k.slave.point_space((self._facet_dofs,))
+        self.xhat_n = dolfinx.fem.Function(self.Qn, name="master_nodes_last_step")
         self.xi_n = dolfinx.fem.Function(k.xi0.function_space)
         self.mask_n = dolfinx.fem.Function(k.mask.function_space)
         self._zero = dolfinx.fem.Function(k.mask.function_space)
@@ -376,7 +382,18 @@ class MeshSlipReference:
         self._xhat_n_commit = None
         self._work = None  # vectors of update_history, allocated once
         self._committed = None  # the converged state, until the next step begins
-        self.y_n = k.master_point(self.xi_n, k.nodes(self.xhat_n))
+        gdim = k.gdim
+        nodes_n = ufl.as_matrix(
+            [[self.xhat_n[a * gdim + i] for i in range(gdim)] for a in range(k.nn)]
+        )
+        self.y_n = k.master_point(self.xi_n, nodes_n)
+
+    def _facet_part(self, values: np.ndarray) -> np.ndarray:
+        """The facet's own nodes (the dofs of ``xhat_n``) of an array over the dofs of
+        ``xhat`` (unrolled, ``nx * gdim`` per point): a copy (with the facet normal,
+        ``nx = nn``, a view would follow the later searches)."""
+        k = self.kinematics
+        return values.reshape(-1, k.nx * k.gdim)[:, : self._facet_dofs].flatten()
 
     @property
     def fields(self) -> list[dolfinx.fem.Function]:
@@ -386,12 +403,12 @@ class MeshSlipReference:
     def residuals(self, ds: ufl.Measure) -> list[ufl.Form]:
         """The zero residual of ``xhat_n``: it has no equation of its own, but derivatives
         with respect to it are assembled and chained onto the displacement by T."""
-        return [self._zero * ufl.dot(self.xhat_n, ufl.TestFunction(self.kinematics.Qx)) * ds]
+        return [self._zero * ufl.dot(self.xhat_n, ufl.TestFunction(self.Qn)) * ds]
 
     def gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
         """The last step's master nodes gather what the converged projection gathered."""
         if self._gather_n is None:
-            self._gather_n = np.full_like(self.kinematics.gather, -1)
+            self._gather_n = np.full_like(self._facet_part(self.kinematics.gather), -1)
         return [(self.xhat_n, self._gather_n)]
 
     def update_history(self, T, x, block_slice) -> None:
@@ -400,7 +417,8 @@ class MeshSlipReference:
         xhat = self.kinematics.xhat
         owned = len(self._gather_n)
         if self._x_commit is None:
-            self.xhat_n.x.array[:owned] = xhat.x.array[:owned]
+            owned_x = owned // self._facet_dofs * xhat.function_space.dofmap.index_map_bs
+            self.xhat_n.x.array[:owned] = self._facet_part(xhat.x.array[:owned_x])
         else:
             if self._work is None:
                 self._work = (x.duplicate(), T.createVecLeft())
@@ -418,12 +436,12 @@ class MeshSlipReference:
         k = self.kinematics
         owned = len(k.gather)
         self._committed = (
-            k.gather.copy(),
-            k.xhat.x.array[:owned].copy(),
+            self._facet_part(k.gather),
+            self._facet_part(k.xhat.x.array[:owned]),
             x.copy(),
             k.xi0.x.array.copy(),
             k.mask.x.array.copy(),
-            k.xhat.x.array.copy(),
+            self._facet_part(k.xhat.x.array),
         )
 
     def begin_step(self) -> None:
@@ -444,6 +462,6 @@ class MeshSlipReference:
         """``y_n`` at the owned slave points, ``(n, gdim)``."""
         k, slave, gdim = self.kinematics, self.kinematics.slave, self.kinematics.gdim
         npts = slave.num_cells * slave.num_points
-        nodes = slave.at_points(self.xhat_n).reshape(npts, k.nx, gdim)[:, : k.nn]
+        nodes = slave.at_points(self.xhat_n).reshape(npts, k.nn, gdim)
         N_n = shape_functions(k.nn, gdim, slave.at_points(self.xi_n))[0]
         return np.einsum("pa,pad->pd", N_n, nodes)

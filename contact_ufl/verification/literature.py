@@ -1,4 +1,5 @@
-"""Published results of the verification problems (shallow ironing, mu = 0.3)."""
+"""Published results of the verification problems (2D shallow ironing, mu = 0.3; what the
+literature has of the 3D ironing)."""
 
 #: Global friction coefficients |Fx/Fy| at t = 1.5 of the shallow ironing problem with
 #: mu = 0.3 in the literature, as compiled by the solids4foam tutorial ``shallowIroning``
@@ -28,13 +29,43 @@ IRONING_FORCES = {
 }
 
 #: The 3D ironing problem (a cylindrical die pressed 1.4 into a Neo-Hookean slab 9 x 4 x 3,
-#: then slid 4 along it; mu = 0.3): Puso & Laursen 2004 (CMAME 193, 601-629, example 2;
-#: report https://www.osti.gov/servlets/purl/15013715), whose data the LLNL Smith example
-#: ``die-on-slab`` restates. Its force histories are published as curves only; no digitised
-#: values were reachable, so there is no reference to compare with yet (TODO).
+#: then slid 4 along it; mu = 0.3): Puso & Laursen 2004, "A mortar segment-to-segment
+#: frictional contact method for large deformations" (CMAME 193, 4891-4913; the report
+#: UCRL-JRNL-200667, https://www.osti.gov/servlets/purl/15013715), example 2 ("ironing"),
+#: whose data the LLNL Smith example ``die-on-slab`` restates. What a search of the stored
+#: public pages, documentation and code found (``sources``): the publication and the later
+#: 3D large-sliding papers show their force histories as figures only; no table, data file
+#: or digitised curve of them was found, so there is no published number to compare with
+#: and ``forces`` is empty (no spread can be given). The checks that need no publication
+#: are in benchmarks/ironing_3d.py: Coulomb's ratio of the frictional to the normal force
+#: (mu = 0.3) and the mirror symmetry of the frictionless force history (mu = 0).
 IRONING_3D = {
-    "source": "Puso & Laursen 2004, CMAME 193:601-629, example 2 (ironing)",
+    "source": "Puso & Laursen 2004, CMAME 193:4891-4913 (UCRL-JRNL-200667), example 2",
     "data_from": "LLNL Smith examples/die-on-slab (README and source)",
-    "status": "TODO: force histories published as curves only; no digitised values found",
+    "status": (
+        "curves only: the force histories are published as figures, no digitised values "
+        "were found (no reference numbers, no spread)"
+    ),
+    "sources": {
+        "Puso & Laursen 2004 (UCRL-JRNL-200667, OSTI 15013715)": (
+            "the problem's data; force histories of the ironing as figures only (the "
+            "report's text was reachable only in part: title pages)"
+        ),
+        "LLNL Smith examples/die-on-slab README": (
+            "geometry, materials, loading (press 1.4 over t = 0-0.2, slide 4 over "
+            "0.2-1.5), penalty 500, mu = 0.3; expected behaviour in words only, no forces"
+        ),
+        "Temizer, Wriggers & Hughes 2012 (CMAME; ICES report 11-16)": (
+            "3D mortar frictional contact (NURBS) with large-sliding examples; abstract "
+            "only reachable, forces as figures"
+        ),
+        "De Lorenzis, Wriggers & Zavarise 2012 (Comput Mech 49:1-20)": (
+            "3D frictionless mortar large sliding (NURBS); traction histories as figures"
+        ),
+        "KratosMultiphysics/Examples ironing_with_die_3D": (
+            "a different die (a full cylinder); a comparison picture, no numbers"
+        ),
+        "MOOSE contact tests": "the ironing tests are 2D; the 3D mortar test is a block",
+    },
     "forces": {},
 }

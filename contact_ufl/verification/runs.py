@@ -27,6 +27,7 @@ from contact_ufl.verification.analytic import (
 
 __all__ = [
     "cattaneo_mindlin_run",
+    "coulomb_ratio_3d",
     "energy_balance",
     "hertz_3d_errors",
     "hertz_3d_run",
@@ -216,10 +217,12 @@ def ironing_3d_run(
     slide: float = 4.0,
     t_end: float = 2.0,
     verbose: bool = False,
+    **scene_options,
 ) -> tuple[dict, ContactProblem]:
     """The 3D ironing problem of :func:`~contact_ufl.verification.scenes.ironing_3d`: the
     die pressed 1.4 into the slab (t = 0 to 1), then slid ``slide`` along it (t = 1 to 2),
     the slide stopped at ``t_end`` (in ``slide_steps`` steps); one record per converged step.
+    ``scene_options`` go to the scene (``slave``, ``quadrature_degree``, ``master_normal``).
 
     Returns ``{"mu", "history", "cutbacks", ...}`` with history records ``time``, ``Fx``,
     ``Fy``, ``Fz`` (the force of the support on the die's top, which balances the contact
@@ -228,10 +231,29 @@ def ironing_3d_run(
     ``top_displacement``, ``stored_energy`` and ``dissipation``, as :func:`ironing_run`;
     and the problem.
     """
-    scene = scenes.ironing_3d(mu=mu, h_die=h_die, h_slab=h_slab, slide=slide)
+    scene = scenes.ironing_3d(mu=mu, h_die=h_die, h_slab=h_slab, slide=slide, **scene_options)
     stages = [(press_steps, 1.0)] + ([(slide_steps, t_end)] if slide_steps > 0 else [])
     run, problem = _driven_run(scene, "die_top", stages, verbose)
-    return {"mu": mu, "h_die": h_die, "h_slab": h_slab, **run}, problem
+    return {"mu": mu, "h_die": h_die, "h_slab": h_slab, **scene_options, **run}, problem
+
+
+def coulomb_ratio_3d(history: list[dict], window: tuple[float, float] = (1.5, 1.9)) -> float:
+    """Mean over the records of ``window`` of the sliding component of the frictional part
+    of the contact force over the vertical component of its normal part,
+    ``|F_fric,x| / |F_normal,z|`` (:func:`contact_force_parts`), in the 3D ironing.
+
+    On the die's cylinder (axis along y) a point at angle theta from the bottom line has
+    the normal ``(-sin theta, 0, cos theta)`` and, sliding along the circumference, the
+    frictional traction ``mu t_N (cos theta, 0, sin theta)``: the ratio of the x component
+    of the one to the z component of the other is ``mu`` at every sliding point, so the
+    ratio of the sums is ``mu`` where the whole contact slides along x (Coulomb's law), less
+    where points stick or slip across the slab. The default window is the steady slide:
+    on the soft slab (E = 1) the contact sticks in part until the die has moved about 1.8
+    (t = 1.45), and the die is 1 from the slab's far end at t = 2."""
+    records = [r for r in history if window[0] <= r["time"] <= window[1]]
+    if not records:
+        raise ValueError(f"no record in the window {window}")
+    return float(np.mean([abs(r["contact_friction"][0] / r["contact_normal"][2]) for r in records]))
 
 
 # -- 3D Hertz -----------------------------------------------------------------------------------
