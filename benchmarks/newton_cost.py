@@ -73,6 +73,7 @@ def run(make, size, contact: bool) -> dict:
     wall = time.perf_counter() - start
     per = timings.per_iteration()
     record = {
+        "analyses": timings.analyses,
         "scene": make.__name__,
         "size": size,
         "case": "contact" if contact else "bulk",
