@@ -161,12 +161,12 @@ class NewtonSolver:
     pattern_slack
         The solver matrix's sparsity pattern is made, not from the current pairing's
         tangent ``T^T K T``, but from a superset: the couplings of every point with the
-        master nodes of the facet fan around its facet (the contacts' ``pattern_gathers``),
-        explicit zeros where there is no coupling. A pairing that moves points onto
-        neighbouring facets then keeps the pattern, and the factorisation keeps its symbolic
-        analysis. A pairing outside it grows the pattern (a union); at the start of a step,
-        a union that holds more than ``1 + pattern_slack`` times the couplings of the
-        current superset is rebuilt on the current one.
+        master nodes of its facet and of the facets beside it (the contacts'
+        ``pattern_gathers``), explicit zeros where there is no coupling. A pairing that
+        moves points onto neighbouring facets then keeps the pattern, and the factorisation
+        keeps its symbolic analysis. A pairing outside it grows the pattern (a union); at
+        the start of a step, a union that holds more than ``1 + pattern_slack`` times the
+        couplings of the current superset is rebuilt on the current one.
     """
 
     def __init__(

@@ -225,7 +225,7 @@ class ContactInterface:
     def pattern_gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
         """A superset of the gathers of the last :meth:`update` (each dof may gather several
         unknowns: ``(ndofs, width)`` arrays, ``-1`` padded) from which the solver makes its
-        sparsity pattern: the master nodes of the facet fans around the points' facets (see
+        sparsity pattern: the master nodes of the points' facets and of those beside them (see
         :meth:`MeshKinematics.pattern_gathers
         <contact_ufl.contact.kinematics.MeshKinematics.pattern_gathers>`)."""
         wide = self.kinematics.pattern_gathers()

@@ -261,7 +261,8 @@ class MeshKinematics:
     def pattern_gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
         """What the gathered fields may gather after a small change of the pairing: pairs of
         a field and, for every owned dof of it (unrolled, local order), the stacked indices
-        of the unknowns of the same component at the nodes of its point's facet fan
+        of the unknowns of the same component at the nodes of its point's facet and of
+        the facets beside it
         (``(ndofs, width)``, ``-1`` padded). A superset of the gathers of :meth:`update`
         (which returned ``xhat``'s): the solver's sparsity pattern is made from it, so that
         the pattern holds a point moving onto a neighbouring facet."""

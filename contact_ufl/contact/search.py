@@ -50,9 +50,9 @@ class Pairing:
         ``(np, 2)``; else ``None``.
     neighbourhood
         Stacked index of the first displacement unknown of every node gathered by the
-        candidate facets that share a node with each point's facet (the facet's fan, the
-        facet included), ``(np, width)`` (``-1`` padded; ``-1`` where unpaired): a pairing
-        that moves a point onto a neighbouring facet gathers within it.
+        candidate facets beside each point's facet (sharing a side with it: a node in 2D,
+        an edge in 3D; the facet included), ``(np, width)`` (``-1`` padded; ``-1`` where
+        unpaired): a pairing that moves a point onto a neighbouring facet gathers within it.
     """
 
     points: np.ndarray
@@ -223,7 +223,8 @@ class ClosestPointSearch:
 
 
 def fan_columns(columns: np.ndarray, nn: int, facets: np.ndarray) -> np.ndarray:
-    """The columns gathered by the candidate facets that share a node with each of ``facets``.
+    """The columns gathered by the candidate facets that share a side with each of ``facets``
+    (the facet included): a node of a segment (2D), an edge (two nodes) of a surface facet.
 
     Parameters
     ----------
@@ -254,7 +255,10 @@ def fan_columns(columns: np.ndarray, nn: int, facets: np.ndarray) -> np.ndarray:
 
     own, gathered = incidence(nn), incidence(columns.shape[1])
     chosen, where = np.unique(facets, return_inverse=True)
-    fans = ((own[chosen] @ own.T) @ gathered).tocsr()
+    shared = own[chosen] @ own.T  # nodes shared by a chosen facet and a candidate
+    shared.data = (shared.data >= (1 if nn == 2 else 2)).astype(float)
+    shared.eliminate_zeros()
+    fans = (shared @ gathered).tocsr()
     fans.sort_indices()
     counts = np.diff(fans.indptr)
     out = np.full((len(chosen), counts.max()), -1, dtype=np.int64)
