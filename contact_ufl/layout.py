@@ -98,7 +98,8 @@ def chain_operator(
         n = rows.local_sizes[rb]
         row_index[offset[rb] : offset[rb] + n, 0] = cols.owned(cb, np.arange(n))
     for gb, cols_b in zip(gather_blocks, gather_cols, strict=True):
-        cols_b = np.asarray(cols_b).reshape(rows.local_sizes[gb], -1)
+        cols_b = np.asarray(cols_b)
+        cols_b = cols_b[:, None] if cols_b.ndim == 1 else cols_b
         row_index[offset[gb] : offset[gb + 1], : cols_b.shape[1]] = cols_b
     row_index.sort(axis=1)  # ascending columns in each row (the -1 first)
     has = row_index >= 0

@@ -283,7 +283,8 @@ class NewtonSolver:
         for g in gathers:
             for f, cols in g:
                 start = offsets[self._field_index[id(f)]]
-                cols = np.asarray(cols).reshape(len(cols), -1)
+                cols = np.asarray(cols)
+                cols = cols[:, None] if cols.ndim == 1 else cols
                 rows = start + np.arange(len(cols))[:, None]
                 keys.append((rows * n + cols)[cols >= 0])
         return np.unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
