@@ -167,6 +167,12 @@ class NewtonSolver:
         keeps its symbolic analysis. A pairing outside it grows the pattern (a union); at
         the start of a step, a union that holds more than ``1 + pattern_slack`` times the
         couplings of the current superset is rebuilt on the current one.
+    pattern_superset
+        Whether the pattern holds the facets beside each point's facet (default: in 2D).
+        Without it (the 3D default) the pattern is the union of the pairings met: an analysis
+        for every pairing that leaves it. In 3D the superset's extra fill (9% more flops at
+        11,000 P2 unknowns; more with the smoothed normal's wide gathers, whose tangent was
+        then 15% slower per iteration) outweighed the analyses it saved.
     """
 
     def __init__(
@@ -198,6 +204,7 @@ class NewtonSolver:
         self._gathers = None  # the parts of the problem that gather, and their gathers
         self._grow = True  # the pattern must grow before the next factorisation
         self.pattern_slack = 0.5
+        self.pattern_superset = problem.gdim == 2
         self._state = None
         self._update_contact(self.x)
         problem.commit(self.x)  # the initial state is the converged state of step 0
@@ -301,7 +308,7 @@ class NewtonSolver:
             if self.comm.allreduce(inside, MPI.LAND):
                 return
         wide = [
-            p.pattern_gathers() if hasattr(p, "pattern_gathers") else g
+            p.pattern_gathers() if self.pattern_superset and hasattr(p, "pattern_gathers") else g
             for p, g in zip(parts, gathers, strict=True)
         ]
         self._T_wide = self._chain_operator(wide)
