@@ -5,7 +5,10 @@ assembled over the fields ``[u, xhat_1, lambda_1, ...]``; the chain operator ``T
 :mod:`contact_ufl.layout` (identity on the unknowns, the gathers ``xhat = Xhat + P u``)
 maps them onto the unknowns ``[u, lambda_1, ...]``: residual ``T^T r``, tangent
 ``T^T K T``. The search runs at every new state; ``T`` and the tangent's sparsity pattern
-change only when the pairing does. The solver times its parts (:class:`NewtonTimings`).
+change only when the pairing does, and the solver matrix's pattern (that of the
+factorisation's symbolic analysis) only when a pairing leaves a superset of the pairings
+met (:attr:`NewtonSolver.pattern_superset`). The solver times its parts
+(:class:`NewtonTimings`).
 """
 
 from __future__ import annotations
@@ -57,8 +60,8 @@ class NewtonTimings:
     jacobian_assembly
         Assembly of the tangent ``K`` over the fields (bulk and contact forms together).
     ptap
-        ``T^T K T``, the copy into the solver's matrix (with a new sparsity pattern and a
-        reset factorisation where the pairing changed) and the Dirichlet rows.
+        ``T^T K T``, the copy into the solver's matrix (whose pattern grows, with a reset
+        factorisation, where a new pairing leaves it) and the Dirichlet rows.
     newton
         Time inside ``SNES.solve``.
     callbacks
