@@ -83,21 +83,27 @@ def chain_operator(
     gather_cols
         For each gather block, for each of its owned dofs (unrolled, in local order), the
         stacked column index of the unknown it copies, or -1 for none (a quadrature point
-        without a master facet).
+        without a master facet). A 2D array ``(ndofs, width)`` gives several columns per
+        dof (``-1`` padded): an operator whose sparsity pattern holds those of several
+        pairings (its values, ones, are not those of a chain rule).
 
     Returns
     -------
     A parallel AIJ matrix of local size ``(rows.local_size, cols.local_size)``.
     """
-    row_index = np.full(rows.local_size, -1, dtype=np.int64)
+    width = max([1, *(c.shape[1] for c in gather_cols if np.ndim(c) == 2)])
+    row_index = np.full((rows.local_size, width), -1, dtype=np.int64)
     offset = np.concatenate([[0], np.cumsum(rows.local_sizes)])
     for rb, cb in identity_blocks:
         n = rows.local_sizes[rb]
-        row_index[offset[rb] : offset[rb] + n] = cols.owned(cb, np.arange(n))
+        row_index[offset[rb] : offset[rb] + n, 0] = cols.owned(cb, np.arange(n))
     for gb, cols_b in zip(gather_blocks, gather_cols, strict=True):
-        row_index[offset[gb] : offset[gb + 1]] = cols_b
+        cols_b = np.asarray(cols_b)
+        cols_b = cols_b[:, None] if cols_b.ndim == 1 else cols_b
+        row_index[offset[gb] : offset[gb + 1], : cols_b.shape[1]] = cols_b
+    row_index.sort(axis=1)  # ascending columns in each row (the -1 first)
     has = row_index >= 0
-    indptr = np.concatenate([[0], np.cumsum(has)]).astype(PETSc.IntType)
+    indptr = np.concatenate([[0], np.cumsum(has.sum(axis=1))]).astype(PETSc.IntType)
     indices = row_index[has].astype(PETSc.IntType)
     values = np.ones(len(indices), dtype=PETSc.ScalarType)
     T = PETSc.Mat().createAIJ(

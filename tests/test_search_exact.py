@@ -16,6 +16,7 @@ from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_
 
 from contact_ufl.contact import projection
 from contact_ufl.contact.projection import TreeCache, closest_points, shape_functions
+from contact_ufl.contact.search import fan_columns
 
 FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
 
@@ -151,3 +152,17 @@ def test_points_searched_in_cell_order(make, nf, monkeypatch):
     order = projection._spatial_order(points)
     assert not np.array_equal(order, np.arange(len(points)))  # the order changes
     check(points, nodes, 0.3)
+
+
+def test_fan_columns_are_the_facets_beside():
+    """The solver pattern's neighbourhood of a facet: its own columns and those of the
+    facets sharing a side with it (a node of a segment, an edge of a triangle), not those
+    sharing only a vertex in 3D; -1 pads the shorter rows."""
+    chain = np.array([[0, 2], [2, 4], [4, 6], [6, 8]])
+    fans = fan_columns(chain, 2, np.array([1, 0]))
+    assert fans.tolist() == [[0, 2, 4, 6], [0, 2, 4, -1]]
+    # triangles: 0 = (0, 1, 2); 1 shares the edge (1, 2); 2 shares only the vertex 0
+    triangles = np.array([[0, 3, 6], [3, 6, 9], [0, 12, 15]])
+    fans = fan_columns(triangles, 3, np.array([0, 2]))
+    assert fans.tolist() == [[0, 3, 6, 9], [0, 12, 15, -1]]
+    assert fan_columns(triangles, 3, np.zeros(0, dtype=int)).shape == (0, 0)

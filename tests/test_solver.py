@@ -119,3 +119,37 @@ def test_a_failed_step_says_where_elements_invert():
     (first, second) = problem.history.cutbacks
     assert first.reason == "DIVERGED_FUNCTION_NANORINF" and "inverted" in first.why
     assert np.all(problem.u.x.array == 0.0)  # the start of the step is kept
+
+
+def test_solver_pattern_holds_the_pairings_met():
+    """The solver matrix's pattern is a superset (the facets beside each point's facet):
+    the pairing changes within a solve, T^T K T gets new patterns, but the factorisation's
+    symbolic analysis is kept (fewer analyses than new patterns), and the solver matrix holds
+    every coupling of the current tangent."""
+    from petsc4py import PETSc
+
+    problem = hertz_problem()
+    solver = problem.solver
+    timings = solver.timings
+    timings.reset()
+    problem.solve(num_steps=2)
+    assert timings.new_patterns >= 1
+    assert timings.analyses < timings.new_patterns
+    J = solver.evaluate_jacobian(solver.x)
+    union = J.duplicate(copy=True)
+    union.axpy(1.0, solver._JT, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    assert union.getInfo()["nz_used"] == J.getInfo()["nz_used"]
+
+
+def test_rebuilt_solver_pattern_gives_the_same_solution():
+    """With no slack the solver matrix is rebuilt on the current pairing's superset at every
+    step whose union grew; the solution is that of the default solver (round-off)."""
+    results = []
+    for slack in (0.5, -1.0):
+        problem = hertz_problem()
+        problem.solver.pattern_slack = slack
+        problem.solve(num_steps=2)
+        results.append((problem.solver.timings.analyses, problem.solver.x.array.copy()))
+    (kept, x_kept), (rebuilt, x_rebuilt) = results
+    assert rebuilt > kept  # the negative slack rebuilt the pattern at every step
+    np.testing.assert_allclose(x_rebuilt, x_kept, rtol=0, atol=1e-10 * np.abs(x_kept).max())

@@ -241,6 +241,15 @@ class ContactInterface:
         gathers = self.kinematics.update(layout)
         return gathers + (self.friction.gathers() if self.friction else [])
 
+    def pattern_gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """A superset of the gathers of the last :meth:`update` (each dof may gather several
+        unknowns: ``(ndofs, width)`` arrays, ``-1`` padded) from which the solver makes its
+        sparsity pattern: the master nodes of the points' facets and of those beside them (see
+        :meth:`MeshKinematics.pattern_gathers
+        <contact_ufl.contact.kinematics.MeshKinematics.pattern_gathers>`)."""
+        wide = self.kinematics.pattern_gathers()
+        return wide + (self.friction.gathers() if self.friction else [])
+
     def held_multipliers(self, prescribed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The multiplier dofs to hold at zero where the slave's displacement is prescribed.
 

@@ -220,6 +220,7 @@ class MeshKinematics:
         #: for every owned dof of ``xhat`` (unrolled), the stacked index of the unknown it
         #: gathers, or -1 (set by :meth:`update`)
         self.gather = None
+        self._neighbourhood = None
         self._build()
 
     def nodes(self, f) -> ufl.core.expr.Expr:
@@ -289,7 +290,24 @@ class MeshKinematics:
         self.gather = self.slave.unrolled(
             self.Qx, pairing.columns.reshape(npts, self.nx * self.gdim), fill=-1
         )
+        self._neighbourhood = pairing.neighbourhood
         return [(self.xhat, self.gather)]
+
+    def pattern_gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """What the gathered fields may gather after a small change of the pairing: pairs of
+        a field and, for every owned dof of it (unrolled, local order), the stacked indices
+        of the unknowns of the same component at the nodes of its point's facet and of
+        the facets beside it
+        (``(ndofs, width)``, ``-1`` padded). A superset of the gathers of :meth:`update`
+        (which returned ``xhat``'s): the solver's sparsity pattern is made from it, so that
+        the pattern holds a point moving onto a neighbouring facet."""
+        fan = self._neighbourhood
+        npts, gdim = len(fan), self.gdim
+        component = np.arange(gdim)[None, None, :, None]
+        wide = np.where(fan[:, None, None, :] >= 0, fan[:, None, None, :] + component, -1)
+        wide = np.broadcast_to(wide, (npts, self.nx, gdim, fan.shape[1]))
+        wide = wide.reshape(npts, self.nx * gdim, fan.shape[1])
+        return [(self.xhat, self.slave.unrolled(self.Qx, wide, fill=-1))]
 
     def set_pairing(self, pairing: Pairing) -> None:
         """Make the point data those of a new search result (value of xi, M, nodes...)."""

@@ -385,6 +385,11 @@ class ObstacleKinematics:
         self.search_time += time.perf_counter() - start
         return []
 
+    def pattern_gathers(self) -> list:
+        """Nothing is gathered (see :meth:`MeshKinematics.pattern_gathers
+        <contact_ufl.contact.kinematics.MeshKinematics.pattern_gathers>`)."""
+        return []
+
     def check_facing(self, description: str) -> None:
         """Raise (on every rank) if no slave point faces the obstacle in the reference
         configuration at its pose at t = 0: outside it, with opposed outward normals."""

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import dolfinx
 import numpy as np
+import scipy.sparse
 from mpi4py import MPI
 
 from contact_ufl.contact.facets import on_edges
@@ -47,6 +48,11 @@ class Pairing:
     flags
         (smoothed normal, 2D) whether the neighbours before / after the segment exist,
         ``(np, 2)``; else ``None``.
+    neighbourhood
+        Stacked index of the first displacement unknown of every node gathered by the
+        candidate facets beside each point's facet (sharing a side with it: a node in 2D,
+        an edge in 3D; the facet included), ``(np, width)`` (``-1`` padded; ``-1`` where
+        unpaired): a pairing that moves a point onto a neighbouring facet gathers within it.
     """
 
     points: np.ndarray
@@ -54,6 +60,7 @@ class Pairing:
     nodes: np.ndarray
     columns: np.ndarray
     flags: np.ndarray | None
+    neighbourhood: np.ndarray | None = None
 
     @property
     def paired(self) -> np.ndarray:
@@ -209,8 +216,56 @@ class ClosestPointSearch:
         gathered[paired] = nodes[proj.facet[paired]]
         gather = np.full((npts, nx, gdim), -1, dtype=np.int64)
         gather[paired] = columns[proj.facet[paired]][:, :, None] + np.arange(gdim)
+        fans = fan_columns(columns, nn, proj.facet[paired])
+        neighbourhood = np.full((npts, fans.shape[1]), -1, dtype=np.int64)
+        neighbourhood[paired] = fans
         self.time += time.perf_counter() - start
-        return Pairing(points, proj, gathered, gather, flags)
+        return Pairing(points, proj, gathered, gather, flags, neighbourhood)
+
+
+def fan_columns(columns: np.ndarray, nn: int, facets: np.ndarray) -> np.ndarray:
+    """The columns gathered by the candidate facets that share a side with each of ``facets``
+    (the facet included): a node of a segment (2D), an edge (two nodes) of a surface facet.
+
+    Parameters
+    ----------
+    columns
+        The gathered columns of the candidate facets, ``(ncand, nx)``, the facet's own
+        ``nn`` nodes first (``-1``: none).
+    nn
+        Nodes of a facet.
+    facets
+        Candidate indices.
+
+    Returns
+    -------
+    ``(len(facets), width)``: the distinct columns of each facet's fan, ``-1`` padded.
+    """
+    if len(facets) == 0 or len(columns) == 0:
+        return np.zeros((len(facets), 0), dtype=np.int64)
+    ids, inverse = np.unique(columns, return_inverse=True)
+    inverse = inverse.reshape(columns.shape)
+
+    def incidence(k: int) -> scipy.sparse.csr_array:
+        valid = columns[:, :k] >= 0
+        rows = np.nonzero(valid)[0]
+        data = np.ones(len(rows))
+        return scipy.sparse.csr_array(
+            (data, (rows, inverse[:, :k][valid])), shape=(len(columns), len(ids))
+        )
+
+    own, gathered = incidence(nn), incidence(columns.shape[1])
+    chosen, where = np.unique(facets, return_inverse=True)
+    shared = own[chosen] @ own.T  # nodes shared by a chosen facet and a candidate
+    shared.data = (shared.data >= (1 if nn == 2 else 2)).astype(float)
+    shared.eliminate_zeros()
+    fans = (shared @ gathered).tocsr()
+    fans.sort_indices()
+    counts = np.diff(fans.indptr)
+    out = np.full((len(chosen), counts.max()), -1, dtype=np.int64)
+    rows = np.repeat(np.arange(len(chosen)), counts)
+    out[rows, np.arange(len(rows)) - np.repeat(fans.indptr[:-1], counts)] = ids[fans.indices]
+    return out[where]
 
 
 def release_beyond_boundary(

@@ -284,12 +284,14 @@ class SlaveSurface:
         return f.x.array.reshape(-1, bs)[self._owned_blocks(f.function_space)]
 
     def unrolled(self, Q: dolfinx.fem.FunctionSpace, values: np.ndarray, fill) -> np.ndarray:
-        """``values`` ``(npoints, bs)`` of the owned points as an array over the owned dofs of
-        the point space ``Q`` (unrolled, local order), ``fill`` at dofs of no owned point."""
+        """``values`` ``(npoints, bs, ...)`` of the owned points as an array over the owned
+        dofs of the point space ``Q`` (unrolled, local order; then the trailing axes of
+        ``values``), ``fill`` at dofs of no owned point."""
         bs = Q.dofmap.index_map_bs
-        out = np.full((Q.dofmap.index_map.size_local, bs), fill, dtype=values.dtype)
-        out[self._owned_blocks(Q)] = values
-        return out.ravel()
+        rest = values.shape[2:]
+        out = np.full((Q.dofmap.index_map.size_local, bs, *rest), fill, dtype=values.dtype)
+        out[self._owned_blocks(Q)] = values.reshape(len(values), bs, *rest)
+        return out.reshape(len(out) * bs, *rest)
 
     # -- the multiplier nodes (P1 on the submesh) ----------------------------------------
     def p1_at_points(self, f: dolfinx.fem.Function) -> np.ndarray:
