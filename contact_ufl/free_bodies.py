@@ -70,8 +70,13 @@ def pieces(problem: ContactProblem) -> list[Piece]:
 
 
 def _on_piece(bulk: Bulk, tag: int, piece: Piece, comm: MPI.Comm) -> bool:
-    """Whether the facets ``tag`` of ``bulk`` have a node on ``piece`` (collective)."""
-    here = bool(np.isin(bulk.facet_dofs(tag), piece.blocks).any())
+    """Whether the contact surface ``tag`` of ``bulk`` (facets; a membrane's cells) has a
+    node on ``piece`` (collective)."""
+    if bulk.membrane:
+        nodes = bulk.V.dofmap.list[bulk.domain.cell_tags.find(tag)].ravel()
+    else:
+        nodes = bulk.facet_dofs(tag)
+    here = bool(np.isin(nodes, piece.blocks).any())
     return comm.allreduce(here, MPI.LOR)
 
 
