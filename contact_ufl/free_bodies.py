@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import dolfinx
 import numpy as np
 from mpi4py import MPI
 
@@ -42,18 +43,26 @@ class Piece:
     free: np.ndarray
 
 
-def _merged(blocks: list[np.ndarray], comm: MPI.Comm) -> list[np.ndarray]:
-    """The union of the node sets ``blocks`` that share a node (on any rank)."""
-    n = len(blocks)
-    shared = np.array([[np.intersect1d(a, b).size > 0 for b in blocks] for a in blocks], int)
-    shared = comm.allreduce(shared.reshape(n, n), MPI.MAX) > 0
-    label = np.arange(n)
-    for _ in range(n):  # the smallest label reachable: a few bodies per mesh
-        label = np.array([label[shared[k]].min() for k in range(n)])
-    return [
-        np.unique(np.concatenate([blocks[k] for k in np.flatnonzero(label == m)]))
-        for m in np.unique(label)
-    ]
+def _indicator(index_map, blocks: np.ndarray) -> np.ndarray:
+    """Which local nodes (owned and ghost) any rank's ``blocks`` hold (collective)."""
+    marks = dolfinx.la.vector(index_map, 1)
+    marks.array[blocks] = 1.0
+    marks.scatter_reverse(dolfinx.la.InsertMode.add)
+    marks.scatter_forward()
+    return marks.array > 0.0
+
+
+def _merged(index_map, blocks: list[np.ndarray], comm: MPI.Comm) -> list[np.ndarray]:
+    """The unions of the node sets ``blocks`` (local nodes of cells) that share a node,
+    as the local nodes (owned and ghost) of each union, also where the cells that share
+    it lie on different ranks (collective)."""
+    held = np.array([_indicator(index_map, b) for b in blocks])
+    owned = held[:, : index_map.size_local].astype(int)
+    shared = (comm.allreduce(owned @ owned.T, MPI.SUM) > 0) | np.eye(len(blocks), dtype=bool)
+    label = np.arange(len(blocks))
+    for _ in blocks:  # the smallest label reachable: a few bodies per mesh
+        label = np.array([label[row].min() for row in shared])
+    return [np.flatnonzero(held[label == m].any(axis=0)) for m in np.unique(label)]
 
 
 def pieces(problem: ContactProblem) -> list[Piece]:
@@ -62,7 +71,7 @@ def pieces(problem: ContactProblem) -> list[Piece]:
     for k, bulk in enumerate(problem.bulks):
         dofs = bulk.V.dofmap.list
         blocks = [np.unique(dofs[bulk.domain.cell_tags.find(b.tag)].ravel()) for b in bulk.bodies]
-        for nodes in _merged(blocks, problem.comm):
+        for nodes in _merged(bulk.V.dofmap.index_map, blocks, problem.comm):
             held = bulk.prescribed_components[nodes].any(axis=0).astype(int)
             free = problem.comm.allreduce(held, MPI.MAX) == 0
             out.append(Piece(k, nodes, free))

@@ -402,6 +402,12 @@ class NewtonSolver:
            it use the contact law again (points in tension are released), so the solution
            is that of the same equations.
 
+        Where the start shows such a body (:meth:`_loose_pairs`: a piece of a mesh with no
+        support along some axis, no point in contact on any of its pairs, and a net force
+        along that axis above the absolute tolerance, so that the Newton equation has no
+        solution), the step begins with the closing iterate on its pairs instead of
+        reaching it after two failed tries; the line-search try follows if that fails.
+
         Returns
         -------
         converged, Newton iterations (of all tries), SNES converged reason (name)
