@@ -73,7 +73,7 @@ def pieces(problem: ContactProblem) -> list[Piece]:
         blocks = [np.unique(dofs[bulk.domain.cell_tags.find(b.tag)].ravel()) for b in bulk.bodies]
         for nodes in _merged(bulk.V.dofmap.index_map, blocks, problem.comm):
             held = bulk.prescribed_components[nodes].any(axis=0).astype(int)
-            free = problem.comm.allreduce(held, MPI.MAX) == 0
+            free = problem.comm.allreduce(held, MPI.SUM) == 0
             out.append(Piece(k, nodes, free))
     return out
 
