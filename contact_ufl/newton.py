@@ -26,6 +26,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from contact_ufl import free_bodies
 from contact_ufl.layout import chain_operator
 
 if TYPE_CHECKING:
@@ -223,6 +224,7 @@ class NewtonSolver:
         self._not_finite = None
         #: try a closing iterate where a pair has no point in contact (:meth:`solve_step`)
         self.close_gaps = True
+        self._pieces = None  # (piece, its pairs) of the pieces free in some direction
         problem._solver = self  # the solver of the problem's results that need T
 
     def _create_snes(self, options: dict, prefix: str) -> PETSc.SNES:
@@ -490,6 +492,12 @@ class NewtonSolver:
            it use the contact law again (points in tension are released), so the solution
            is that of the same equations.
 
+        Where the start shows such a body (:meth:`_loose_pairs`: a piece of a mesh with no
+        support along some axis, no point in contact on any of its pairs, and a net force
+        along that axis above the absolute tolerance, so that the Newton equation has no
+        solution), the step begins with the closing iterate on its pairs instead of
+        reaching it after two failed tries; the line-search try follows if that fails.
+
         Returns
         -------
         converged, Newton iterations (of all tries), SNES converged reason (name)
@@ -498,7 +506,11 @@ class NewtonSolver:
         fem_petsc.assign(self.problem.unknowns, self.x)
         self._shrink_pattern()
         start = self.x.copy()
-        reason, its = self._newton()
+        loose = self._loose_pairs() if self.close_gaps else []
+        if loose:  # no Newton step without contact: close first
+            reason, its = self._closed_newton(loose)
+        else:
+            reason, its = self._newton()
         linesearch = self.snes.getLineSearch()
         primary = linesearch.getType()
         if reason <= 0 and self.fallback_linesearch not in (None, primary):
@@ -509,13 +521,12 @@ class NewtonSolver:
             finally:
                 linesearch.setType(primary)
             its += more
-        if reason <= 0 and self.close_gaps:
+        if reason <= 0 and self.close_gaps and not loose:
             start.copy(self.x)
             open_pairs = self._open_pairs()
             if open_pairs:
-                self._closing_iterate(open_pairs)
-                reason, more = self._newton()
-                its += 1 + more
+                reason, more = self._closed_newton(open_pairs)
+                its += more
         self._state = None
         self._set_state(self.x)
         names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
@@ -528,6 +539,43 @@ class NewtonSolver:
         contacts = self.problem.contacts
         counts = self.comm.allreduce(np.array([c.active().sum() for c in contacts]), MPI.SUM)
         return [c for c, n in zip(contacts, counts, strict=True) if n == 0]
+
+    def _closed_newton(self, pairs: list) -> tuple[int, int]:
+        """A closing iterate on ``pairs``, then Newton: converged reason and iterations
+        (the closing iterate counted)."""
+        self._closing_iterate(pairs)
+        reason, its = self._newton()
+        return reason, 1 + its
+
+    def _loose_pairs(self) -> list:
+        """The contact pairs to close before the first try (collective): the pairs with no
+        point in contact at :attr:`x` on a piece held by no point in contact, free to
+        translate along a direction in which the residual at :attr:`x` has a net force
+        above the absolute tolerance (:mod:`contact_ufl.free_bodies`): there the tangent is
+        singular and the Newton equation has no solution."""
+        problem = self.problem
+        if self._pieces is None:
+            self._pieces = [
+                (piece, on)
+                for piece in free_bodies.pieces(problem)
+                if piece.free.any() and (on := free_bodies.pairs_on(problem, piece))
+            ]
+        if not self._pieces:
+            return []
+        self._state = None  # the search at the step's time (a rigid obstacle moves)
+        residual = self.evaluate_residual(self.x).array_r
+        counts = self.comm.allreduce(
+            np.array([c.active().sum() for c in problem.contacts]), MPI.SUM
+        )
+        atol = self.snes.getTolerances()[0]
+        loose = set()
+        for piece, on in self._pieces:
+            if np.any(counts[on] > 0):
+                continue  # a point in contact holds the piece
+            force = free_bodies.net_force(problem, residual, piece)
+            if np.any(piece.free & (np.abs(force) > atol)):
+                loose.update(on)
+        return [c for k, c in enumerate(problem.contacts) if k in loose]
 
     def _closing_iterate(self, pairs: list) -> None:
         """One Newton iterate from :attr:`x` in which the open points of ``pairs`` near the

@@ -102,3 +102,80 @@ def test_force_driven_patch_3d_from_a_gap(cell, degree, subdivisions, tolerance)
     touching, _ = run(0.0)
     difference = np.abs(lam - touching).max() / pressure
     assert problem.comm.allreduce(difference, op=MPI.MAX) < 1e-6
+
+
+# -- a force-driven start closes first (no failed tries) -----------------------------------
+
+
+@pytest.mark.parametrize("gap, newton", [(0.0, 7), (1e-3, 6)])
+def test_force_driven_hertz_newton_count(force, gap, newton):
+    """In one step from touching or from a gap, the disc pushed by the force closes before
+    the first try: 7 and 6 Newton iterations, closing iterate included (8 and 7 when the
+    closing iterate came after a failed full-step and a failed line-search try)."""
+    problem = solved(hertz_scene("force", force, gap=gap), steps=1)
+    assert not problem.history.cutbacks
+    assert problem.history.steps[0].newton_iterations == newton
+
+
+UPPER_TOP = 13
+"""Tag of the upper block's top in :func:`scenes.patch_3d_pressed`."""
+
+
+def patch_problem(cell: str, gap: float, top: float | None = None) -> cu.ContactProblem:
+    """:func:`scenes.patch_3d_pressed` in one step; with ``top``: displacement-driven, the
+    upper block's top moved vertically by ``top`` instead of the dead pressure."""
+    degree, subdivisions = (2, 4) if cell == "tetrahedron" else (3, 2)
+    scene = scenes.patch_3d_pressed(
+        1e-4 * E_STEEL, gap, cell=cell, quadrature_degree=degree, subdivisions=subdivisions
+    )
+    assert scene.tags["upper_top"] == UPPER_TOP
+    if top is not None:
+        scene.loads.clear()
+        scene.dirichlet.append(cu.Dirichlet(UPPER_TOP, lambda t: top * t, component=2))
+    return solved(scene, steps=1)
+
+
+def top_displacement(problem) -> float:
+    """The mean vertical displacement of the upper block's top."""
+    bulk = problem.bulks[0]
+    nodes = bulk.facet_dofs(UPPER_TOP)
+    uz = bulk.u.x.array.reshape(-1, 3)[nodes, 2]
+    total = problem.comm.allreduce(np.array([uz.sum(), len(uz)]), MPI.SUM)
+    return float(total[0] / total[1])
+
+
+@pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
+@pytest.mark.parametrize("gap", [0.0, 1e-3])
+def test_force_driven_patch_3d_newton_count_and_displacement_driven(cell, gap):
+    """The 3D patch pressed from touching or from a gap in one step: 2 Newton iterations
+    (from the gap: 27 in each of two steps when the closing iterate came after two failed
+    tries), and the displacement-driven scene whose top moves as the pressed top's mean
+    carries the same force with the same multipliers (measured: force 1e-7 (tetrahedra),
+    6e-5 (hexahedra); lambda_N 1.4e-5 and 3.3e-4 of the pressure)."""
+    pressure = 1e-4 * E_STEEL
+    problem = patch_problem(cell, gap)
+    assert not problem.history.cutbacks
+    assert problem.history.steps[0].newton_iterations == 2
+    driven = patch_problem(cell, gap, top=top_displacement(problem))
+    force, force0 = problem.contact_force()[2], driven.contact_force()[2]
+    assert force == pytest.approx(pressure, rel=1e-8)  # a unit square
+    assert abs(force0 / force - 1.0) < 2e-4
+    difference = np.abs(problem.contacts[0].lambda_N.x.array - driven.contacts[0].lambda_N.x.array)
+    assert problem.comm.allreduce(difference.max(initial=0.0), op=MPI.MAX) < 1e-3 * pressure
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_membrane_pressed_onto_a_block_from_a_gap(dim):
+    """The membrane of :func:`scenes.membrane_on_block`, held only in its plane, lifted by
+    a gap and pressed by its follower pressure: 3 Newton iterations, as from touching, and
+    the exact contact pressure (3 and 4 iterations when Newton found the contact alone)."""
+    p, s = 0.01, 1.05
+    for gap in (0.0, 1e-2):
+        scene = scenes.membrane_on_block(dim=dim, n=4, a=0.5, stretch=s, pressure=p)
+        scene.domains[0].mesh.geometry.x[:, dim - 1] += gap
+        problem = solved(scene, steps=1)
+        assert [r.newton_iterations for r in problem.history.steps] == [3]
+        (c,) = problem.contacts
+        lam = c.multiplier_at_points()
+        error = np.abs(lam / (p * s ** (dim - 1)) - 1.0).max(initial=0.0)
+        assert problem.comm.allreduce(error, MPI.MAX) < 1e-12
