@@ -91,6 +91,10 @@ _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
 _CELLS = 64  # cells per dimension of the grid that orders the points
 _SORT = 1 << 14  # facets above which the points are ordered by cells
+_GRID_WIDTH = 1.5
+_GRID_CELL = 1.0
+_GRID_MARGIN = 0.5
+_GRID_MOVE = 0.25
 _FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
 
 #: An admissibility test of (point, facet) pairs: point and facet indices in, mask out.
@@ -257,6 +261,15 @@ def _normalise(v: list[FloatArray]) -> list[FloatArray]:
     length = np.sqrt(sum(vk * vk for vk in v))
     scale = np.divide(1.0, length, out=np.zeros_like(length), where=length > 0)
     return [vk * scale for vk in v]
+
+
+def _tangents(dN: FloatArray, X: FloatArray) -> FloatArray:
+    """Tangent vectors ``a[p, alpha] = sum_n dN[p, n, alpha] X[p, n]`` (P, fdim, gdim) from
+    the shape function derivatives (P, nn, fdim) and the nodes (P, nn, gdim)."""
+    a = dN[:, 0, :, None] * X[:, 0, None, :]
+    for n in range(1, X.shape[1]):
+        a += dN[:, n, :, None] * X[:, n, None, :]
+    return a
 
 
 def _unit_normal(a: FloatArray) -> FloatArray:
@@ -601,6 +614,35 @@ class TreeCache:
 
     def __init__(self) -> None:
         self.entries: OrderedDict[tuple[int, ...], tuple[FloatArray, cKDTree]] = OrderedDict()
+        #: cell grids by node array shape: the nodes they were built from, the margin asked
+        #: for, and the grid (built with a margin wider by the movement allowed)
+        self.grids: OrderedDict[tuple[int, ...], tuple[FloatArray, float, _Grid | None]] = (
+            OrderedDict()
+        )
+
+    def grid(self, nodes: FloatArray, radius: float) -> tuple[_Grid | None, float]:
+        """A cell grid of the facets ``nodes`` for a search of ``radius`` and the margin it
+        ensures now: its margin less the largest node movement since it was built.
+
+        The grid is built with the margin ``min(radius, 0.5 e) + 0.25 e`` (``e`` a typical
+        facet width, see :func:`_grid`) and reused while no node has moved more than ``0.25
+        e``; ``None`` where no grid serves (degenerate or too fine a master).
+        """
+        key = nodes.shape
+        entry = self.grids.get(key)
+        if entry is not None:
+            built, asked, grid = entry
+            move = float(np.max(np.abs(nodes - built))) * np.sqrt(nodes.shape[2])
+            if grid is not None and move <= grid.allowance and min(radius, grid.reach) == asked:
+                self.grids.move_to_end(key)
+                return grid, grid.margin - move
+        grid = _grid(nodes, radius)
+        asked = min(radius, grid.reach) if grid is not None else radius
+        self.grids[key] = (nodes.copy(), asked, grid)
+        self.grids.move_to_end(key)
+        while len(self.grids) > _TREES:
+            self.grids.popitem(last=False)
+        return grid, (grid.margin if grid is not None else 0.0)
 
     def tree(
         self, nodes: FloatArray, centroid: FloatArray, R_max: float
@@ -629,6 +671,185 @@ class TreeCache:
         return tree, 0.0
 
 
+class _Grid:
+    """Uniform grids of cells listing the facets near each cell (a spatial hash).
+
+    The facets are sorted into levels by the width of their bounding box: level ``l`` holds
+    the facets at most ``width 2^l`` wide (level 0 all the narrower ones), on a grid of cells
+    ``cell width 2^l`` wide, so that a facet spans a few cells of its level whatever the sizes
+    of the others (a few large facets on a finely meshed surface do not widen the cells of the
+    fine ones). Every facet is listed in the cells its bounding box, widened by ``margin``,
+    overlaps: the facets within ``margin`` of a point are all listed in the cells that hold
+    the point (one per level). The cells are numbered in a box over the widened boxes of a
+    level; the lists are in compressed-row form, indexed directly by the cell number or, over
+    a box of many more cells than entries, through the sorted numbers of the occupied cells.
+
+    Attributes
+    ----------
+    margin : float
+        The width added to the facets' boxes on each side.
+    allowance : float
+        The node movement up to which the grid is reused.
+    reach : float
+        The margin asked for, less the allowance, when the radius is larger.
+    """
+
+    def __init__(
+        self,
+        lo: FloatArray,
+        hi: FloatArray,
+        margin: float,
+        width: float,
+        cell: float,
+        allowance: float = 0.0,
+        reach: float = np.inf,
+    ) -> None:
+        self.margin, self.allowance, self.reach = margin, allowance, reach
+        extent = (hi - lo).max(axis=1)
+        level = np.zeros(len(lo), dtype=np.int64)
+        wide = extent > width
+        level[wide] = np.ceil(np.log2(extent[wide] / width)).astype(np.int64)
+        self.levels = [
+            _GridLevel(f, lo[f] - margin, hi[f] + margin, cell * width * 2.0**k)
+            for k in np.unique(level)
+            for f in [np.flatnonzero(level == k)]
+        ]
+        self.entries = sum(lv.facets.size for lv in self.levels)
+
+    def pairs(self, x: FloatArray) -> tuple[IntArray, IntArray]:
+        """The (point, facet) pairs of the facets listed in the cells of the points ``x``,
+        grouped by point (in increasing point order)."""
+        found = [lv.pairs(x) for lv in self.levels]
+        pid = np.concatenate([p for p, _ in found])
+        fid = np.concatenate([f for _, f in found])
+        if len(found) > 1:
+            order = np.argsort(pid, kind="stable")
+            pid, fid = pid[order], fid[order]
+        return pid, fid
+
+
+class _GridLevel:
+    """One level of a :class:`_Grid`: the facets ``f`` with widened boxes ``lo, hi`` on a
+    grid of cells ``size`` wide."""
+
+    def __init__(self, f: IntArray, lo: FloatArray, hi: FloatArray, size: float) -> None:
+        self.size = size
+        g = lo.shape[1]
+        a = [np.floor(lo[:, k] / size).astype(np.int64) for k in range(g)]
+        b = [np.floor(hi[:, k] / size).astype(np.int64) for k in range(g)]
+        self.base = [int(ak.min()) for ak in a]
+        self.dims = [int(bk.max()) - base + 1 for bk, base in zip(b, self.base, strict=True)]
+        a = [ak - base for ak, base in zip(a, self.base, strict=True)]
+        span = [bk - base - ak for ak, bk, base in zip(a, b, self.base, strict=True)]
+        # the cells of the boxes: one pass per offset from the box's first cell (few: a box
+        # spans at most a few cells of its level per axis)
+        keys, facets = [], []
+        for offset in itertools.product(*(range(int(sk.max()) + 1) for sk in span)):
+            on = span[0] >= offset[0]
+            for k in range(1, g):
+                on &= span[k] >= offset[k]
+            i = np.flatnonzero(on)
+            key = a[0][i] + offset[0]
+            for k in range(1, g):
+                key = key * self.dims[k] + (a[k][i] + offset[k])
+            keys.append(key)
+            facets.append(f[i])
+        key = np.concatenate(keys)
+        order = np.argsort(key)
+        key = key[order]
+        self.facets = np.concatenate(facets)[order]
+        ncells = int(np.prod(self.dims, dtype=np.float64))
+        self.dense = ncells <= max(4 * key.size, 1 << 12)
+        if self.dense:  # start of the list of each cell, by cell number
+            self.start = np.zeros(ncells + 1, dtype=np.int64)
+            np.cumsum(np.bincount(key, minlength=ncells), out=self.start[1:])
+        else:  # the occupied cells' numbers and the starts of their lists
+            head = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+            self.cells = key[head]
+            self.start = np.r_[head, key.size]
+
+    def pairs(self, x: FloatArray) -> tuple[IntArray, IntArray]:
+        """The (point, facet) pairs of the facets listed in the cell of each point."""
+        g = x.shape[1]
+        key = np.zeros(x.shape[0], dtype=np.int64)
+        inside = np.ones(x.shape[0], dtype=bool)
+        scale = 1.0 / self.size
+        for k in range(g):
+            c = np.floor(x[:, k] * scale) - self.base[k]
+            inside &= (c >= 0) & (c < self.dims[k])
+            key = key * int(self.dims[k]) + np.where(inside, c, 0).astype(np.int64)
+        pid = np.flatnonzero(inside)
+        key = key[pid]
+        if self.dense:
+            first, last = self.start[key], self.start[key + 1]
+        else:
+            i = np.searchsorted(self.cells, key)
+            hit = self.cells[np.minimum(i, self.cells.size - 1)] == key
+            pid, i = pid[hit], i[hit]
+            first, last = self.start[i], self.start[i + 1]
+        count = last - first
+        total = int(count.sum())
+        shift = np.repeat(first - (np.cumsum(count) - count), count)
+        return np.repeat(pid, count), self.facets[np.arange(total) + shift]
+
+
+def _grid_block(
+    master: _Master,
+    grid: _Grid,
+    margin: float,
+    x: FloatArray,
+    radius: float,
+    out: Projection,
+    admit: Admit | None = None,
+) -> IntArray:
+    """Fill ``out`` for the points of the block ``x`` whose closest point the grid decides,
+    and return the indices of the others (left to the KD-tree search).
+
+    The facets listed in a point's cells hold every facet point within ``margin`` of it (the
+    grid's margin less the node movement since it was built). A point is decided when
+    ``reach = min(d1, radius) <= margin`` (with ``d1``
+    the exact distance to the admissible listed facet of smallest distance lower bound), or
+    when no admissible listed facet is within ``radius <= margin``; its pairs are then pruned and
+    projected as in the KD-tree search (same bounds, same selection: the same closest point).
+    """
+    npts = x.shape[0]
+    pid, fid = grid.pairs(x)
+    limit = min(radius, margin)
+    lower = master.lower_bound(x, fid, pid)
+    near = lower - 1e-9 * master.size[fid] <= limit * (1 + 1e-9)
+    if admit is not None:
+        near[near] = admit(pid[near], fid[near])
+    pid, fid, lower = pid[near], fid[near], lower[near]
+    decided = np.zeros(npts, dtype=bool)
+    if pid.size == 0:
+        decided[:] = radius <= margin
+        return np.flatnonzero(~decided)
+    # the pair of smallest lower bound of each point (pairs grouped by point)
+    head = np.flatnonzero(np.r_[True, pid[1:] != pid[:-1]])
+    least = np.minimum.reduceat(lower, head)
+    count = np.diff(np.r_[head, pid.size])
+    hits = np.flatnonzero(lower == np.repeat(least, count))
+    hits = hits[np.r_[True, pid[hits[1:]] != pid[hits[:-1]]]]
+    active, nearest = pid[hits], fid[hits]
+    first = master.project(x[active], nearest, np.arange(active.size), active.size)
+    reach = np.full(npts, radius)
+    reach[active] = np.minimum(first.dist, radius)
+    # decided: all facets of the tie-break (within 1e-10 (d + 2 R) of d <= reach) listed
+    decided[:] = radius <= margin
+    decided[active] = reach[active] * (1 + 1e-8) + 1e-8 * master.R_max <= margin
+    keep = decided[pid] & (lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9))
+    keep[hits] = False  # projected already
+    take = decided[active]
+    active, nearest = active[take], nearest[take]
+    first = _Pairs(first.xi[take], first.dist[take], first.edge[take], first.vertex[take])
+    pid, fid = pid[keep], fid[keep]
+    pairs = _concatenate(master.project(x[pid], fid, pid, npts), first)
+    pid, fid = np.concatenate([pid, active]), np.concatenate([fid, nearest])
+    if pid.size:
+        _select(master, x, radius, out, pid, fid, pairs)
+    return np.flatnonzero(~decided)
+
+
 def _candidates(
     master: _Master, x: FloatArray, bound: FloatArray, active: IntArray
 ) -> tuple[IntArray, IntArray]:
@@ -652,38 +873,45 @@ def _sliding(
     xi: FloatArray,
     a: FloatArray,
     r: FloatArray,
-    d2N: FloatArray,
     f: IntArray,
     edge: IntArray,
     vertex: npt.NDArray[np.bool_],
 ) -> FloatArray:
     """Linearisation matrix ``M`` of the closest points (see the module docstring)."""
     P, fdim = xi.shape
-    # A_ab = a_a . a_b - (x - y) . d(a_a)/d(xi^b),  d(a_a)/d(xi^b) = sum_n d2N_n x_n
-    curv = np.einsum("pnab,png->pabg", d2N, master.nodes[f])
-    A = np.einsum("pag,pbg->pab", a, a) - np.einsum("pg,pabg->pab", r, curv)
+    g = master.gdim
+    # A_ab = a_a . a_b - (x - y) . d(a_a)/d(xi^b),  d(a_a)/d(xi^b) = sum_n d2N_n x_n: zero
+    # but for the bilinear quadrilateral, whose only second derivative is d2y/ds dt = c3
+    col = [[a[:, i, k] for k in range(g)] for i in range(fdim)]
     M = np.zeros((P, fdim, fdim))
     if fdim == 1:
-        interior = ~vertex
-        A11 = A[:, 0, 0]
-        ok = interior & (A11 != 0)
-        M[ok, 0, 0] = 1.0 / A11[ok]
+        A11 = sum(c * c for c in col[0])
+        ok = ~vertex & (A11 != 0)
+        M[:, 0, 0] = np.where(ok, 1.0 / np.where(ok, A11, 1.0), 0.0)
         return M
+    A00 = sum(c * c for c in col[0])
+    A11 = sum(c * c for c in col[1])
+    A01 = sum(c0 * c1 for c0, c1 in zip(col[0], col[1], strict=True))
+    if master.kind == "quadrilateral":
+        c3 = master.bilinear[3]
+        A01 = A01 - sum(r[:, k] * c3[k][f] for k in range(g))
     interior = (edge < 0) & ~vertex
-    det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+    det = A00 * A11 - A01 * A01
     ok = interior & (det != 0)
-    inv = 1.0 / det[ok]
-    M[ok, 0, 0] = A[ok, 1, 1] * inv
-    M[ok, 1, 1] = A[ok, 0, 0] * inv
-    M[ok, 0, 1] = -A[ok, 0, 1] * inv
-    M[ok, 1, 0] = -A[ok, 1, 0] * inv
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    M[:, 0, 0] = A11 * inv
+    M[:, 1, 1] = A00 * inv
+    M[:, 0, 1] = M[:, 1, 0] = -A01 * inv
     on_edge = (edge >= 0) & ~vertex
     if on_edge.any():
         tangents = np.array([np.subtract(e, s) for _, _, s, e in _EDGES[master.kind]])
-        t = tangents[edge[on_edge]]
-        tAt = np.einsum("pa,pab,pb->p", t, A[on_edge], t)
+        i = np.flatnonzero(on_edge)
+        t0, t1 = tangents[edge[i], 0], tangents[edge[i], 1]
+        tAt = t0 * (A00[i] * t0 + A01[i] * t1) + t1 * (A01[i] * t0 + A11[i] * t1)
         tAt = np.where(tAt != 0, tAt, np.inf)
-        M[on_edge] = t[:, :, None] * t[:, None, :] / tAt[:, None, None]
+        M[i, 0, 0] = t0 * t0 / tAt
+        M[i, 0, 1] = M[i, 1, 0] = t0 * t1 / tAt
+        M[i, 1, 1] = t1 * t1 / tAt
     return M
 
 
@@ -782,28 +1010,44 @@ def _closest_block(
     pid, fid = pid[keep], fid[keep]
     pairs = _concatenate(master.project(x[pid], fid, pid, npts), first)
     pid, fid = np.concatenate([pid, active]), np.concatenate([fid, nearest])
+    _select(master, x, radius, out, pid, fid, pairs)
 
+
+def _select(
+    master: _Master,
+    x: FloatArray,
+    radius: float,
+    out: Projection,
+    pid: IntArray,
+    fid: IntArray,
+    pairs: _Pairs,
+) -> None:
+    """Fill ``out`` with the closest point of each point ``x[pid]`` among its projected pairs
+    ``(pid, fid)`` (their projections ``pairs``), with the tie-break of :func:`closest_points`;
+    the points farther than ``radius`` from all their pairs are left unpaired."""
+    npts = x.shape[0]
     # minimum per point; ties (shared edges and vertices) go to the best-aligned normal
     dmin = np.full(npts, np.inf)
     np.minimum.at(dmin, pid, pairs.dist)
     tie = pairs.dist <= dmin[pid] + _TIE * (dmin[pid] + 2.0 * master.size[fid])
     e = np.flatnonzero(tie)
-    pe, fe, xi = pid[e], fid[e], pairs.xi[e]
-    N, dN, d2N = shape_functions(master.nn, master.gdim, xi)
+    pe = pid[e]
+    # a point with one pair within the tie tolerance takes it; the others break the tie
+    several = np.bincount(pe, minlength=npts)[pe] > 1
+    k = np.flatnonzero(~several)
+    if several.any():
+        tied = np.flatnonzero(several)
+        k = np.concatenate([k, tied[_tie_break(master, x, e[tied], pe[tied], fid, pairs)]])
+    e, pe = e[k], pe[k]
+    fe, xi = fid[e], pairs.xi[e]
+    N, dN, _ = shape_functions(master.nn, master.gdim, xi)
     X = master.nodes[fe]
     y = np.einsum("pn,png->pg", N, X)
     r = x[pe] - y
-    a = np.einsum("pna,png->pag", dN, X)
+    a = _tangents(dN, X)
     nu = _unit_normal(a)
     dist = np.linalg.norm(r, axis=1)
-    align = np.divide(np.abs(_dot(nu, r)), dist, out=np.zeros_like(dist), where=dist > 0)
-    # equal alignments: the nearer centroid, then the lower facet index
-    c = x[pe] - master.centroid[fe]
-    order = np.lexsort((fe, _dot(c, c), -align, pe))
-    head = np.ones(order.size, dtype=bool)
-    head[1:] = pe[order[1:]] != pe[order[:-1]]
-    k = order[head]
-    k = k[dist[k] <= radius]
+    k = np.flatnonzero(dist <= radius)
     p, f = pe[k], fe[k]
     out.facet[p] = f
     out.xi[p] = xi[k]
@@ -812,9 +1056,32 @@ def _closest_block(
     out.gap[p] = -_dot(nu[k], r[k])
     out.distance[p] = dist[k]
     best = e[k]
-    out.sliding[p] = _sliding(
-        master, xi[k], a[k], r[k], d2N[k], f, pairs.edge[best], pairs.vertex[best]
-    )
+    out.sliding[p] = _sliding(master, xi[k], a[k], r[k], f, pairs.edge[best], pairs.vertex[best])
+
+
+def _tie_break(
+    master: _Master,
+    x: FloatArray,
+    e: IntArray,
+    pe: IntArray,
+    fid: IntArray,
+    pairs: _Pairs,
+) -> IntArray:
+    """Positions in ``e`` of the winners among the tied pairs ``e`` (of the points ``pe``,
+    several per point): the normal most aligned with ``x - y``, then the nearer centroid,
+    then the lower facet index."""
+    fe, xi = fid[e], pairs.xi[e]
+    N, dN, _ = shape_functions(master.nn, master.gdim, xi)
+    X = master.nodes[fe]
+    r = x[pe] - np.einsum("pn,png->pg", N, X)
+    nu = _unit_normal(_tangents(dN, X))
+    dist = np.linalg.norm(r, axis=1)
+    align = np.divide(np.abs(_dot(nu, r)), dist, out=np.zeros_like(dist), where=dist > 0)
+    c = x[pe] - master.centroid[fe]
+    order = np.lexsort((fe, _dot(c, c), -align, pe))
+    head = np.ones(order.size, dtype=bool)
+    head[1:] = pe[order[1:]] != pe[order[:-1]]
+    return order[head]
 
 
 def _check_self_contact(self_contact: SelfContact, npts: int, nf: int, gdim: int) -> None:
@@ -838,6 +1105,28 @@ def _admission(self_contact: SelfContact, master: _Master, index: IntArray) -> A
         return self_contact.admissible(index[pid], fid, master.axis[fid])
 
     return admit
+
+
+def _grid(nodes: FloatArray, radius: float) -> _Grid | None:
+    """The cell grid of the facets ``nodes`` for a search of ``radius``.
+
+    With ``e`` the 90th percentile of the facets' bounding-box widths: cells ``e`` wide (the
+    first level), margin ``min(radius, 0.5 e) + 0.25 e`` (the last term allows the nodes to
+    move by ``0.25 e`` before the grid is rebuilt). ``None`` for a master of zero extent or
+    with more than ``2^62`` cells in a level (the search then uses the KD-tree alone).
+    """
+    g = nodes.shape[2]
+    columns = [[nodes[:, a, k] for a in range(nodes.shape[1])] for k in range(g)]
+    lo = np.stack([np.minimum.reduce(c) for c in columns], axis=1)
+    hi = np.stack([np.maximum.reduce(c) for c in columns], axis=1)
+    width = np.max(hi - lo, axis=1)
+    typical = _GRID_WIDTH * float(np.median(width))
+    span = float(np.max(hi.max(axis=0) - lo.min(axis=0)))
+    if not (typical > 0.0 and np.isfinite(span)) or (span / typical + 4) ** g > 2.0**62:
+        return None
+    allowance = _GRID_MOVE * typical
+    margin = min(radius, _GRID_MARGIN * typical) + allowance
+    return _Grid(lo, hi, margin, typical, _GRID_CELL, allowance, _GRID_MARGIN * typical)
 
 
 def _spatial_order(points: FloatArray) -> IntArray:
@@ -951,7 +1240,9 @@ def closest_points(
         return out
     if self_contact is not None:
         _check_self_contact(self_contact, npts, nf, gdim)
+    trees = trees if trees is not None else TreeCache()
     master = _Master(nodes, trees)
+    grid, margin = trees.grid(nodes, radius)
     # on a large master the points in the order of a grid of cells (neighbours searched
     # together: the KD-tree and the gathers of facet data stay in cache), results scattered
     order = _spatial_order(points) if nf > _SORT else None
@@ -964,7 +1255,16 @@ def closest_points(
         if self_contact is not None:
             index = (np.arange(npts) if order is None else order)[block]
             admit = _admission(self_contact, master, index)
-        _closest_block(master, x[block], radius, view, admit)
+        rest = np.arange(block.stop - block.start)
+        if grid is not None:
+            rest = _grid_block(master, grid, margin, x[block], radius, view, admit)
+        if rest.size:
+            if self_contact is not None:
+                admit = _admission(self_contact, master, index[rest])
+            part = Projection(*(getattr(view, k)[rest] for k in _FIELDS))
+            _closest_block(master, x[block][rest], radius, part, admit)
+            for k in _FIELDS:
+                getattr(view, k)[rest] = getattr(part, k)
     if order is not None:
         for k in _FIELDS:
             getattr(out, k)[order] = getattr(work, k)
