@@ -85,6 +85,8 @@ _EDGES = {
 _K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
 _MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
+_LEVEL_RADIUS = 2.0  # facets of radius up to this times the median share the first KD-tree
+_LEVEL_RATIO = 4.0  # ratio of the largest facet radii of successive KD-tree levels
 _BLOCK = 1 << 12  # points processed at once (keeps the arrays of the candidate pairs in cache)
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
@@ -292,14 +294,70 @@ class _Pairs:
     vertex: npt.NDArray[np.bool_]  # (P,) closest point at a vertex
 
 
+@dataclass
+class _TreeLevel:
+    """The facets of one size class of a master surface and the KD-tree of their centroids.
+
+    Attributes
+    ----------
+    facets : ndarray of int64 or None
+        Indices of the facets of the level (``None``: all the facets, in order).
+    n : int
+        Number of facets of the level.
+    R : float
+        Largest facet radius ``R_f`` of the level.
+    tree : cKDTree
+        KD-tree of the level's centroids (indices local to the level).
+    slack : float
+        Largest node movement since the tree was built.
+    """
+
+    facets: IntArray | None
+    n: int
+    R: float
+    tree: cKDTree
+    slack: float
+
+    def facet(self, local: IntArray) -> IntArray:
+        """Master facet indices of the level's facets ``local``."""
+        return local if self.facets is None else self.facets[local]
+
+
+def _tree_levels(
+    nodes: FloatArray, centroid: FloatArray, size: FloatArray, trees: TreeCache
+) -> list[_TreeLevel]:
+    """The facets by size class, each with a KD-tree of its centroids: level ``l`` holds the
+    facets of radius ``R_f`` in ``(R0 4^(l-1), R0 4^l]`` (level 0: ``R_f <= R0``), ``R0 =
+    2 median(R_f)``. The candidates of a point are the centroids within ``r + R`` of it, with
+    ``R`` the largest radius *of the level*: a few large facets do not widen the queries among
+    the many small ones. A master of even facet size has one level (all its facets)."""
+    if len(nodes) == 0:
+        return []
+    level = np.zeros(len(nodes), dtype=np.int64)
+    base = _LEVEL_RADIUS * float(np.median(size))
+    large = size > base
+    if base > 0.0 and large.any():
+        level[large] = np.ceil(np.log(size[large] / base) / np.log(_LEVEL_RATIO))
+    kinds = np.unique(level)
+    levels = []
+    for k in kinds:
+        f = None if kinds.size == 1 else np.flatnonzero(level == k)
+        sub = (lambda a: a) if f is None else (lambda a, f=f: a[f])
+        R = float(sub(size).max())
+        tree, slack = trees.tree(sub(nodes), sub(centroid), R, int(k))
+        levels.append(_TreeLevel(f, len(sub(size)), R, tree, slack))
+    return levels
+
+
 class _Master:
     """Master facets with the per-facet data of the search and the projections.
 
-    The KD-tree of the centroids is taken from ``trees`` (a :class:`TreeCache`, if given)
-    when a master surface of the same shape was searched before and no node has moved more
-    than ``_MOVE R_max`` since that tree was built: ``slack`` is then that movement, a bound
-    of how far every centroid is from the one the tree holds, and the search widens its
-    bounds by it.
+    The facets are sorted by their radius ``R_f`` into levels (:func:`_tree_levels`), each
+    with a KD-tree of its centroids, taken from ``trees`` (a :class:`TreeCache`, if given)
+    when a master surface of the same shape was searched before and no node of the level has
+    moved more than ``_MOVE R`` (``R`` the largest radius of the level) since that tree was
+    built: the level's ``slack`` is then that movement, a bound of how far every centroid is
+    from the one the tree holds, and the search widens its bounds by it.
     """
 
     def __init__(self, nodes: FloatArray, trees: TreeCache | None = None) -> None:
@@ -327,7 +385,7 @@ class _Master:
         self.size = np.sqrt(radius2)
         self.R_max = float(self.size.max()) if self.nf else 0.0
         trees = trees if trees is not None else TreeCache()
-        self.tree, self.slack = trees.tree(nodes, self.centroid, self.R_max)
+        self.levels = _tree_levels(nodes, self.centroid, self.size, trees)
         # slab of the facet: unit normal at the centre, largest node offset along it
         n = _normalise(self._centre_normal(X))
         self.axis = np.stack(n, axis=1)
@@ -645,7 +703,7 @@ class TreeCache:
         return grid, (grid.margin if grid is not None else 0.0)
 
     def tree(
-        self, nodes: FloatArray, centroid: FloatArray, R_max: float
+        self, nodes: FloatArray, centroid: FloatArray, R_max: float, level: int = 0
     ) -> tuple[cKDTree | None, float]:
         """A KD-tree of centroids within ``slack`` of ``centroid``, and that slack.
 
@@ -654,7 +712,7 @@ class TreeCache:
         """
         if len(nodes) == 0:
             return None, 0.0
-        key = nodes.shape
+        key = (*nodes.shape, level)
         entry = self.entries.get(key)
         if entry is not None:
             built, tree = entry
@@ -851,21 +909,19 @@ def _grid_block(
 
 
 def _candidates(
-    master: _Master, x: FloatArray, bound: FloatArray, active: IntArray
+    level: _TreeLevel, x: FloatArray, bound: FloatArray, active: IntArray
 ) -> tuple[IntArray, IntArray]:
-    """All (point, facet) pairs with the facet's centroid within ``bound`` of the point.
+    """All (point, facet) pairs with a centroid of the ``level`` within ``bound`` of the point.
 
     One ball query of the KD-tree per point, with the point's own bound (widened by the
     slack of a reused tree): no repeated K-nearest queries.
     """
     if active.size == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    lists = master.tree.query_ball_point(
-        x[active], bound[active] + master.slack, return_sorted=False
-    )
+    lists = level.tree.query_ball_point(x[active], bound[active] + level.slack, return_sorted=False)
     count = np.fromiter(map(len, lists), dtype=np.int64, count=len(lists))
     fid = np.fromiter(itertools.chain.from_iterable(lists), dtype=np.int64, count=count.sum())
-    return np.repeat(active, count), fid
+    return np.repeat(active, count), level.facet(fid)
 
 
 def _sliding(
@@ -926,7 +982,7 @@ def _concatenate(a: _Pairs, b: _Pairs) -> _Pairs:
 
 
 def _nearest_admissible(
-    master: _Master,
+    level: _TreeLevel,
     x: FloatArray,
     active: IntArray,
     d: FloatArray,
@@ -934,9 +990,10 @@ def _nearest_admissible(
     reach0: float,
     admit: Admit,
 ) -> tuple[IntArray, BoolArray]:
-    """The admissible facet of the nearest centroid of each point ``x[active]``, and
-    whether there is one within ``reach0`` (the K nearest ``d, near`` first, then queries
-    of twice as many neighbours for the points that have none among them)."""
+    """The admissible facet of the nearest centroid of the ``level`` of each point
+    ``x[active]``, and whether there is one within ``reach0`` (the K nearest ``d, near``
+    first, then queries of twice as many neighbours for the points that have none among
+    them)."""
     nearest = np.zeros(active.size, dtype=np.int64)
     found = np.zeros(active.size, dtype=bool)
     rows = np.arange(active.size)
@@ -949,17 +1006,50 @@ def _nearest_admissible(
         valid = d <= reach0
         r, c = np.nonzero(valid)
         ok = np.zeros(d.shape, dtype=bool)
-        ok[r, c] = admit(active[rows[r]], near[r, c])
+        ok[r, c] = admit(active[rows[r]], level.facet(near[r, c]))
         has = ok.any(axis=1)
-        nearest[rows[has]] = near[has, ok[has].argmax(axis=1)]
+        nearest[rows[has]] = level.facet(near[has, ok[has].argmax(axis=1)])
         found[rows[has]] = True
         # the points with no admissible facet among k neighbours all within reach0
         more = ~has & valid[:, -1]
-        if k >= master.nf or not more.any():
+        if k >= level.n or not more.any():
             return nearest, found
-        rows, start, k = rows[more], k, min(2 * k, master.nf)
-        d, near = master.tree.query(x[active[rows]], k=k, distance_upper_bound=reach0)
+        rows, start, k = rows[more], k, min(2 * k, level.n)
+        d, near = level.tree.query(x[active[rows]], k=k, distance_upper_bound=reach0)
         d, near = d.reshape(rows.size, k), near.reshape(rows.size, k)
+
+
+def _nearest(
+    master: _Master,
+    x: FloatArray,
+    queries: list[tuple[FloatArray, IntArray, float]],
+    admit: Admit | None,
+) -> tuple[IntArray, IntArray]:
+    """The points with a (admissible) centroid within the first bound of some level, and
+    the facet of the nearest such centroid (over the levels) of each.
+
+    ``queries``: per level of ``master.levels``, the distances and indices of the K nearest
+    centroids of each point and the bound of that query."""
+    npts = x.shape[0]
+    best = np.full(npts, np.inf)
+    nearest = np.full(npts, -1, dtype=np.int64)
+    for level, (d, near, reach0) in zip(master.levels, queries, strict=True):
+        rows = np.flatnonzero(d[:, 0] <= reach0)
+        if rows.size == 0:
+            continue
+        if admit is None:
+            facet = level.facet(near[rows, 0].astype(np.int64))
+            dist = d[rows, 0]
+        else:
+            # the bound d1 must come from an admissible facet (a point's own facet is at 0)
+            facet, found = _nearest_admissible(level, x, rows, d[rows], near[rows], reach0, admit)
+            rows, facet = rows[found], facet[found]
+            dist = np.linalg.norm(x[rows] - master.centroid[facet], axis=1)
+        closer = dist < best[rows]
+        best[rows[closer]] = dist[closer]
+        nearest[rows[closer]] = facet[closer]
+    active = np.flatnonzero(nearest >= 0)
+    return active, nearest[active]
 
 
 def _closest_block(
@@ -968,37 +1058,33 @@ def _closest_block(
     """Fill ``out`` (arrays of this block of points) with the closest points of ``x``, over
     the pairs that ``admit`` (block point indices, facets) accepts if it is given."""
     npts = x.shape[0]
-    # the K nearest centroids, where they can hold a facet point within the radius
-    reach0 = (radius + master.R_max + 2.0 * master.slack) * (1 + 1e-12)
-    K = min(_K[master.gdim], master.nf)
-    d, near = master.tree.query(x, k=K, distance_upper_bound=reach0)
-    d, near = d.reshape(npts, K), near.reshape(npts, K)
-    active = np.flatnonzero(d[:, 0] <= reach0)
+    # per level, the K nearest centroids, where they can hold a facet point within the radius
+    queries = []
+    for level in master.levels:
+        reach0 = (radius + level.R + 2.0 * level.slack) * (1 + 1e-12)
+        K = min(_K[master.gdim], level.n)
+        d, near = level.tree.query(x, k=K, distance_upper_bound=reach0)
+        queries.append((d.reshape(npts, K), near.reshape(npts, K), reach0))
+    active, nearest = _nearest(master, x, queries, admit)
     if active.size == 0:
         return
-    d, near = d[active], near[active].astype(np.int64)
-    if admit is None:
-        nearest = near[:, 0]
-    else:
-        # the bound d1 must come from an admissible facet (a point's own facet is at 0)
-        nearest, found = _nearest_admissible(master, x, active, d, near, reach0, admit)
-        active, d, near, nearest = active[found], d[found], near[found], nearest[found]
-        if active.size == 0:
-            return
     # an upper bound of the distance: the exact distance to the facet of the nearest centroid
     first = master.project(x[active], nearest, np.arange(active.size), active.size)
     d1 = np.full(npts, np.inf)
     d1[active] = first.dist
     reach = np.minimum(d1, radius)
-    # candidates: the centroids within reach + R_max, from the K found (a ball query for the
-    # points whose K-th neighbour is within it: they may have more)
-    bound = (reach + master.R_max) * (1 + 1e-12)
-    within = d <= (bound[active] + master.slack)[:, None]
-    cut = within[:, -1] if K < master.nf else np.zeros(active.size, dtype=bool)
-    rows, cols = np.nonzero(within & ~cut[:, None])
-    pid_ball, fid_ball = _candidates(master, x, bound, active[cut])
-    pid = np.concatenate([active[rows], pid_ball])
-    fid = np.concatenate([near[rows, cols], fid_ball])
+    # candidates: per level, the centroids within reach + R, from the K found (a ball query
+    # for the points whose K-th neighbour is within it: they may have more)
+    pid, fid = [], []
+    for level, (d, near, _) in zip(master.levels, queries, strict=True):
+        bound = (reach + level.R) * (1 + 1e-12)
+        within = d[active] <= (bound[active] + level.slack)[:, None]
+        cut = within[:, -1] if d.shape[1] < level.n else np.zeros(active.size, dtype=bool)
+        rows, cols = np.nonzero(within & ~cut[:, None])
+        pid_ball, fid_ball = _candidates(level, x, bound, active[cut])
+        pid += [active[rows], pid_ball]
+        fid += [level.facet(near[active[rows], cols].astype(np.int64)), fid_ball]
+    pid, fid = np.concatenate(pid), np.concatenate(fid)
     lower = master.lower_bound(x, fid, pid)
     keep = lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9)
     if admit is not None:
