@@ -151,3 +151,67 @@ def test_points_searched_in_cell_order(make, nf, monkeypatch):
     order = projection._spatial_order(points)
     assert not np.array_equal(order, np.arange(len(points)))  # the order changes
     check(points, nodes, 0.3)
+
+
+@pytest.mark.parametrize(
+    ("make", "nf"),
+    [(segment_polyline, 50), (triangle_soup, 40), (warped_quads, 20), (wavy_quads, 36)],
+    ids=["segments", "triangles", "quadrilaterals", "quad-grid"],
+)
+@pytest.mark.parametrize("radius", [np.inf, 0.05, 0.3])
+def test_grid_search_against_every_facet(make, nf, radius, monkeypatch):
+    """A master searched again (its KD-trees kept) is searched through the cell grid first:
+    the same closest points, and the grid decides some of the points."""
+    rng = np.random.default_rng(nf + 5)
+    nodes = make(rng, nf)
+    points = near_and_far(rng, nodes, 30)
+    trees = TreeCache()
+    closest_points(points, nodes, radius, trees)
+    decided = []
+    grid_block = projection._grid_block
+
+    def counted(*args, **kwargs):
+        rest = grid_block(*args, **kwargs)
+        decided.append(len(args[3]) - len(rest))
+        return rest
+
+    monkeypatch.setattr(projection, "_grid_block", counted)
+    check(points, nodes, radius, trees)
+    assert sum(decided) > 0
+
+
+def test_graded_master_candidates(monkeypatch):
+    """Two large facets beside many small ones (a graded master) leave the number of
+    candidate pairs of the points near the small ones as it is without them: the large
+    facets have KD-trees (and grid levels) of their own instead of widening every query."""
+    x = np.linspace(0.0, 20.0, 5001)
+    v = np.stack([x, 0.01 * np.sin(x)], axis=1)
+    fine = np.stack([v[:-1], v[1:]], axis=1)
+    end = v[-1]
+    large = np.array([[end, end + [0.6, 0.0]], [end + [0.6, 0.0], end + [1.2, 0.0]]])
+    graded = np.concatenate([fine, large])
+    rng = np.random.default_rng(3)
+    u = rng.uniform(0.0, 19.0, 2000)
+    offset = rng.choice([-1.0, 1.0], 2000) * 0.004 * 10.0 ** rng.uniform(-2.0, 1.0, 2000)
+    points = np.stack([u, 0.01 * np.sin(u) + offset], axis=1)
+    pairs = []
+    lower_bound = projection._Master.lower_bound
+
+    def counted(self, x, f, pid=None):
+        pairs.append(len(f))
+        return lower_bound(self, x, f, pid)
+
+    monkeypatch.setattr(projection._Master, "lower_bound", counted)
+    for radius in (0.04, np.inf):
+        counts = []
+        for nodes in (fine, graded):
+            trees = TreeCache()
+            for _ in range(2):  # the KD-tree search, then the grid's
+                pairs.clear()
+                proj = closest_points(points, nodes, radius, trees)
+                counts.append(sum(pairs))
+            assert np.all(proj.facet < len(fine))
+        # at most the K = 2 nearest centroids of the large facets' level more per point
+        assert counts[2] <= counts[0] + 2 * len(points)
+        assert counts[3] <= counts[1] + 2 * len(points)
+        assert counts[0] < 20 * len(points)

@@ -90,6 +90,24 @@ def test_self_contact_matches_brute_force(slit):
     assert np.all(proj.gap < 0)
 
 
+@pytest.mark.parametrize("slit", [_slit_2d, _slit_3d])
+@pytest.mark.parametrize("radius", [np.inf, 0.11])
+def test_self_contact_through_the_grid(slit, radius):
+    """A self-contact surface searched again (through the cell grid first): the same
+    distances as facet by facet."""
+    nodes, facet_nodes = slit()
+    points, rule = _facet_points(nodes, facet_nodes)
+    trees = projection.TreeCache()
+    closest_points(points, nodes, radius, trees, rule)
+    proj = closest_points(points, nodes, radius, trees, rule)
+    (entry,) = trees.grids.values()
+    assert entry[2] is not None  # the grid was built and used
+    expected = _brute_force(points, nodes, rule)
+    paired = expected <= radius
+    np.testing.assert_array_equal(proj.facet >= 0, paired)
+    np.testing.assert_allclose(proj.distance[paired], expected[paired], rtol=1e-12, atol=1e-14)
+
+
 def test_self_contact_across_an_elliptic_slit():
     """The points of each arc find the other arc across the slit, symmetrically about y = 0."""
     nodes, facet_nodes = _slit_2d(n=80, b=0.05)

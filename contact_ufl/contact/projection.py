@@ -310,6 +310,8 @@ class _TreeLevel:
         KD-tree of the level's centroids (indices local to the level).
     slack : float
         Largest node movement since the tree was built.
+    reused : bool
+        Whether the tree is one of an earlier search.
     """
 
     facets: IntArray | None
@@ -317,6 +319,7 @@ class _TreeLevel:
     R: float
     tree: cKDTree
     slack: float
+    reused: bool
 
     def facet(self, local: IntArray) -> IntArray:
         """Master facet indices of the level's facets ``local``."""
@@ -344,8 +347,8 @@ def _tree_levels(
         f = None if kinds.size == 1 else np.flatnonzero(level == k)
         sub = (lambda a: a) if f is None else (lambda a, f=f: a[f])
         R = float(sub(size).max())
-        tree, slack = trees.tree(sub(nodes), sub(centroid), R, int(k))
-        levels.append(_TreeLevel(f, len(sub(size)), R, tree, slack))
+        tree, slack, reused = trees.tree(sub(nodes), sub(centroid), R, int(k))
+        levels.append(_TreeLevel(f, len(sub(size)), R, tree, slack, reused))
     return levels
 
 
@@ -678,9 +681,12 @@ class TreeCache:
             OrderedDict()
         )
 
-    def grid(self, nodes: FloatArray, radius: float) -> tuple[_Grid | None, float]:
+    def grid(
+        self, nodes: FloatArray, radius: float, build: bool = True
+    ) -> tuple[_Grid | None, float]:
         """A cell grid of the facets ``nodes`` for a search of ``radius`` and the margin it
-        ensures now: its margin less the largest node movement since it was built.
+        ensures now: its margin less the largest node movement since it was built. Without
+        ``build``, only a grid kept from an earlier search (else ``None``).
 
         The grid is built with the margin ``min(radius, 0.5 e) + 0.25 e`` (``e`` a typical
         facet width, see :func:`_grid`) and reused while no node has moved more than ``0.25
@@ -694,6 +700,8 @@ class TreeCache:
             if grid is not None and move <= grid.allowance and min(radius, grid.reach) == asked:
                 self.grids.move_to_end(key)
                 return grid, grid.margin - move
+        if not build:
+            return None, 0.0
         grid = _grid(nodes, radius)
         asked = min(radius, grid.reach) if grid is not None else radius
         self.grids[key] = (nodes.copy(), asked, grid)
@@ -704,14 +712,15 @@ class TreeCache:
 
     def tree(
         self, nodes: FloatArray, centroid: FloatArray, R_max: float, level: int = 0
-    ) -> tuple[cKDTree | None, float]:
-        """A KD-tree of centroids within ``slack`` of ``centroid``, and that slack.
+    ) -> tuple[cKDTree | None, float, bool]:
+        """A KD-tree of centroids within ``slack`` of ``centroid``, that slack, and whether
+        the tree is an earlier one (reused).
 
         The centroid is the mean of the nodes, so it moves at most as far as the farthest
         node: a tree of earlier centroids serves with ``slack`` the largest node movement.
         """
         if len(nodes) == 0:
-            return None, 0.0
+            return None, 0.0, False
         key = (*nodes.shape, level)
         entry = self.entries.get(key)
         if entry is not None:
@@ -720,13 +729,13 @@ class TreeCache:
             move = float(np.max(np.abs(nodes - built))) * np.sqrt(nodes.shape[2])
             if move <= _MOVE * R_max:
                 self.entries.move_to_end(key)
-                return tree, move
+                return tree, move, True
         tree = cKDTree(centroid)
         self.entries[key] = (nodes.copy(), tree)
         self.entries.move_to_end(key)
         while len(self.entries) > _TREES:
             self.entries.popitem(last=False)
-        return tree, 0.0
+        return tree, 0.0, False
 
 
 class _Grid:
@@ -774,6 +783,21 @@ class _Grid:
         ]
         self.entries = sum(lv.facets.size for lv in self.levels)
 
+    def far(self, x: FloatArray, radius: float) -> BoolArray:
+        """Mask of the points ``x`` farther than ``radius`` from every facet (a sufficient
+        test: ``False`` does not mean near).
+
+        A facet within ``radius`` of ``x`` is within ``radius`` of a cell that lists it. On
+        the grid of coarse cells ``2^j`` cells wide, at least ``radius`` wide (aligned with
+        the cells), the coarse cell of ``x`` is then a neighbour of, or, the coarse cell of
+        that cell: a point whose coarse cell is not among the occupied coarse cells and
+        their neighbours is farther than ``radius`` from every facet of the level.
+        """
+        far = np.ones(x.shape[0], dtype=bool)
+        for level in self.levels:
+            far[far] = ~level.occupied(x[far], radius)
+        return far
+
     def pairs(self, x: FloatArray) -> tuple[IntArray, IntArray]:
         """The (point, facet) pairs of the facets listed in the cells of the points ``x``,
         grouped by point (in increasing point order)."""
@@ -816,6 +840,7 @@ class _GridLevel:
         order = np.argsort(key)
         key = key[order]
         self.facets = np.concatenate(facets)[order]
+        self.coarse: dict[int, tuple[list[int], list[int], IntArray]] = {}
         ncells = int(np.prod(self.dims, dtype=np.float64))
         self.dense = ncells <= max(4 * key.size, 1 << 12)
         if self.dense:  # start of the list of each cell, by cell number
@@ -825,6 +850,44 @@ class _GridLevel:
             head = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
             self.cells = key[head]
             self.start = np.r_[head, key.size]
+
+    def _occupied_cells(self) -> list[IntArray]:
+        """Cell coordinates (absolute: ``floor(x / size)``) of the cells with a list."""
+        if self.dense:
+            key = np.flatnonzero(np.diff(self.start))
+        else:
+            key = self.cells
+        coords = []
+        for k in range(len(self.dims) - 1, -1, -1):
+            coords.append(key % self.dims[k] + self.base[k])
+            key = key // self.dims[k]
+        return coords[::-1]
+
+    def occupied(self, x: FloatArray, radius: float) -> BoolArray:
+        """Mask of the points ``x`` whose coarse cell (``2^j`` cells, at least ``radius``
+        wide) is occupied or next to an occupied one (see :meth:`_Grid.far`)."""
+        j = max(int(np.ceil(np.log2(radius / self.size))), 0) if radius > self.size else 0
+        if j not in self.coarse:
+            cells = [c >> j for c in self._occupied_cells()]
+            base = [int(c.min()) - 1 for c in cells]
+            dims = [int(c.max()) - b + 2 for c, b in zip(cells, base, strict=True)]
+            keys = []
+            for offset in itertools.product((-1, 0, 1), repeat=len(cells)):
+                key = np.zeros(cells[0].size, dtype=np.int64)
+                for c, b, n, o in zip(cells, base, dims, offset, strict=True):
+                    key = key * n + (c + o - b)
+                keys.append(key)
+            self.coarse[j] = (base, dims, np.unique(np.concatenate(keys)))
+        base, dims, keys = self.coarse[j]
+        key = np.zeros(x.shape[0], dtype=np.int64)
+        inside = np.ones(x.shape[0], dtype=bool)
+        scale = 1.0 / (self.size * 2.0**j)
+        for k in range(x.shape[1]):
+            c = np.floor(x[:, k] * scale) - base[k]
+            inside &= (c >= 0) & (c < dims[k])
+            key = key * dims[k] + np.where(inside, c, 0).astype(np.int64)
+        i = np.minimum(np.searchsorted(keys, key), keys.size - 1)
+        return inside & (keys[i] == key)
 
     def pairs(self, x: FloatArray) -> tuple[IntArray, IntArray]:
         """The (point, facet) pairs of the facets listed in the cell of each point."""
@@ -865,42 +928,51 @@ def _grid_block(
 
     The facets listed in a point's cells hold every facet point within ``margin`` of it (the
     grid's margin less the node movement since it was built). A point is decided when
-    ``reach = min(d1, radius) <= margin`` (with ``d1``
-    the exact distance to the admissible listed facet of smallest distance lower bound), or
+    ``reach = min(d1, radius) <= margin`` (with ``d1`` the exact distance to the admissible
+    listed facet of the nearest centroid), or
     when no admissible listed facet is within ``radius <= margin``; its pairs are then pruned and
     projected as in the KD-tree search (same bounds, same selection: the same closest point).
     """
-    npts = x.shape[0]
+    npts, g = x.shape
     pid, fid = grid.pairs(x)
-    limit = min(radius, margin)
-    lower = master.lower_bound(x, fid, pid)
-    near = lower - 1e-9 * master.size[fid] <= limit * (1 + 1e-9)
     if admit is not None:
-        near[near] = admit(pid[near], fid[near])
-    pid, fid, lower = pid[near], fid[near], lower[near]
-    decided = np.zeros(npts, dtype=bool)
+        ok = admit(pid, fid)
+        pid, fid = pid[ok], fid[ok]
+    # squared centroid distances; the pairs whose facet (within R_f of its centroid) can be
+    # within min(radius, margin) of the point (the others do not matter to a decided point)
+    dc = [x[:, k][pid] - master.slab[k][fid] for k in range(g)]
+    d2 = dc[0] * dc[0]
+    for k in range(1, g):
+        d2 += dc[k] * dc[k]
+    R = master.size[fid]
+    limit = min(radius, margin) * (1 + 1e-9)
+    near = d2 <= (limit + R * (1 + 1e-9)) ** 2
+    pid, fid, d2, R = pid[near], fid[near], d2[near], R[near]
+    decided = np.full(npts, radius <= margin)
     if pid.size == 0:
-        decided[:] = radius <= margin
         return np.flatnonzero(~decided)
-    # the pair of smallest lower bound of each point (pairs grouped by point)
+    # the pair of the nearest centroid of each point (pairs grouped by point)
     head = np.flatnonzero(np.r_[True, pid[1:] != pid[:-1]])
-    least = np.minimum.reduceat(lower, head)
+    least = np.minimum.reduceat(d2, head)
     count = np.diff(np.r_[head, pid.size])
-    hits = np.flatnonzero(lower == np.repeat(least, count))
+    hits = np.flatnonzero(d2 == np.repeat(least, count))
     hits = hits[np.r_[True, pid[hits[1:]] != pid[hits[:-1]]]]
     active, nearest = pid[hits], fid[hits]
     first = master.project(x[active], nearest, np.arange(active.size), active.size)
     reach = np.full(npts, radius)
     reach[active] = np.minimum(first.dist, radius)
     # decided: all facets of the tie-break (within 1e-10 (d + 2 R) of d <= reach) listed
-    decided[:] = radius <= margin
     decided[active] = reach[active] * (1 + 1e-8) + 1e-8 * master.R_max <= margin
-    keep = decided[pid] & (lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9))
+    # the pairs that the KD-tree search would keep and that can hold the closest point
+    keep = decided[pid] & (d2 <= ((reach[pid] + R) * (1 + 1e-9)) ** 2)
     keep[hits] = False  # projected already
+    pid, fid, R = pid[keep], fid[keep], R[keep]
+    lower = master.lower_bound(x, fid, pid)
+    keep = lower - 1e-9 * R <= reach[pid] * (1 + 1e-9)
+    pid, fid = pid[keep], fid[keep]
     take = decided[active]
     active, nearest = active[take], nearest[take]
     first = _Pairs(first.xi[take], first.dist[take], first.edge[take], first.vertex[take])
-    pid, fid = pid[keep], fid[keep]
     pairs = _concatenate(master.project(x[pid], fid, pid, npts), first)
     pid, fid = np.concatenate([pid, active]), np.concatenate([fid, nearest])
     if pid.size:
@@ -1328,7 +1400,9 @@ def closest_points(
         _check_self_contact(self_contact, npts, nf, gdim)
     trees = trees if trees is not None else TreeCache()
     master = _Master(nodes, trees)
-    grid, margin = trees.grid(nodes, radius)
+    # the grid is built for a master searched again (its KD-trees kept): built for one
+    # search alone it would cost more than it saves
+    grid, margin = trees.grid(nodes, radius, all(level.reused for level in master.levels))
     # on a large master the points in the order of a grid of cells (neighbours searched
     # together: the KD-tree and the gathers of facet data stay in cache), results scattered
     order = _spatial_order(points) if nf > _SORT else None
@@ -1344,6 +1418,8 @@ def closest_points(
         rest = np.arange(block.stop - block.start)
         if grid is not None:
             rest = _grid_block(master, grid, margin, x[block], radius, view, admit)
+            if rest.size and np.isfinite(radius):  # unpaired: no facet within the radius
+                rest = rest[~grid.far(x[block][rest], radius)]
         if rest.size:
             if self_contact is not None:
                 admit = _admission(self_contact, master, index[rest])
