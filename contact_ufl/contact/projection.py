@@ -1,10 +1,11 @@
 """Closest-point projection of many slave points onto a master surface made of facets.
 
-Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search), vectorised over
-points and facets: the only Python loops run over a fixed small number of items (nodes,
-edges and coordinates of a facet, Newton iterations, blocks of points). The hot kernels work
-on coordinate columns (one 1D gather per node coordinate) rather than on rows of 2 or 3
-numbers, which NumPy gathers and reduces slowly. Throughput: ``benchmarks/search.py``.
+Pure NumPy (plus :class:`scipy.spatial.cKDTree` and a cell grid for the candidate search),
+vectorised over points and facets: the only Python loops run over a fixed small number of
+items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points, levels).
+The hot kernels work on coordinate columns (one 1D gather per node coordinate) rather than on
+rows of 2 or 3 numbers, which NumPy gathers and reduces slowly. Throughput:
+``benchmarks/search.py``.
 
 Facet kinds and conventions
 ---------------------------
@@ -93,10 +94,15 @@ _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
 _CELLS = 64  # cells per dimension of the grid that orders the points
 _SORT = 1 << 14  # facets above which the points are ordered by cells
+# cell grid, in units of W = _GRID_WIDTH median facet box width (the widest facets of the
+# first level): cells _GRID_CELL W wide, boxes widened by min(radius, _GRID_MARGIN W) plus
+# the node movement allowed before the grid is rebuilt, _GRID_MOVE W
 _GRID_WIDTH = 1.5
-_GRID_CELL = 1.0
+_GRID_CELL = 2.0 / 3.0
 _GRID_MARGIN = 0.5
-_GRID_MOVE = 0.25
+_GRID_MOVE = 0.1
+_DIRECTIONS = {2: 8, 3: 32}  # normal bins of a self-contact search, by dimension
+_DIRECTIONS_MIN = 1 << 10  # facets above which a self-contact search goes by normal bins
 _FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
 
 #: An admissibility test of (point, facet) pairs: point and facet indices in, mask out.
@@ -294,6 +300,92 @@ class _Pairs:
     vertex: npt.NDArray[np.bool_]  # (P,) closest point at a vertex
 
 
+def _centre_normal(X: list[list[FloatArray]], nn: int, g: int) -> list[FloatArray]:
+    """Columns of the normal ``a1 x a2`` (2D: ``(a1[1], -a1[0])``) at the centre of each
+    facet of ``nn`` nodes in dimension ``g``, from the coordinate columns ``X[a][k]`` of its
+    nodes."""
+    _, dN, _ = shape_functions(nn, g, np.full((1, g - 1), 0.5))
+    a = [
+        [
+            sum(dN[0, n, alpha] * X[n][k] for n in range(nn) if dN[0, n, alpha] != 0)
+            for k in range(g)
+        ]
+        for alpha in range(g - 1)
+    ]
+    if g == 2:
+        return [a[0][1], -a[0][0]]
+    a1, a2 = a
+    return [
+        a1[1] * a2[2] - a1[2] * a2[1],
+        a1[2] * a2[0] - a1[0] * a2[2],
+        a1[0] * a2[1] - a1[1] * a2[0],
+    ]
+
+
+def _directions(gdim: int) -> FloatArray:
+    """Unit directions of the normal bins: 8 on the circle, 32 on the sphere (Fibonacci)."""
+    if gdim == 2:
+        t = np.arange(_DIRECTIONS[2]) * (2.0 * np.pi / _DIRECTIONS[2])
+        return np.stack([np.cos(t), np.sin(t)], axis=1)
+    n = _DIRECTIONS[3]
+    z = 1.0 - (2.0 * np.arange(n) + 1.0) / n
+    t = np.arange(n) * np.pi * (3.0 - np.sqrt(5.0))
+    r = np.sqrt(1.0 - z * z)
+    return np.stack([r * np.cos(t), r * np.sin(t), z], axis=1)
+
+
+def _bins(normals: FloatArray, directions: FloatArray) -> tuple[IntArray, FloatArray]:
+    """The bin (nearest direction) of each normal, and the largest angle between a bin's
+    direction and its normals (a zero normal counts as at a right angle)."""
+    length = np.linalg.norm(normals, axis=1, keepdims=True)
+    unit = np.divide(normals, length, out=np.zeros_like(normals), where=length > 0)
+    cos = unit @ directions.T
+    b = np.argmax(cos, axis=1)
+    angle = np.arccos(np.clip(cos[np.arange(len(b)), b], -1.0, 1.0))
+    spread = np.zeros(len(directions))
+    np.maximum.at(spread, b, angle)
+    return b, spread
+
+
+def _by_direction(
+    points: FloatArray,
+    nodes: FloatArray,
+    radius: float,
+    rule: SelfContact,
+    out: Projection,
+) -> None:
+    """Self-contact search by normal bins: the points of a bin are searched against the
+    facets of the bins that may face them only.
+
+    A pair is admissible only if ``n_f . n_p < 0``. The normals are sorted into bins by the
+    nearest of a few fixed directions; with ``theta`` a bin's largest angle between its
+    direction and its normals, every pair of a point bin ``A`` and a facet bin ``B`` has
+    ``n_f . n_p >= 0`` when ``angle(u_A, u_B) + theta_A + theta_B <= pi / 2``: the facets of
+    such bins are inadmissible for those points and skipped (the facets around a point on its
+    own side, which otherwise fill every query up to the partner across the gap). The
+    admissible pairs are all kept (facets in their given order): the same closest points.
+    """
+    g = points.shape[1]
+    X = [[np.ascontiguousarray(nodes[:, a, k]) for k in range(g)] for a in range(nodes.shape[1])]
+    axis = np.stack(_centre_normal(X, nodes.shape[1], g), axis=1)
+    u = _directions(g)
+    facet_bin, facet_spread = _bins(axis, u)
+    point_bin, point_spread = _bins(np.asarray(rule.point_normals, dtype=np.float64), u)
+    between = np.arccos(np.clip(u @ u.T, -1.0, 1.0))
+    for A in np.unique(point_bin):
+        p = np.flatnonzero(point_bin == A)
+        same_side = between[A] + point_spread[A] + facet_spread <= 0.5 * np.pi - 1e-6
+        f = np.flatnonzero(~same_side[facet_bin])
+        if f.size == 0:
+            continue
+        part = Projection(*(getattr(out, k)[p] for k in _FIELDS))
+        sub = SelfContact(rule.point_nodes[p], rule.facet_nodes[f], rule.point_normals[p])
+        _search(points[p], nodes[f], radius, TreeCache(), sub, part)
+        part.facet[part.facet >= 0] = f[part.facet[part.facet >= 0]]
+        for k in _FIELDS:
+            getattr(out, k)[p] = getattr(part, k)
+
+
 @dataclass
 class _TreeLevel:
     """The facets of one size class of a master surface and the KD-tree of their centroids.
@@ -390,7 +482,7 @@ class _Master:
         trees = trees if trees is not None else TreeCache()
         self.levels = _tree_levels(nodes, self.centroid, self.size, trees)
         # slab of the facet: unit normal at the centre, largest node offset along it
-        n = _normalise(self._centre_normal(X))
+        n = _normalise(_centre_normal(X, self.nn, g))
         self.axis = np.stack(n, axis=1)
         thickness = np.abs(sum(offsets[0][k] * n[k] for k in range(g)))
         for d in offsets[1:]:
@@ -416,27 +508,6 @@ class _Master:
                 [x2[k] - x0[k] for k in range(3)],
                 [x0[k] - x1[k] - x2[k] + x3[k] for k in range(3)],
             ]
-
-    def _centre_normal(self, X: list[list[FloatArray]]) -> list[FloatArray]:
-        """Columns of the normal ``a1 x a2`` (2D: ``(a1[1], -a1[0])``) at the centre of each
-        facet, from the coordinate columns ``X[a][k]`` of its nodes."""
-        g = self.gdim
-        _, dN, _ = shape_functions(self.nn, g, np.full((1, self.fdim), 0.5))
-        a = [
-            [
-                sum(dN[0, n, alpha] * X[n][k] for n in range(self.nn) if dN[0, n, alpha] != 0)
-                for k in range(g)
-            ]
-            for alpha in range(self.fdim)
-        ]
-        if g == 2:
-            return [a[0][1], -a[0][0]]
-        a1, a2 = a
-        return [
-            a1[1] * a2[2] - a1[2] * a2[1],
-            a1[2] * a2[0] - a1[0] * a2[2],
-            a1[0] * a2[1] - a1[1] * a2[0],
-        ]
 
     def lower_bound(self, x: FloatArray, f: IntArray, pid: IntArray | None = None) -> FloatArray:
         """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``
@@ -688,9 +759,9 @@ class TreeCache:
         ensures now: its margin less the largest node movement since it was built. Without
         ``build``, only a grid kept from an earlier search (else ``None``).
 
-        The grid is built with the margin ``min(radius, 0.5 e) + 0.25 e`` (``e`` a typical
-        facet width, see :func:`_grid`) and reused while no node has moved more than ``0.25
-        e``; ``None`` where no grid serves (degenerate or too fine a master).
+        The grid (see :func:`_grid`) is reused while no node has moved more than its
+        allowance and the radius asks for the same margin; ``None`` where no grid serves
+        (degenerate or too fine a master).
         """
         key = nodes.shape
         entry = self.grids.get(key)
@@ -1268,10 +1339,11 @@ def _admission(self_contact: SelfContact, master: _Master, index: IntArray) -> A
 def _grid(nodes: FloatArray, radius: float) -> _Grid | None:
     """The cell grid of the facets ``nodes`` for a search of ``radius``.
 
-    With ``e`` the 90th percentile of the facets' bounding-box widths: cells ``e`` wide (the
-    first level), margin ``min(radius, 0.5 e) + 0.25 e`` (the last term allows the nodes to
-    move by ``0.25 e`` before the grid is rebuilt). ``None`` for a master of zero extent or
-    with more than ``2^62`` cells in a level (the search then uses the KD-tree alone).
+    With ``w`` the median width of the facets' bounding boxes and ``W = 1.5 w``: first level
+    for the facets up to ``W`` wide, cells ``w`` wide, margin ``min(radius, 0.5 W) + 0.1 W``
+    (the last term allows the nodes to move by ``0.1 W`` before the grid is rebuilt).
+    ``None`` for a master of zero extent or with more than ``2^62`` cells in a level (the
+    search then uses the KD-trees alone).
     """
     g = nodes.shape[2]
     columns = [[nodes[:, a, k] for a in range(nodes.shape[1])] for k in range(g)]
@@ -1336,24 +1408,39 @@ def closest_points(
 
     Notes
     -----
-    Candidate search: a KD-tree of the facet centroids. The centroid of a facet lies on the
+    Candidate search: KD-trees of the facet centroids. The centroid of a facet lies on the
     facet and every facet point is within ``R_f`` (largest node distance from the centroid) of
-    it, ``R_max = max R_f``. With ``d1 <= d0`` the exact distance of ``x`` to the facet of its
-    nearest centroid (``d0`` away, a query bounded by ``radius + R_max``), the closest point
-    is within ``r = min(d1, radius)`` of ``x``, so its facet has its centroid within ``r +
-    R_max`` (one ball query per point, with the point's own ``r``: the work follows ``r``,
-    not the search radius). The facets whose distance lower bound (node sphere and slab along
-    the normal at the centre) exceeds ``r`` are dropped, the others projected exactly. Points
-    with ``d0 > radius + R_max`` get ``facet = -1`` at once. The KD-tree is reused from one
-    call to the next while the master nodes (same array shape) have moved less than ``0.25
-    R_max``, the bounds being widened by that movement. On a master of over ``2^14`` facets
-    the points are searched in the order of the cells of a ``64^gdim`` grid over them (the
-    results are returned in the order given): neighbouring points query the same branches of
-    the tree and gather the same facets' data while they are in cache.
+    it. The facets are sorted by ``R_f`` into levels (radius ratio 4 between levels, the first
+    up to twice the median ``R_f``; an even mesh has one level), each with its KD-tree and its
+    largest radius ``R``. With ``d1 <= d0`` the exact distance of ``x`` to the facet of its
+    nearest centroid (``d0`` away over the levels, queries bounded by ``radius + R``), the
+    closest point is within ``r = min(d1, radius)`` of ``x``, so its facet has its centroid
+    within ``r + R`` of it in its level (one ball query per point and level, with the point's
+    own ``r``: the work follows ``r``, not the search radius, and a few large facets do not
+    widen the queries among the small ones). The facets whose distance lower bound (node
+    sphere and slab along the normal at the centre) exceeds ``r`` are dropped, the others
+    projected exactly. Points with ``d0 > radius + R`` in every level get ``facet = -1`` at
+    once. The KD-trees are reused from one call to the next while the master nodes (same
+    array shape) have moved less than ``0.25 R``, the bounds being widened by that movement.
+    On a master of over ``2^14`` facets the points are searched in the order of the cells of
+    a ``64^gdim`` grid over them (the results are returned in the order given): neighbouring
+    points query the same branches of the tree and gather the same facets' data while they
+    are in cache.
+
+    Cell grid (a master searched again, its KD-trees reused): before the KD-trees, a uniform
+    grid of cells (:class:`_Grid`; cells as wide as the median facet box width ``w``, levels
+    for the facets over ``1.5 w`` wide, the boxes widened by ``min(radius, 0.75 w) + 0.15 w``)
+    lists the facets near each cell. The candidates of a point are the facets of its cell, pruned
+    by centroid sphere and slab bounds with ``d1`` the exact distance to the facet of the
+    nearest centroid among them; a point with ``min(d1, radius)`` within the grid's margin
+    (less the node movement since the grid was built) is decided there, with the same
+    bounds, projections and selection as above (the same closest point). Points beyond a
+    finite radius from every occupied cell are unpaired at once; the others are left to the
+    KD-trees. The grid is reused while no node has moved more than ``0.15 w``.
 
     The work of a point grows with its distance ``D`` from the master surface, not with the
     search radius: its candidates are the facets with a centroid within ``min(D, radius) +
-    R_max`` (about ``D R_max / h^2`` of them on a surface of facet size ``h``).
+    R`` (about ``D R / h^2`` of them on a surface of facet size ``h``).
 
     When several facets are at the same distance up to ``1e-10 (distance + facet size)``
     (the point projects onto a shared edge or vertex), the facet whose normal is the most
@@ -1398,7 +1485,23 @@ def closest_points(
         return out
     if self_contact is not None:
         _check_self_contact(self_contact, npts, nf, gdim)
-    trees = trees if trees is not None else TreeCache()
+        if nf > _DIRECTIONS_MIN:
+            _by_direction(points, nodes, radius, self_contact, out)
+            return out
+    _search(points, nodes, radius, trees if trees is not None else TreeCache(), self_contact, out)
+    return out
+
+
+def _search(
+    points: FloatArray,
+    nodes: FloatArray,
+    radius: float,
+    trees: TreeCache,
+    self_contact: SelfContact | None,
+    out: Projection,
+) -> None:
+    """Fill ``out`` with the closest points of :func:`closest_points` (checked input)."""
+    npts, nf = points.shape[0], nodes.shape[0]
     master = _Master(nodes, trees)
     # the grid is built for a master searched again (its KD-trees kept): built for one
     # search alone it would cost more than it saves
@@ -1430,4 +1533,3 @@ def closest_points(
     if order is not None:
         for k in _FIELDS:
             getattr(out, k)[order] = getattr(work, k)
-    return out
