@@ -387,7 +387,10 @@ def main() -> None:
     parser.add_argument(
         "--largest", type=float, default=1e6, help="largest number of facets (full run)"
     )
+    parser.add_argument("--grid", action="store_true", help="with the cell grid")
     args = parser.parse_args()
+    if hasattr(projection, "_GRID"):
+        projection._GRID = args.grid
     sizes = [1_000, 10_000] if args.quick else [1_000, 10_000, 100_000]
     if not args.quick and args.largest > 100_000:
         sizes.append(int(args.largest))
@@ -400,7 +403,7 @@ def main() -> None:
         100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
     )
     with open(args.json, "w") as f:
-        json.dump({"quick": args.quick, "records": records}, f, indent=1)
+        json.dump({"quick": args.quick, "grid": args.grid, "records": records}, f, indent=1)
 
 
 if __name__ == "__main__":

@@ -162,6 +162,7 @@ def test_points_searched_in_cell_order(make, nf, monkeypatch):
 def test_grid_search_against_every_facet(make, nf, radius, monkeypatch):
     """A master searched again (its KD-trees kept) is searched through the cell grid first:
     the same closest points, and the grid decides some of the points."""
+    monkeypatch.setattr(projection, "_GRID", True)
     rng = np.random.default_rng(nf + 5)
     nodes = make(rng, nf)
     points = near_and_far(rng, nodes, 30)
@@ -202,6 +203,7 @@ def test_graded_master_candidates(monkeypatch):
         return lower_bound(self, x, f, pid)
 
     monkeypatch.setattr(projection._Master, "lower_bound", counted)
+    monkeypatch.setattr(projection, "_GRID", True)
     for radius in (0.04, np.inf):
         counts = []
         for nodes in (fine, graded):

@@ -92,9 +92,10 @@ def test_self_contact_matches_brute_force(slit):
 
 @pytest.mark.parametrize("slit", [_slit_2d, _slit_3d])
 @pytest.mark.parametrize("radius", [np.inf, 0.11])
-def test_self_contact_through_the_grid(slit, radius):
+def test_self_contact_through_the_grid(slit, radius, monkeypatch):
     """A self-contact surface searched again (through the cell grid first): the same
     distances as facet by facet."""
+    monkeypatch.setattr(projection, "_GRID", True)
     nodes, facet_nodes = slit()
     points, rule = _facet_points(nodes, facet_nodes)
     trees = projection.TreeCache()

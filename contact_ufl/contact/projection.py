@@ -97,6 +97,7 @@ _SORT = 1 << 14  # facets above which the points are ordered by cells
 # cell grid, in units of W = _GRID_WIDTH median facet box width (the widest facets of the
 # first level): cells _GRID_CELL W wide, boxes widened by min(radius, _GRID_MARGIN W) plus
 # the node movement allowed before the grid is rebuilt, _GRID_MOVE W
+_GRID = False  # the cell grid: same results, but its build costs more than it saves
 _GRID_WIDTH = 1.5
 _GRID_CELL = 2.0 / 3.0
 _GRID_MARGIN = 0.5
@@ -1352,7 +1353,10 @@ def _grid(nodes: FloatArray, radius: float) -> _Grid | None:
     width = np.max(hi - lo, axis=1)
     typical = _GRID_WIDTH * float(np.median(width))
     span = float(np.max(hi.max(axis=0) - lo.min(axis=0)))
-    if not (typical > 0.0 and np.isfinite(span)) or (span / typical + 4) ** g > 2.0**62:
+    if (
+        not (typical > 0.0 and np.isfinite(span))
+        or (span / (_GRID_CELL * typical) + 4) ** g > 2.0**62
+    ):
         return None
     allowance = _GRID_MOVE * typical
     margin = min(radius, _GRID_MARGIN * typical) + allowance
@@ -1427,16 +1431,22 @@ def closest_points(
     points query the same branches of the tree and gather the same facets' data while they
     are in cache.
 
-    Cell grid (a master searched again, its KD-trees reused): before the KD-trees, a uniform
-    grid of cells (:class:`_Grid`; cells as wide as the median facet box width ``w``, levels
-    for the facets over ``1.5 w`` wide, the boxes widened by ``min(radius, 0.75 w) + 0.15 w``)
-    lists the facets near each cell. The candidates of a point are the facets of its cell, pruned
-    by centroid sphere and slab bounds with ``d1`` the exact distance to the facet of the
-    nearest centroid among them; a point with ``min(d1, radius)`` within the grid's margin
-    (less the node movement since the grid was built) is decided there, with the same
-    bounds, projections and selection as above (the same closest point). Points beyond a
-    finite radius from every occupied cell are unpaired at once; the others are left to the
-    KD-trees. The grid is reused while no node has moved more than ``0.15 w``.
+    Cell grid (off by default, ``_GRID``: measured in ``benchmarks/search.py``, it gains up to
+    1.3 times at a radius of a facet size but its build costs up to ten searches on 1e6
+    facets; when on, for a master searched again, its KD-trees reused): before the KD-trees,
+    a uniform grid of cells (:class:`_Grid`; cells as wide as the median facet box width
+    ``w``, levels for the facets over ``1.5 w`` wide, the boxes widened by ``min(radius, 0.75
+    w) + 0.15 w``) lists the facets near each cell. The candidates of a point are the facets
+    of its cell, pruned by centroid sphere and slab bounds with ``d1`` the exact distance to
+    the facet of the nearest centroid among them; a point with ``min(d1, radius)`` within the
+    grid's margin (less the node movement since the grid was built) is decided there, with
+    the same bounds, projections and selection as above (the same closest point). Points
+    beyond a finite radius from every occupied cell are unpaired at once; the others are left
+    to the KD-trees. The grid is reused while no node has moved more than ``0.15 w``.
+
+    Self-contact on a surface of over 1024 facets: the points are searched by bins of their
+    normal, each against the facets of the bins that may face it only (see
+    :func:`_by_direction`); the admissible pairs, so the results, are those of one search.
 
     The work of a point grows with its distance ``D`` from the master surface, not with the
     search radius: its candidates are the facets with a centroid within ``min(D, radius) +
@@ -1503,9 +1513,11 @@ def _search(
     """Fill ``out`` with the closest points of :func:`closest_points` (checked input)."""
     npts, nf = points.shape[0], nodes.shape[0]
     master = _Master(nodes, trees)
-    # the grid is built for a master searched again (its KD-trees kept): built for one
-    # search alone it would cost more than it saves
-    grid, margin = trees.grid(nodes, radius, all(level.reused for level in master.levels))
+    # the grid (off by default: _GRID) is built for a master searched again (its KD-trees
+    # kept): built for one search alone it would cost more than it saves
+    grid, margin = None, 0.0
+    if _GRID:
+        grid, margin = trees.grid(nodes, radius, all(level.reused for level in master.levels))
     # on a large master the points in the order of a grid of cells (neighbours searched
     # together: the KD-tree and the gathers of facet data stay in cache), results scattered
     order = _spatial_order(points) if nf > _SORT else None
