@@ -15,14 +15,25 @@ with slave points on a perturbed copy of the surface: uniform over the parameter
 part of them lies within the search radius and a part beyond it. The radii run from ``h``
 to infinity. Each timing is the best of several calls (one call if it takes over a second).
 
-    python benchmarks/search.py --json benchmarks/results/search.json [--quick]
+    python benchmarks/search.py --json benchmarks/results/search.json [--quick] [--grid]
+        [--largest 1e6]
+
+``--grid`` turns the cell grid of the search on (off by default); ``--largest`` is the
+largest master of the radius sweep (1e6 facets by default).
 
 Records (``sweep``):
+
+* ``"graded"``: 5,000 segments 0.004 long with (``large_facets = 2``) and without two
+  segments 0.6 long beyond their end, points over the small ones, radii 0.004, 0.04 and
+  infinity (the pathology of a single KD-tree bounded by the largest facet);
+* ``"self_contact"``: the boundary of an elliptic slit of 10,000 segments searched against
+  itself, radii 0.05 and infinity (``first_call_s``, ``second_call_s``: CPU);
 
 * ``"radius"``: the slave points above, radii h to infinity: ``kind``, ``gdim``, ``facets``,
   ``points``, ``radius_over_h`` (``null``: infinite), ``paired_fraction``, ``seconds`` and
   ``cpu_seconds`` (best repeated call, wall and CPU of this process: the KD-tree of the
-  unchanged master is reused), ``first_call_s`` (wall, the KD-tree built),
+  unchanged master is reused), ``first_call_s`` (CPU, the KD-trees built), ``second_call_s``
+  (CPU, the grid built if ``--grid``),
   ``points_per_s`` and ``cpu_points_per_s``;
 * ``"distance"`` (the largest master of each kind): all points at ``offset_over_h`` (0.1 to
   50) from the surface, radii 2 and 10 times that offset and infinity (all points paired):
@@ -49,6 +60,12 @@ triangles 4.0e5 -> 4.1e5 / 7.2e4 -> 7.2e4; 1e5 triangles 2.6e5 -> 3.0e5 / 2.7e4 
 quadrilaterals 4.2e5 -> 3.7e5 / 7.4e4 -> 7.8e4; 1e5 quadrilaterals 2.4e5 -> 2.7e5 / 4.0e4 ->
 4.8e4 (per-facet data from contiguous columns: half the time; points ordered by grid cells
 on a master of over 2^14 facets; blocks of 4096 points).
+
+Third round (README): KD-trees by facet size class (graded masters 14 to 18 times faster),
+self-contact by normal bins (10 times faster on the 10,000-segment slit), the linearisation
+from coordinate columns; the cell grid measured (``search_grid.json``: up to 1.3 times faster
+at radius h in 3D, its build 5 to 10 searches on 1e6 facets) and left off.
+``search_before_grid.json`` holds the code before that round run with this script.
 
 The distance sweep shows where the time goes: at a given distance the cost is flat in the
 radius (within the timing noise, e.g. 1e5 triangles at 1 h: 1.2e5 points/s at radii 2 h, 10

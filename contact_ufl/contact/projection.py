@@ -1530,11 +1530,12 @@ def _search(
         if self_contact is not None:
             index = (np.arange(npts) if order is None else order)[block]
             admit = _admission(self_contact, master, index)
-        rest = np.arange(block.stop - block.start)
-        if grid is not None:
-            rest = _grid_block(master, grid, margin, x[block], radius, view, admit)
-            if rest.size and np.isfinite(radius):  # unpaired: no facet within the radius
-                rest = rest[~grid.far(x[block][rest], radius)]
+        if grid is None:  # the KD-trees alone
+            _closest_block(master, x[block], radius, view, admit)
+            continue
+        rest = _grid_block(master, grid, margin, x[block], radius, view, admit)
+        if rest.size and np.isfinite(radius):  # unpaired: no facet within the radius
+            rest = rest[~grid.far(x[block][rest], radius)]
         if rest.size:
             if self_contact is not None:
                 admit = _admission(self_contact, master, index[rest])
