@@ -15,11 +15,9 @@ with slave points on a perturbed copy of the surface: uniform over the parameter
 part of them lies within the search radius and a part beyond it. The radii run from ``h``
 to infinity. Each timing is the best of several calls (one call if it takes over a second).
 
-    python benchmarks/search.py --json benchmarks/results/search.json [--quick] [--grid]
-        [--largest 1e6]
+    python benchmarks/search.py --json benchmarks/results/search.json [--quick] [--largest 1e6]
 
-``--grid`` turns the cell grid of the search on (off by default); ``--largest`` is the
-largest master of the radius sweep (1e6 facets by default).
+``--largest`` is the largest master of the radius sweep (1e6 facets by default).
 
 Records (``sweep``):
 
@@ -33,8 +31,7 @@ Records (``sweep``):
   ``points``, ``radius_over_h`` (``null``: infinite), ``paired_fraction``, ``seconds`` and
   ``cpu_seconds`` (best repeated call, wall and CPU of this process: the KD-tree of the
   unchanged master is reused), ``first_call_s`` (CPU, the KD-trees built), ``second_call_s``
-  (CPU, the grid built if ``--grid``),
-  ``points_per_s`` and ``cpu_points_per_s``;
+  (CPU, the KD-trees reused), ``points_per_s`` and ``cpu_points_per_s``;
 * ``"distance"`` (the largest master of each kind): all points at ``offset_over_h`` (0.1 to
   50) from the surface, radii 2 and 10 times that offset and infinity (all points paired):
   the cost against the points' distance and the radius;
@@ -63,8 +60,9 @@ on a master of over 2^14 facets; blocks of 4096 points).
 
 Third round (README): KD-trees by facet size class (graded masters 14 to 18 times faster),
 self-contact by normal bins (10 times faster on the 10,000-segment slit), the linearisation
-from coordinate columns; the cell grid measured (``search_grid.json``: up to 1.3 times faster
-at radius h in 3D, its build 5 to 10 searches on 1e6 facets) and left off.
+from coordinate columns. A uniform cell grid before the KD-trees was measured
+(``search_grid.json``, run with the ``--grid`` option of commit 3b6744e: up to 1.3 times
+faster at radius h in 3D, its build 5 to 10 searches on 1e6 facets) and not kept.
 ``search_before_grid.json`` holds the code before that round run with this script.
 
 The distance sweep shows where the time goes: at a given distance the cost is flat in the
@@ -171,9 +169,8 @@ def best_of(call: Callable[[], object]) -> tuple[float, float, object]:
 
 def time_call(points: np.ndarray, nodes: np.ndarray, radius: float) -> dict:
     """CPU times of a first call of ``closest_points`` (no KD-tree kept from an earlier call)
-    and of a second one (the cell grid built, if the code has one), the best wall and CPU
-    times over a few more calls (the trees and grid of the unchanged master reused), and the
-    fraction of points paired."""
+    and of a second one (the KD-trees reused), the best wall and CPU times over a few more
+    calls (the trees of the unchanged master reused), and the fraction of points paired."""
     trees = projection.TreeCache() if hasattr(projection, "TreeCache") else None
     options = {} if trees is None else {"trees": trees}
     start = time.process_time()
@@ -404,10 +401,7 @@ def main() -> None:
     parser.add_argument(
         "--largest", type=float, default=1e6, help="largest number of facets (full run)"
     )
-    parser.add_argument("--grid", action="store_true", help="with the cell grid")
     args = parser.parse_args()
-    if hasattr(projection, "_GRID"):
-        projection._GRID = args.grid
     sizes = [1_000, 10_000] if args.quick else [1_000, 10_000, 100_000]
     if not args.quick and args.largest > 100_000:
         sizes.append(int(args.largest))
@@ -420,7 +414,7 @@ def main() -> None:
         100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
     )
     with open(args.json, "w") as f:
-        json.dump({"quick": args.quick, "grid": args.grid, "records": records}, f, indent=1)
+        json.dump({"quick": args.quick, "records": records}, f, indent=1)
 
 
 if __name__ == "__main__":

@@ -153,38 +153,10 @@ def test_points_searched_in_cell_order(make, nf, monkeypatch):
     check(points, nodes, 0.3)
 
 
-@pytest.mark.parametrize(
-    ("make", "nf"),
-    [(segment_polyline, 50), (triangle_soup, 40), (warped_quads, 20), (wavy_quads, 36)],
-    ids=["segments", "triangles", "quadrilaterals", "quad-grid"],
-)
-@pytest.mark.parametrize("radius", [np.inf, 0.05, 0.3])
-def test_grid_search_against_every_facet(make, nf, radius, monkeypatch):
-    """A master searched again (its KD-trees kept) is searched through the cell grid first:
-    the same closest points, and the grid decides some of the points."""
-    monkeypatch.setattr(projection, "_GRID", True)
-    rng = np.random.default_rng(nf + 5)
-    nodes = make(rng, nf)
-    points = near_and_far(rng, nodes, 30)
-    trees = TreeCache()
-    closest_points(points, nodes, radius, trees)
-    decided = []
-    grid_block = projection._grid_block
-
-    def counted(*args, **kwargs):
-        rest = grid_block(*args, **kwargs)
-        decided.append(len(args[3]) - len(rest))
-        return rest
-
-    monkeypatch.setattr(projection, "_grid_block", counted)
-    check(points, nodes, radius, trees)
-    assert sum(decided) > 0
-
-
 def test_graded_master_candidates(monkeypatch):
     """Two large facets beside many small ones (a graded master) leave the number of
     candidate pairs of the points near the small ones as it is without them: the large
-    facets have KD-trees (and grid levels) of their own instead of widening every query."""
+    facets have KD-trees of their own instead of widening every query."""
     x = np.linspace(0.0, 20.0, 5001)
     v = np.stack([x, 0.01 * np.sin(x)], axis=1)
     fine = np.stack([v[:-1], v[1:]], axis=1)
@@ -203,12 +175,11 @@ def test_graded_master_candidates(monkeypatch):
         return lower_bound(self, x, f, pid)
 
     monkeypatch.setattr(projection._Master, "lower_bound", counted)
-    monkeypatch.setattr(projection, "_GRID", True)
     for radius in (0.04, np.inf):
         counts = []
         for nodes in (fine, graded):
             trees = TreeCache()
-            for _ in range(2):  # the KD-tree search, then the grid's
+            for _ in range(2):  # KD-trees built, then reused
                 pairs.clear()
                 proj = closest_points(points, nodes, radius, trees)
                 counts.append(sum(pairs))

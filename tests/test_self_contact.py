@@ -92,17 +92,14 @@ def test_self_contact_matches_brute_force(slit):
 
 @pytest.mark.parametrize("slit", [_slit_2d, _slit_3d])
 @pytest.mark.parametrize("radius", [np.inf, 0.11])
-def test_self_contact_through_the_grid(slit, radius, monkeypatch):
-    """A self-contact surface searched again (through the cell grid first): the same
-    distances as facet by facet."""
-    monkeypatch.setattr(projection, "_GRID", True)
+def test_self_contact_searched_again(slit, radius):
+    """A self-contact surface searched again (its KD-trees reused): the same distances as
+    facet by facet."""
     nodes, facet_nodes = slit()
     points, rule = _facet_points(nodes, facet_nodes)
     trees = projection.TreeCache()
     closest_points(points, nodes, radius, trees, rule)
     proj = closest_points(points, nodes, radius, trees, rule)
-    (entry,) = trees.grids.values()
-    assert entry[2] is not None  # the grid was built and used
     expected = _brute_force(points, nodes, rule)
     paired = expected <= radius
     np.testing.assert_array_equal(proj.facet >= 0, paired)

@@ -1,6 +1,6 @@
 """Closest-point projection of many slave points onto a master surface made of facets.
 
-Pure NumPy (plus :class:`scipy.spatial.cKDTree` and a cell grid for the candidate search),
+Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search),
 vectorised over points and facets: the only Python loops run over a fixed small number of
 items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points, levels).
 The hot kernels work on coordinate columns (one 1D gather per node coordinate) rather than on
@@ -94,14 +94,6 @@ _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
 _CELLS = 64  # cells per dimension of the grid that orders the points
 _SORT = 1 << 14  # facets above which the points are ordered by cells
-# cell grid, in units of W = _GRID_WIDTH median facet box width (the widest facets of the
-# first level): cells _GRID_CELL W wide, boxes widened by min(radius, _GRID_MARGIN W) plus
-# the node movement allowed before the grid is rebuilt, _GRID_MOVE W
-_GRID = False  # the cell grid: same results, but its build costs more than it saves
-_GRID_WIDTH = 1.5
-_GRID_CELL = 2.0 / 3.0
-_GRID_MARGIN = 0.5
-_GRID_MOVE = 0.1
 _DIRECTIONS = {2: 8, 3: 32}  # normal bins of a self-contact search, by dimension
 _DIRECTIONS_MIN = 1 << 10  # facets above which a self-contact search goes by normal bins
 _FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
@@ -403,8 +395,6 @@ class _TreeLevel:
         KD-tree of the level's centroids (indices local to the level).
     slack : float
         Largest node movement since the tree was built.
-    reused : bool
-        Whether the tree is one of an earlier search.
     """
 
     facets: IntArray | None
@@ -412,7 +402,6 @@ class _TreeLevel:
     R: float
     tree: cKDTree
     slack: float
-    reused: bool
 
     def facet(self, local: IntArray) -> IntArray:
         """Master facet indices of the level's facets ``local``."""
@@ -440,8 +429,8 @@ def _tree_levels(
         f = None if kinds.size == 1 else np.flatnonzero(level == k)
         sub = (lambda a: a) if f is None else (lambda a, f=f: a[f])
         R = float(sub(size).max())
-        tree, slack, reused = trees.tree(sub(nodes), sub(centroid), R, int(k))
-        levels.append(_TreeLevel(f, len(sub(size)), R, tree, slack, reused))
+        tree, slack = trees.tree(sub(nodes), sub(centroid), R, int(k))
+        levels.append(_TreeLevel(f, len(sub(size)), R, tree, slack))
     return levels
 
 
@@ -747,52 +736,17 @@ class TreeCache:
 
     def __init__(self) -> None:
         self.entries: OrderedDict[tuple[int, ...], tuple[FloatArray, cKDTree]] = OrderedDict()
-        #: cell grids by node array shape: the nodes they were built from, the margin asked
-        #: for, and the grid (built with a margin wider by the movement allowed)
-        self.grids: OrderedDict[tuple[int, ...], tuple[FloatArray, float, _Grid | None]] = (
-            OrderedDict()
-        )
-
-    def grid(
-        self, nodes: FloatArray, radius: float, build: bool = True
-    ) -> tuple[_Grid | None, float]:
-        """A cell grid of the facets ``nodes`` for a search of ``radius`` and the margin it
-        ensures now: its margin less the largest node movement since it was built. Without
-        ``build``, only a grid kept from an earlier search (else ``None``).
-
-        The grid (see :func:`_grid`) is reused while no node has moved more than its
-        allowance and the radius asks for the same margin; ``None`` where no grid serves
-        (degenerate or too fine a master).
-        """
-        key = nodes.shape
-        entry = self.grids.get(key)
-        if entry is not None:
-            built, asked, grid = entry
-            move = float(np.max(np.abs(nodes - built))) * np.sqrt(nodes.shape[2])
-            if grid is not None and move <= grid.allowance and min(radius, grid.reach) == asked:
-                self.grids.move_to_end(key)
-                return grid, grid.margin - move
-        if not build:
-            return None, 0.0
-        grid = _grid(nodes, radius)
-        asked = min(radius, grid.reach) if grid is not None else radius
-        self.grids[key] = (nodes.copy(), asked, grid)
-        self.grids.move_to_end(key)
-        while len(self.grids) > _TREES:
-            self.grids.popitem(last=False)
-        return grid, (grid.margin if grid is not None else 0.0)
 
     def tree(
         self, nodes: FloatArray, centroid: FloatArray, R_max: float, level: int = 0
-    ) -> tuple[cKDTree | None, float, bool]:
-        """A KD-tree of centroids within ``slack`` of ``centroid``, that slack, and whether
-        the tree is an earlier one (reused).
+    ) -> tuple[cKDTree | None, float]:
+        """A KD-tree of centroids within ``slack`` of ``centroid`` and that slack.
 
         The centroid is the mean of the nodes, so it moves at most as far as the farthest
         node: a tree of earlier centroids serves with ``slack`` the largest node movement.
         """
         if len(nodes) == 0:
-            return None, 0.0, False
+            return None, 0.0
         key = (*nodes.shape, level)
         entry = self.entries.get(key)
         if entry is not None:
@@ -801,255 +755,13 @@ class TreeCache:
             move = float(np.max(np.abs(nodes - built))) * np.sqrt(nodes.shape[2])
             if move <= _MOVE * R_max:
                 self.entries.move_to_end(key)
-                return tree, move, True
+                return tree, move
         tree = cKDTree(centroid)
         self.entries[key] = (nodes.copy(), tree)
         self.entries.move_to_end(key)
         while len(self.entries) > _TREES:
             self.entries.popitem(last=False)
-        return tree, 0.0, False
-
-
-class _Grid:
-    """Uniform grids of cells listing the facets near each cell (a spatial hash).
-
-    The facets are sorted into levels by the width of their bounding box: level ``l`` holds
-    the facets at most ``width 2^l`` wide (level 0 all the narrower ones), on a grid of cells
-    ``cell width 2^l`` wide, so that a facet spans a few cells of its level whatever the sizes
-    of the others (a few large facets on a finely meshed surface do not widen the cells of the
-    fine ones). Every facet is listed in the cells its bounding box, widened by ``margin``,
-    overlaps: the facets within ``margin`` of a point are all listed in the cells that hold
-    the point (one per level). The cells are numbered in a box over the widened boxes of a
-    level; the lists are in compressed-row form, indexed directly by the cell number or, over
-    a box of many more cells than entries, through the sorted numbers of the occupied cells.
-
-    Attributes
-    ----------
-    margin : float
-        The width added to the facets' boxes on each side.
-    allowance : float
-        The node movement up to which the grid is reused.
-    reach : float
-        The margin asked for, less the allowance, when the radius is larger.
-    """
-
-    def __init__(
-        self,
-        lo: FloatArray,
-        hi: FloatArray,
-        margin: float,
-        width: float,
-        cell: float,
-        allowance: float = 0.0,
-        reach: float = np.inf,
-    ) -> None:
-        self.margin, self.allowance, self.reach = margin, allowance, reach
-        extent = (hi - lo).max(axis=1)
-        level = np.zeros(len(lo), dtype=np.int64)
-        wide = extent > width
-        level[wide] = np.ceil(np.log2(extent[wide] / width)).astype(np.int64)
-        self.levels = [
-            _GridLevel(f, lo[f] - margin, hi[f] + margin, cell * width * 2.0**k)
-            for k in np.unique(level)
-            for f in [np.flatnonzero(level == k)]
-        ]
-        self.entries = sum(lv.facets.size for lv in self.levels)
-
-    def far(self, x: FloatArray, radius: float) -> BoolArray:
-        """Mask of the points ``x`` farther than ``radius`` from every facet (a sufficient
-        test: ``False`` does not mean near).
-
-        A facet within ``radius`` of ``x`` is within ``radius`` of a cell that lists it. On
-        the grid of coarse cells ``2^j`` cells wide, at least ``radius`` wide (aligned with
-        the cells), the coarse cell of ``x`` is then a neighbour of, or, the coarse cell of
-        that cell: a point whose coarse cell is not among the occupied coarse cells and
-        their neighbours is farther than ``radius`` from every facet of the level.
-        """
-        far = np.ones(x.shape[0], dtype=bool)
-        for level in self.levels:
-            far[far] = ~level.occupied(x[far], radius)
-        return far
-
-    def pairs(self, x: FloatArray) -> tuple[IntArray, IntArray]:
-        """The (point, facet) pairs of the facets listed in the cells of the points ``x``,
-        grouped by point (in increasing point order)."""
-        found = [lv.pairs(x) for lv in self.levels]
-        pid = np.concatenate([p for p, _ in found])
-        fid = np.concatenate([f for _, f in found])
-        if len(found) > 1:
-            order = np.argsort(pid, kind="stable")
-            pid, fid = pid[order], fid[order]
-        return pid, fid
-
-
-class _GridLevel:
-    """One level of a :class:`_Grid`: the facets ``f`` with widened boxes ``lo, hi`` on a
-    grid of cells ``size`` wide."""
-
-    def __init__(self, f: IntArray, lo: FloatArray, hi: FloatArray, size: float) -> None:
-        self.size = size
-        g = lo.shape[1]
-        a = [np.floor(lo[:, k] / size).astype(np.int64) for k in range(g)]
-        b = [np.floor(hi[:, k] / size).astype(np.int64) for k in range(g)]
-        self.base = [int(ak.min()) for ak in a]
-        self.dims = [int(bk.max()) - base + 1 for bk, base in zip(b, self.base, strict=True)]
-        a = [ak - base for ak, base in zip(a, self.base, strict=True)]
-        span = [bk - base - ak for ak, bk, base in zip(a, b, self.base, strict=True)]
-        # the cells of the boxes: one pass per offset from the box's first cell (few: a box
-        # spans at most a few cells of its level per axis)
-        keys, facets = [], []
-        for offset in itertools.product(*(range(int(sk.max()) + 1) for sk in span)):
-            on = span[0] >= offset[0]
-            for k in range(1, g):
-                on &= span[k] >= offset[k]
-            i = np.flatnonzero(on)
-            key = a[0][i] + offset[0]
-            for k in range(1, g):
-                key = key * self.dims[k] + (a[k][i] + offset[k])
-            keys.append(key)
-            facets.append(f[i])
-        key = np.concatenate(keys)
-        order = np.argsort(key)
-        key = key[order]
-        self.facets = np.concatenate(facets)[order]
-        self.coarse: dict[int, tuple[list[int], list[int], IntArray]] = {}
-        ncells = int(np.prod(self.dims, dtype=np.float64))
-        self.dense = ncells <= max(4 * key.size, 1 << 12)
-        if self.dense:  # start of the list of each cell, by cell number
-            self.start = np.zeros(ncells + 1, dtype=np.int64)
-            np.cumsum(np.bincount(key, minlength=ncells), out=self.start[1:])
-        else:  # the occupied cells' numbers and the starts of their lists
-            head = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-            self.cells = key[head]
-            self.start = np.r_[head, key.size]
-
-    def _occupied_cells(self) -> list[IntArray]:
-        """Cell coordinates (absolute: ``floor(x / size)``) of the cells with a list."""
-        if self.dense:
-            key = np.flatnonzero(np.diff(self.start))
-        else:
-            key = self.cells
-        coords = []
-        for k in range(len(self.dims) - 1, -1, -1):
-            coords.append(key % self.dims[k] + self.base[k])
-            key = key // self.dims[k]
-        return coords[::-1]
-
-    def occupied(self, x: FloatArray, radius: float) -> BoolArray:
-        """Mask of the points ``x`` whose coarse cell (``2^j`` cells, at least ``radius``
-        wide) is occupied or next to an occupied one (see :meth:`_Grid.far`)."""
-        j = max(int(np.ceil(np.log2(radius / self.size))), 0) if radius > self.size else 0
-        if j not in self.coarse:
-            cells = [c >> j for c in self._occupied_cells()]
-            base = [int(c.min()) - 1 for c in cells]
-            dims = [int(c.max()) - b + 2 for c, b in zip(cells, base, strict=True)]
-            keys = []
-            for offset in itertools.product((-1, 0, 1), repeat=len(cells)):
-                key = np.zeros(cells[0].size, dtype=np.int64)
-                for c, b, n, o in zip(cells, base, dims, offset, strict=True):
-                    key = key * n + (c + o - b)
-                keys.append(key)
-            self.coarse[j] = (base, dims, np.unique(np.concatenate(keys)))
-        base, dims, keys = self.coarse[j]
-        key = np.zeros(x.shape[0], dtype=np.int64)
-        inside = np.ones(x.shape[0], dtype=bool)
-        scale = 1.0 / (self.size * 2.0**j)
-        for k in range(x.shape[1]):
-            c = np.floor(x[:, k] * scale) - base[k]
-            inside &= (c >= 0) & (c < dims[k])
-            key = key * dims[k] + np.where(inside, c, 0).astype(np.int64)
-        i = np.minimum(np.searchsorted(keys, key), keys.size - 1)
-        return inside & (keys[i] == key)
-
-    def pairs(self, x: FloatArray) -> tuple[IntArray, IntArray]:
-        """The (point, facet) pairs of the facets listed in the cell of each point."""
-        g = x.shape[1]
-        key = np.zeros(x.shape[0], dtype=np.int64)
-        inside = np.ones(x.shape[0], dtype=bool)
-        scale = 1.0 / self.size
-        for k in range(g):
-            c = np.floor(x[:, k] * scale) - self.base[k]
-            inside &= (c >= 0) & (c < self.dims[k])
-            key = key * int(self.dims[k]) + np.where(inside, c, 0).astype(np.int64)
-        pid = np.flatnonzero(inside)
-        key = key[pid]
-        if self.dense:
-            first, last = self.start[key], self.start[key + 1]
-        else:
-            i = np.searchsorted(self.cells, key)
-            hit = self.cells[np.minimum(i, self.cells.size - 1)] == key
-            pid, i = pid[hit], i[hit]
-            first, last = self.start[i], self.start[i + 1]
-        count = last - first
-        total = int(count.sum())
-        shift = np.repeat(first - (np.cumsum(count) - count), count)
-        return np.repeat(pid, count), self.facets[np.arange(total) + shift]
-
-
-def _grid_block(
-    master: _Master,
-    grid: _Grid,
-    margin: float,
-    x: FloatArray,
-    radius: float,
-    out: Projection,
-    admit: Admit | None = None,
-) -> IntArray:
-    """Fill ``out`` for the points of the block ``x`` whose closest point the grid decides,
-    and return the indices of the others (left to the KD-tree search).
-
-    The facets listed in a point's cells hold every facet point within ``margin`` of it (the
-    grid's margin less the node movement since it was built). A point is decided when
-    ``reach = min(d1, radius) <= margin`` (with ``d1`` the exact distance to the admissible
-    listed facet of the nearest centroid), or
-    when no admissible listed facet is within ``radius <= margin``; its pairs are then pruned and
-    projected as in the KD-tree search (same bounds, same selection: the same closest point).
-    """
-    npts, g = x.shape
-    pid, fid = grid.pairs(x)
-    if admit is not None:
-        ok = admit(pid, fid)
-        pid, fid = pid[ok], fid[ok]
-    # squared centroid distances; the pairs whose facet (within R_f of its centroid) can be
-    # within min(radius, margin) of the point (the others do not matter to a decided point)
-    dc = [x[:, k][pid] - master.slab[k][fid] for k in range(g)]
-    d2 = dc[0] * dc[0]
-    for k in range(1, g):
-        d2 += dc[k] * dc[k]
-    R = master.size[fid]
-    limit = min(radius, margin) * (1 + 1e-9)
-    near = d2 <= (limit + R * (1 + 1e-9)) ** 2
-    pid, fid, d2, R = pid[near], fid[near], d2[near], R[near]
-    decided = np.full(npts, radius <= margin)
-    if pid.size == 0:
-        return np.flatnonzero(~decided)
-    # the pair of the nearest centroid of each point (pairs grouped by point)
-    head = np.flatnonzero(np.r_[True, pid[1:] != pid[:-1]])
-    least = np.minimum.reduceat(d2, head)
-    count = np.diff(np.r_[head, pid.size])
-    hits = np.flatnonzero(d2 == np.repeat(least, count))
-    hits = hits[np.r_[True, pid[hits[1:]] != pid[hits[:-1]]]]
-    active, nearest = pid[hits], fid[hits]
-    first = master.project(x[active], nearest, np.arange(active.size), active.size)
-    reach = np.full(npts, radius)
-    reach[active] = np.minimum(first.dist, radius)
-    # decided: all facets of the tie-break (within 1e-10 (d + 2 R) of d <= reach) listed
-    decided[active] = reach[active] * (1 + 1e-8) + 1e-8 * master.R_max <= margin
-    # the pairs that the KD-tree search would keep and that can hold the closest point
-    keep = decided[pid] & (d2 <= ((reach[pid] + R) * (1 + 1e-9)) ** 2)
-    keep[hits] = False  # projected already
-    pid, fid, R = pid[keep], fid[keep], R[keep]
-    lower = master.lower_bound(x, fid, pid)
-    keep = lower - 1e-9 * R <= reach[pid] * (1 + 1e-9)
-    pid, fid = pid[keep], fid[keep]
-    take = decided[active]
-    active, nearest = active[take], nearest[take]
-    first = _Pairs(first.xi[take], first.dist[take], first.edge[take], first.vertex[take])
-    pairs = _concatenate(master.project(x[pid], fid, pid, npts), first)
-    pid, fid = np.concatenate([pid, active]), np.concatenate([fid, nearest])
-    if pid.size:
-        _select(master, x, radius, out, pid, fid, pairs)
-    return np.flatnonzero(~decided)
+        return tree, 0.0
 
 
 def _candidates(
@@ -1337,32 +1049,6 @@ def _admission(self_contact: SelfContact, master: _Master, index: IntArray) -> A
     return admit
 
 
-def _grid(nodes: FloatArray, radius: float) -> _Grid | None:
-    """The cell grid of the facets ``nodes`` for a search of ``radius``.
-
-    With ``w`` the median width of the facets' bounding boxes and ``W = 1.5 w``: first level
-    for the facets up to ``W`` wide, cells ``w`` wide, margin ``min(radius, 0.5 W) + 0.1 W``
-    (the last term allows the nodes to move by ``0.1 W`` before the grid is rebuilt).
-    ``None`` for a master of zero extent or with more than ``2^62`` cells in a level (the
-    search then uses the KD-trees alone).
-    """
-    g = nodes.shape[2]
-    columns = [[nodes[:, a, k] for a in range(nodes.shape[1])] for k in range(g)]
-    lo = np.stack([np.minimum.reduce(c) for c in columns], axis=1)
-    hi = np.stack([np.maximum.reduce(c) for c in columns], axis=1)
-    width = np.max(hi - lo, axis=1)
-    typical = _GRID_WIDTH * float(np.median(width))
-    span = float(np.max(hi.max(axis=0) - lo.min(axis=0)))
-    if (
-        not (typical > 0.0 and np.isfinite(span))
-        or (span / (_GRID_CELL * typical) + 4) ** g > 2.0**62
-    ):
-        return None
-    allowance = _GRID_MOVE * typical
-    margin = min(radius, _GRID_MARGIN * typical) + allowance
-    return _Grid(lo, hi, margin, typical, _GRID_CELL, allowance, _GRID_MARGIN * typical)
-
-
 def _spatial_order(points: FloatArray) -> IntArray:
     """An order of the points by the cells of a ``_CELLS^gdim`` grid over their bounding
     box (lexicographic in the cell coordinates)."""
@@ -1430,19 +1116,6 @@ def closest_points(
     a ``64^gdim`` grid over them (the results are returned in the order given): neighbouring
     points query the same branches of the tree and gather the same facets' data while they
     are in cache.
-
-    Cell grid (off by default, ``_GRID``: measured in ``benchmarks/search.py``, it gains up to
-    1.3 times at a radius of a facet size but its build costs up to ten searches on 1e6
-    facets; when on, for a master searched again, its KD-trees reused): before the KD-trees,
-    a uniform grid of cells (:class:`_Grid`; cells as wide as the median facet box width
-    ``w``, levels for the facets over ``1.5 w`` wide, the boxes widened by ``min(radius, 0.75
-    w) + 0.15 w``) lists the facets near each cell. The candidates of a point are the facets
-    of its cell, pruned by centroid sphere and slab bounds with ``d1`` the exact distance to
-    the facet of the nearest centroid among them; a point with ``min(d1, radius)`` within the
-    grid's margin (less the node movement since the grid was built) is decided there, with
-    the same bounds, projections and selection as above (the same closest point). Points
-    beyond a finite radius from every occupied cell are unpaired at once; the others are left
-    to the KD-trees. The grid is reused while no node has moved more than ``0.15 w``.
 
     Self-contact on a surface of over 1024 facets: the points are searched by bins of their
     normal, each against the facets of the bins that may face it only (see
@@ -1513,11 +1186,6 @@ def _search(
     """Fill ``out`` with the closest points of :func:`closest_points` (checked input)."""
     npts, nf = points.shape[0], nodes.shape[0]
     master = _Master(nodes, trees)
-    # the grid (off by default: _GRID) is built for a master searched again (its KD-trees
-    # kept): built for one search alone it would cost more than it saves
-    grid, margin = None, 0.0
-    if _GRID:
-        grid, margin = trees.grid(nodes, radius, all(level.reused for level in master.levels))
     # on a large master the points in the order of a grid of cells (neighbours searched
     # together: the KD-tree and the gathers of facet data stay in cache), results scattered
     order = _spatial_order(points) if nf > _SORT else None
@@ -1530,19 +1198,7 @@ def _search(
         if self_contact is not None:
             index = (np.arange(npts) if order is None else order)[block]
             admit = _admission(self_contact, master, index)
-        if grid is None:  # the KD-trees alone
-            _closest_block(master, x[block], radius, view, admit)
-            continue
-        rest = _grid_block(master, grid, margin, x[block], radius, view, admit)
-        if rest.size and np.isfinite(radius):  # unpaired: no facet within the radius
-            rest = rest[~grid.far(x[block][rest], radius)]
-        if rest.size:
-            if self_contact is not None:
-                admit = _admission(self_contact, master, index[rest])
-            part = Projection(*(getattr(view, k)[rest] for k in _FIELDS))
-            _closest_block(master, x[block][rest], radius, part, admit)
-            for k in _FIELDS:
-                getattr(view, k)[rest] = getattr(part, k)
+        _closest_block(master, x[block], radius, view, admit)
     if order is not None:
         for k in _FIELDS:
             getattr(out, k)[order] = getattr(work, k)
