@@ -15,15 +15,23 @@ with slave points on a perturbed copy of the surface: uniform over the parameter
 part of them lies within the search radius and a part beyond it. The radii run from ``h``
 to infinity. Each timing is the best of several calls (one call if it takes over a second).
 
-    python benchmarks/search.py --json benchmarks/results/search.json [--quick]
+    python benchmarks/search.py --json benchmarks/results/search.json [--quick] [--largest 1e6]
+
+``--largest`` is the largest master of the radius sweep (1e6 facets by default).
 
 Records (``sweep``):
+
+* ``"graded"``: 5,000 segments 0.004 long with (``large_facets = 2``) and without two
+  segments 0.6 long beyond their end, points over the small ones, radii 0.004, 0.04 and
+  infinity (the pathology of a single KD-tree bounded by the largest facet);
+* ``"self_contact"``: the boundary of an elliptic slit of 10,000 segments searched against
+  itself, radii 0.05 and infinity (``first_call_s``, ``second_call_s``: CPU);
 
 * ``"radius"``: the slave points above, radii h to infinity: ``kind``, ``gdim``, ``facets``,
   ``points``, ``radius_over_h`` (``null``: infinite), ``paired_fraction``, ``seconds`` and
   ``cpu_seconds`` (best repeated call, wall and CPU of this process: the KD-tree of the
-  unchanged master is reused), ``first_call_s`` (wall, the KD-tree built),
-  ``points_per_s`` and ``cpu_points_per_s``;
+  unchanged master is reused), ``first_call_s`` (CPU, the KD-trees built), ``second_call_s``
+  (CPU, the KD-trees reused), ``points_per_s`` and ``cpu_points_per_s``;
 * ``"distance"`` (the largest master of each kind): all points at ``offset_over_h`` (0.1 to
   50) from the surface, radii 2 and 10 times that offset and infinity (all points paired):
   the cost against the points' distance and the radius;
@@ -49,6 +57,13 @@ triangles 4.0e5 -> 4.1e5 / 7.2e4 -> 7.2e4; 1e5 triangles 2.6e5 -> 3.0e5 / 2.7e4 
 quadrilaterals 4.2e5 -> 3.7e5 / 7.4e4 -> 7.8e4; 1e5 quadrilaterals 2.4e5 -> 2.7e5 / 4.0e4 ->
 4.8e4 (per-facet data from contiguous columns: half the time; points ordered by grid cells
 on a master of over 2^14 facets; blocks of 4096 points).
+
+Third round (README): KD-trees by facet size class (graded masters 14 to 18 times faster),
+self-contact by normal bins (10 times faster on the 10,000-segment slit), the linearisation
+from coordinate columns. A uniform cell grid before the KD-trees was measured
+(``search_grid.json``, run with the ``--grid`` option of commit 3b6744e: up to 1.3 times
+faster at radius h in 3D, its build 5 to 10 searches on 1e6 facets) and not kept.
+``search_before_grid.json`` holds the code before that round run with this script.
 
 The distance sweep shows where the time goes: at a given distance the cost is flat in the
 radius (within the timing noise, e.g. 1e5 triangles at 1 h: 1.2e5 points/s at radii 2 h, 10
@@ -153,14 +168,17 @@ def best_of(call: Callable[[], object]) -> tuple[float, float, object]:
 
 
 def time_call(points: np.ndarray, nodes: np.ndarray, radius: float) -> dict:
-    """Wall time of a first call of ``closest_points`` (no KD-tree kept from an earlier call),
-    the best wall and CPU times over a few more calls (the tree of the unchanged master
-    reused), and the fraction of points paired."""
+    """CPU times of a first call of ``closest_points`` (no KD-tree kept from an earlier call)
+    and of a second one (the KD-trees reused), the best wall and CPU times over a few more
+    calls (the trees of the unchanged master reused), and the fraction of points paired."""
     trees = projection.TreeCache() if hasattr(projection, "TreeCache") else None
     options = {} if trees is None else {"trees": trees}
-    start = time.perf_counter()
+    start = time.process_time()
     closest_points(points, nodes, radius, **options)
-    first = time.perf_counter() - start
+    first = time.process_time() - start
+    start = time.process_time()
+    closest_points(points, nodes, radius, **options)
+    second = time.process_time() - start
     wall, cpu, proj = best_of(lambda: closest_points(points, nodes, radius, **options))
     npts = len(points)
     return {
@@ -168,6 +186,7 @@ def time_call(points: np.ndarray, nodes: np.ndarray, radius: float) -> dict:
         "seconds": wall,
         "cpu_seconds": cpu,
         "first_call_s": first,
+        "second_call_s": second,
         "points_per_s": npts / wall,
         "cpu_points_per_s": npts / cpu,
     }
@@ -180,10 +199,12 @@ def stages(points: np.ndarray, nodes: np.ndarray) -> dict:
     centroid)."""
     trees = projection.TreeCache()
     master = projection._Master(nodes, trees)
+    # the KD-tree of all the centroids (one level on these even meshes)
+    tree = master.levels[0].tree if hasattr(master, "levels") else master.tree
     K = min(projection._K[nodes.shape[2]], len(nodes))
     _, master_s, _ = best_of(lambda: projection._Master(nodes, trees))
-    _, k1_s, (_, nearest) = best_of(lambda: master.tree.query(points, k=1))
-    _, kK_s, _ = best_of(lambda: master.tree.query(points, k=K))
+    _, k1_s, (_, nearest) = best_of(lambda: tree.query(points, k=1))
+    _, kK_s, _ = best_of(lambda: tree.query(points, k=K))
     n = len(points)
     _, project_s, _ = best_of(lambda: master.project(points, nearest, np.arange(n), n))
     return {
@@ -292,16 +313,106 @@ def distance_sweep(nf: int, npts: int, offsets, factors) -> list[dict]:
     return records
 
 
+def graded_master(big: bool) -> np.ndarray:
+    """5,000 segments 0.004 long on ``y = 0.01 sin x``, ``x`` in [0, 20], and (``big``) two
+    segments 0.6 long beyond its end."""
+    x = np.linspace(0.0, 20.0, 5001)
+    v = np.stack([x, 0.01 * np.sin(x)], axis=1)
+    nodes = np.stack([v[:-1], v[1:]], axis=1)
+    if big:
+        end = v[-1]
+        large = np.array([[end, end + [0.6, 0.0]], [end + [0.6, 0.0], end + [1.2, 0.0]]])
+        nodes = np.concatenate([nodes, large])
+    return nodes
+
+
+def graded_sweep(npts: int) -> list[dict]:
+    """The graded master with and without its two large facets: points over the small ones
+    at ``0.004 10^U(-2, 1)`` from them, radii 0.004, 0.04 and infinity."""
+    rng = np.random.default_rng(0)
+    u = rng.uniform(0.0, 20.0, npts)
+    offset = rng.choice([-1.0, 1.0], npts) * 0.004 * 10.0 ** rng.uniform(-2.0, 1.0, npts)
+    points = np.stack([u, 0.01 * np.sin(u) + offset], axis=1)
+    records = []
+    for radius in (0.004, 0.04, np.inf):
+        for big in (False, True):
+            nodes = graded_master(big)
+            record = {
+                "sweep": "graded",
+                "large_facets": 2 if big else 0,
+                "facets": len(nodes),
+                "points": npts,
+                "radius": None if np.isinf(radius) else radius,
+                **time_call(points, nodes, radius),
+            }
+            records.append(record)
+            print(
+                f"graded master, {record['large_facets']} large facets, radius {radius:6g}: "
+                f"first call {record['first_call_s']:.3f} s, best {record['cpu_seconds']:.3f} s "
+                f"CPU ({npts} points)",
+                flush=True,
+            )
+    return records
+
+
+def self_contact_sweep(n: int) -> list[dict]:
+    """Self-contact of the boundary of an elliptic slit (half-axes 1 and 0.06) of ``n``
+    segments, the slave points at their centres (as ``tests/test_self_contact.py``)."""
+    t = -np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    ring = np.stack([np.cos(t), 0.06 * np.sin(t)], axis=1)
+    facet_nodes = np.stack([np.arange(n), (np.arange(n) + 1) % n], axis=1)
+    nodes = ring[facet_nodes]
+    points = nodes.mean(axis=1)
+    a1 = nodes[:, 1] - nodes[:, 0]
+    normals = np.stack([a1[:, 1], -a1[:, 0]], axis=1)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    rule = projection.SelfContact(facet_nodes, facet_nodes, normals)
+    records = []
+    for radius in (0.05, np.inf):
+        trees = projection.TreeCache()
+        start = time.process_time()
+        closest_points(points, nodes, radius, trees, rule)
+        first = time.process_time() - start
+        start = time.process_time()
+        proj = closest_points(points, nodes, radius, trees, rule)
+        second = time.process_time() - start
+        record = {
+            "sweep": "self_contact",
+            "facets": n,
+            "points": n,
+            "radius": None if np.isinf(radius) else radius,
+            "paired_fraction": float(np.mean(proj.facet >= 0)),
+            "first_call_s": first,
+            "second_call_s": second,
+        }
+        records.append(record)
+        print(
+            f"self-contact, {n} segments, radius {radius}: first call {first:.3f} s, second "
+            f"{second:.3f} s CPU",
+            flush=True,
+        )
+    return records
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--json", required=True)
     parser.add_argument("--quick", action="store_true", help="fewer facets and points")
+    parser.add_argument(
+        "--largest", type=float, default=1e6, help="largest number of facets (full run)"
+    )
     args = parser.parse_args()
-    sizes = (1_000, 10_000) if args.quick else (1_000, 10_000, 100_000)
+    sizes = [1_000, 10_000] if args.quick else [1_000, 10_000, 100_000]
+    if not args.quick and args.largest > 100_000:
+        sizes.append(int(args.largest))
     npts = 10_000 if args.quick else 50_000
     factors = (1.0, 10.0, np.inf) if args.quick else (1.0, 10.0, 100.0, np.inf)
-    records = radius_sweep(sizes, npts, factors)
-    records += distance_sweep(sizes[-1], npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf))
+    records = graded_sweep(npts // 2)
+    records += self_contact_sweep(2_000 if args.quick else 10_000)
+    records += radius_sweep(sizes, npts, factors)
+    records += distance_sweep(
+        100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
+    )
     with open(args.json, "w") as f:
         json.dump({"quick": args.quick, "records": records}, f, indent=1)
 

@@ -166,3 +166,40 @@ def test_fan_columns_are_the_facets_beside():
     fans = fan_columns(triangles, 3, np.array([0, 2]))
     assert fans.tolist() == [[0, 3, 6, 9], [0, 12, 15, -1]]
     assert fan_columns(triangles, 3, np.zeros(0, dtype=int)).shape == (0, 0)
+
+
+def test_graded_master_candidates(monkeypatch):
+    """Two large facets beside many small ones (a graded master) leave the number of
+    candidate pairs of the points near the small ones as it is without them: the large
+    facets have KD-trees of their own instead of widening every query."""
+    x = np.linspace(0.0, 20.0, 5001)
+    v = np.stack([x, 0.01 * np.sin(x)], axis=1)
+    fine = np.stack([v[:-1], v[1:]], axis=1)
+    end = v[-1]
+    large = np.array([[end, end + [0.6, 0.0]], [end + [0.6, 0.0], end + [1.2, 0.0]]])
+    graded = np.concatenate([fine, large])
+    rng = np.random.default_rng(3)
+    u = rng.uniform(0.0, 19.0, 2000)
+    offset = rng.choice([-1.0, 1.0], 2000) * 0.004 * 10.0 ** rng.uniform(-2.0, 1.0, 2000)
+    points = np.stack([u, 0.01 * np.sin(u) + offset], axis=1)
+    pairs = []
+    lower_bound = projection._Master.lower_bound
+
+    def counted(self, x, f, pid=None):
+        pairs.append(len(f))
+        return lower_bound(self, x, f, pid)
+
+    monkeypatch.setattr(projection._Master, "lower_bound", counted)
+    for radius in (0.04, np.inf):
+        counts = []
+        for nodes in (fine, graded):
+            trees = TreeCache()
+            for _ in range(2):  # KD-trees built, then reused
+                pairs.clear()
+                proj = closest_points(points, nodes, radius, trees)
+                counts.append(sum(pairs))
+            assert np.all(proj.facet < len(fine))
+        # at most the K = 2 nearest centroids of the large facets' level more per point
+        assert counts[2] <= counts[0] + 2 * len(points)
+        assert counts[3] <= counts[1] + 2 * len(points)
+        assert counts[0] < 20 * len(points)

@@ -91,6 +91,50 @@ def test_self_contact_matches_brute_force(slit):
     assert np.all(proj.gap < 0)
 
 
+@pytest.mark.parametrize("slit", [_slit_2d, _slit_3d])
+@pytest.mark.parametrize("radius", [np.inf, 0.11])
+def test_self_contact_searched_again(slit, radius):
+    """A self-contact surface searched again (its KD-trees reused): the same distances as
+    facet by facet."""
+    nodes, facet_nodes = slit()
+    points, rule = _facet_points(nodes, facet_nodes)
+    trees = projection.TreeCache()
+    closest_points(points, nodes, radius, trees, rule)
+    proj = closest_points(points, nodes, radius, trees, rule)
+    expected = _brute_force(points, nodes, rule)
+    paired = expected <= radius
+    np.testing.assert_array_equal(proj.facet >= 0, paired)
+    np.testing.assert_allclose(proj.distance[paired], expected[paired], rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize("slit", [_slit_2d, _slit_3d])
+@pytest.mark.parametrize("radius", [np.inf, 0.11])
+def test_self_contact_by_normal_bins(slit, radius, monkeypatch):
+    """The search by normal bins (as on a large surface) skips, for each bin of points, the
+    facets that face the same way, and finds the same partners as the plain search."""
+    nodes, facet_nodes = slit()
+    points, rule = _facet_points(nodes, facet_nodes)
+    reference = closest_points(points, nodes, radius, self_contact=rule)
+    monkeypatch.setattr(projection, "_DIRECTIONS_MIN", 0)
+    sizes = []
+    search = projection._search
+
+    def counted(points, nodes, *args):
+        sizes.append(len(nodes))
+        return search(points, nodes, *args)
+
+    monkeypatch.setattr(projection, "_search", counted)
+    proj = closest_points(points, nodes, radius, self_contact=rule)
+    assert len(sizes) > 1 and max(sizes) < len(nodes)  # bins, each without some facets
+    np.testing.assert_array_equal(proj.facet, reference.facet)
+    for field in ("xi", "y", "normal", "gap", "distance", "sliding"):
+        np.testing.assert_array_equal(getattr(proj, field), getattr(reference, field))
+    expected = _brute_force(points, nodes, rule)
+    paired = expected <= radius
+    np.testing.assert_array_equal(proj.facet >= 0, paired)
+    np.testing.assert_allclose(proj.distance[paired], expected[paired], rtol=1e-12, atol=1e-14)
+
+
 def test_self_contact_across_an_elliptic_slit():
     """The points of each arc find the other arc across the slit, symmetrically about y = 0."""
     nodes, facet_nodes = _slit_2d(n=80, b=0.05)

@@ -1,10 +1,11 @@
 """Closest-point projection of many slave points onto a master surface made of facets.
 
-Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search), vectorised over
-points and facets: the only Python loops run over a fixed small number of items (nodes,
-edges and coordinates of a facet, Newton iterations, blocks of points). The hot kernels work
-on coordinate columns (one 1D gather per node coordinate) rather than on rows of 2 or 3
-numbers, which NumPy gathers and reduces slowly. Throughput: ``benchmarks/search.py``.
+Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search),
+vectorised over points and facets: the only Python loops run over a fixed small number of
+items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points, levels).
+The hot kernels work on coordinate columns (one 1D gather per node coordinate) rather than on
+rows of 2 or 3 numbers, which NumPy gathers and reduces slowly. Throughput:
+``benchmarks/search.py``.
 
 Facet kinds and conventions
 ---------------------------
@@ -116,12 +117,16 @@ _EDGES["quadrilateral9"] = _EDGES["quadrilateral"]
 _K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
 _MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
+_LEVEL_RADIUS = 2.0  # facets of radius up to this times the median share the first KD-tree
+_LEVEL_RATIO = 4.0  # ratio of the largest facet radii of successive KD-tree levels
 _BLOCK = 1 << 12  # points processed at once (keeps the arrays of the candidate pairs in cache)
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
 _CELLS = 64  # cells per dimension of the grid that orders the points
 _SORT = 1 << 14  # facets above which the points are ordered by cells
+_DIRECTIONS = {2: 8, 3: 32}  # normal bins of a self-contact search, by dimension
+_DIRECTIONS_MIN = 1 << 10  # facets above which a self-contact search goes by normal bins
 _FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
 
 #: An admissibility test of (point, facet) pairs: point and facet indices in, mask out.
@@ -292,6 +297,15 @@ def _normalise(v: list[FloatArray]) -> list[FloatArray]:
     return [vk * scale for vk in v]
 
 
+def _tangents(dN: FloatArray, X: FloatArray) -> FloatArray:
+    """Tangent vectors ``a[p, alpha] = sum_n dN[p, n, alpha] X[p, n]`` (P, fdim, gdim) from
+    the shape function derivatives (P, nn, fdim) and the nodes (P, nn, gdim)."""
+    a = dN[:, 0, :, None] * X[:, 0, None, :]
+    for n in range(1, X.shape[1]):
+        a += dN[:, n, :, None] * X[:, n, None, :]
+    return a
+
+
 def _unit_normal(a: FloatArray) -> FloatArray:
     """Unit normal from the tangent vectors ``a`` (P, fdim, gdim); zero if degenerate."""
     if a.shape[1] == 1:
@@ -312,14 +326,157 @@ class _Pairs:
     vertex: npt.NDArray[np.bool_]  # (P,) closest point at a vertex
 
 
+def _centre_normal(X: list[list[FloatArray]], nn: int, g: int) -> list[FloatArray]:
+    """Columns of the normal ``a1 x a2`` (2D: ``(a1[1], -a1[0])``) at the centre of each
+    facet of ``nn`` nodes in dimension ``g``, from the coordinate columns ``X[a][k]`` of its
+    nodes."""
+    centre = 1.0 / 3.0 if facet_kind(nn, g) == "triangle6" else 0.5
+    _, dN, _ = shape_functions(nn, g, np.full((1, g - 1), centre))
+    a = [
+        [
+            sum(dN[0, n, alpha] * X[n][k] for n in range(nn) if dN[0, n, alpha] != 0)
+            for k in range(g)
+        ]
+        for alpha in range(g - 1)
+    ]
+    if g == 2:
+        return [a[0][1], -a[0][0]]
+    a1, a2 = a
+    return [
+        a1[1] * a2[2] - a1[2] * a2[1],
+        a1[2] * a2[0] - a1[0] * a2[2],
+        a1[0] * a2[1] - a1[1] * a2[0],
+    ]
+
+
+def _directions(gdim: int) -> FloatArray:
+    """Unit directions of the normal bins: 8 on the circle, 32 on the sphere (Fibonacci)."""
+    if gdim == 2:
+        t = np.arange(_DIRECTIONS[2]) * (2.0 * np.pi / _DIRECTIONS[2])
+        return np.stack([np.cos(t), np.sin(t)], axis=1)
+    n = _DIRECTIONS[3]
+    z = 1.0 - (2.0 * np.arange(n) + 1.0) / n
+    t = np.arange(n) * np.pi * (3.0 - np.sqrt(5.0))
+    r = np.sqrt(1.0 - z * z)
+    return np.stack([r * np.cos(t), r * np.sin(t), z], axis=1)
+
+
+def _bins(normals: FloatArray, directions: FloatArray) -> tuple[IntArray, FloatArray]:
+    """The bin (nearest direction) of each normal, and the largest angle between a bin's
+    direction and its normals (a zero normal counts as at a right angle)."""
+    length = np.linalg.norm(normals, axis=1, keepdims=True)
+    unit = np.divide(normals, length, out=np.zeros_like(normals), where=length > 0)
+    cos = unit @ directions.T
+    b = np.argmax(cos, axis=1)
+    angle = np.arccos(np.clip(cos[np.arange(len(b)), b], -1.0, 1.0))
+    spread = np.zeros(len(directions))
+    np.maximum.at(spread, b, angle)
+    return b, spread
+
+
+def _by_direction(
+    points: FloatArray,
+    nodes: FloatArray,
+    radius: float,
+    rule: SelfContact,
+    out: Projection,
+) -> None:
+    """Self-contact search by normal bins: the points of a bin are searched against the
+    facets of the bins that may face them only.
+
+    A pair is admissible only if ``n_f . n_p < 0``. The normals are sorted into bins by the
+    nearest of a few fixed directions; with ``theta`` a bin's largest angle between its
+    direction and its normals, every pair of a point bin ``A`` and a facet bin ``B`` has
+    ``n_f . n_p >= 0`` when ``angle(u_A, u_B) + theta_A + theta_B <= pi / 2``: the facets of
+    such bins are inadmissible for those points and skipped (the facets around a point on its
+    own side, which otherwise fill every query up to the partner across the gap). The
+    admissible pairs are all kept (facets in their given order): the same closest points.
+    """
+    g = points.shape[1]
+    X = [[np.ascontiguousarray(nodes[:, a, k]) for k in range(g)] for a in range(nodes.shape[1])]
+    axis = np.stack(_centre_normal(X, nodes.shape[1], g), axis=1)
+    u = _directions(g)
+    facet_bin, facet_spread = _bins(axis, u)
+    point_bin, point_spread = _bins(np.asarray(rule.point_normals, dtype=np.float64), u)
+    between = np.arccos(np.clip(u @ u.T, -1.0, 1.0))
+    for A in np.unique(point_bin):
+        p = np.flatnonzero(point_bin == A)
+        same_side = between[A] + point_spread[A] + facet_spread <= 0.5 * np.pi - 1e-6
+        f = np.flatnonzero(~same_side[facet_bin])
+        if f.size == 0:
+            continue
+        part = Projection(*(getattr(out, k)[p] for k in _FIELDS))
+        sub = SelfContact(rule.point_nodes[p], rule.facet_nodes[f], rule.point_normals[p])
+        _search(points[p], nodes[f], radius, TreeCache(), sub, part)
+        part.facet[part.facet >= 0] = f[part.facet[part.facet >= 0]]
+        for k in _FIELDS:
+            getattr(out, k)[p] = getattr(part, k)
+
+
+@dataclass
+class _TreeLevel:
+    """The facets of one size class of a master surface and the KD-tree of their centroids.
+
+    Attributes
+    ----------
+    facets : ndarray of int64 or None
+        Indices of the facets of the level (``None``: all the facets, in order).
+    n : int
+        Number of facets of the level.
+    R : float
+        Largest facet radius ``R_f`` of the level.
+    tree : cKDTree
+        KD-tree of the level's centroids (indices local to the level).
+    slack : float
+        Largest node movement since the tree was built.
+    """
+
+    facets: IntArray | None
+    n: int
+    R: float
+    tree: cKDTree
+    slack: float
+
+    def facet(self, local: IntArray) -> IntArray:
+        """Master facet indices of the level's facets ``local``."""
+        return local if self.facets is None else self.facets[local]
+
+
+def _tree_levels(
+    nodes: FloatArray, centroid: FloatArray, size: FloatArray, trees: TreeCache
+) -> list[_TreeLevel]:
+    """The facets by size class, each with a KD-tree of its centroids: level ``l`` holds the
+    facets of radius ``R_f`` in ``(R0 4^(l-1), R0 4^l]`` (level 0: ``R_f <= R0``), ``R0 =
+    2 median(R_f)``. The candidates of a point are the centroids within ``r + R`` of it, with
+    ``R`` the largest radius *of the level*: a few large facets do not widen the queries among
+    the many small ones. A master of even facet size has one level (all its facets)."""
+    if len(nodes) == 0:
+        return []
+    level = np.zeros(len(nodes), dtype=np.int64)
+    base = _LEVEL_RADIUS * float(np.median(size))
+    large = size > base
+    if base > 0.0 and large.any():
+        level[large] = np.ceil(np.log(size[large] / base) / np.log(_LEVEL_RATIO))
+    kinds = np.unique(level)
+    levels = []
+    for k in kinds:
+        f = None if kinds.size == 1 else np.flatnonzero(level == k)
+        sub = (lambda a: a) if f is None else (lambda a, f=f: a[f])
+        R = float(sub(size).max())
+        tree, slack = trees.tree(sub(nodes), sub(centroid), R, int(k))
+        levels.append(_TreeLevel(f, len(sub(size)), R, tree, slack))
+    return levels
+
+
 class _Master:
     """Master facets with the per-facet data of the search and the projections.
 
-    The KD-tree of the centroids is taken from ``trees`` (a :class:`TreeCache`, if given)
-    when a master surface of the same shape was searched before and no node has moved more
-    than ``_MOVE R_max`` since that tree was built: ``slack`` is then that movement, a bound
-    of how far every centroid is from the one the tree holds, and the search widens its
-    bounds by it.
+    The facets are sorted by their radius ``R_f`` into levels (:func:`_tree_levels`), each
+    with a KD-tree of its centroids, taken from ``trees`` (a :class:`TreeCache`, if given)
+    when a master surface of the same shape was searched before and no node of the level has
+    moved more than ``_MOVE R`` (``R`` the largest radius of the level) since that tree was
+    built: the level's ``slack`` is then that movement, a bound of how far every centroid is
+    from the one the tree holds, and the search widens its bounds by it.
     """
 
     def __init__(self, nodes: FloatArray, trees: TreeCache | None = None) -> None:
@@ -353,9 +510,9 @@ class _Master:
         self.size = np.sqrt(radius2)
         self.R_max = float(self.size.max()) if self.nf else 0.0
         trees = trees if trees is not None else TreeCache()
-        self.tree, self.slack = trees.tree(hull, self.centroid, self.R_max)
+        self.levels = _tree_levels(hull, self.centroid, self.size, trees)
         # slab of the facet: unit normal at the centre, largest hull offset along it
-        n = _normalise(self._centre_normal(X if hull is nodes else X_nodes))
+        n = _normalise(_centre_normal(X if hull is nodes else X_nodes, self.nn, g))
         self.axis = np.stack(n, axis=1)
         thickness = np.abs(sum(offsets[0][k] * n[k] for k in range(g)))
         for d in offsets[1:]:
@@ -381,28 +538,6 @@ class _Master:
                 [x2[k] - x0[k] for k in range(3)],
                 [x0[k] - x1[k] - x2[k] + x3[k] for k in range(3)],
             ]
-
-    def _centre_normal(self, X: list[list[FloatArray]]) -> list[FloatArray]:
-        """Columns of the normal ``a1 x a2`` (2D: ``(a1[1], -a1[0])``) at the centre of each
-        facet, from the coordinate columns ``X[a][k]`` of its nodes."""
-        g = self.gdim
-        centre = 1.0 / 3.0 if self.kind == "triangle6" else 0.5
-        _, dN, _ = shape_functions(self.nn, g, np.full((1, self.fdim), centre))
-        a = [
-            [
-                sum(dN[0, n, alpha] * X[n][k] for n in range(self.nn) if dN[0, n, alpha] != 0)
-                for k in range(g)
-            ]
-            for alpha in range(self.fdim)
-        ]
-        if g == 2:
-            return [a[0][1], -a[0][0]]
-        a1, a2 = a
-        return [
-            a1[1] * a2[2] - a1[2] * a2[1],
-            a1[2] * a2[0] - a1[0] * a2[2],
-            a1[0] * a2[1] - a1[1] * a2[0],
-        ]
 
     def lower_bound(self, x: FloatArray, f: IntArray, pid: IntArray | None = None) -> FloatArray:
         """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``
@@ -677,16 +812,16 @@ class TreeCache:
         self.entries: OrderedDict[tuple[int, ...], tuple[FloatArray, cKDTree]] = OrderedDict()
 
     def tree(
-        self, nodes: FloatArray, centroid: FloatArray, R_max: float
+        self, nodes: FloatArray, centroid: FloatArray, R_max: float, level: int = 0
     ) -> tuple[cKDTree | None, float]:
-        """A KD-tree of centroids within ``slack`` of ``centroid``, and that slack.
+        """A KD-tree of centroids within ``slack`` of ``centroid`` and that slack.
 
         The centroid is the mean of the nodes, so it moves at most as far as the farthest
         node: a tree of earlier centroids serves with ``slack`` the largest node movement.
         """
         if len(nodes) == 0:
             return None, 0.0
-        key = nodes.shape
+        key = (*nodes.shape, level)
         entry = self.entries.get(key)
         if entry is not None:
             built, tree = entry
@@ -704,21 +839,19 @@ class TreeCache:
 
 
 def _candidates(
-    master: _Master, x: FloatArray, bound: FloatArray, active: IntArray
+    level: _TreeLevel, x: FloatArray, bound: FloatArray, active: IntArray
 ) -> tuple[IntArray, IntArray]:
-    """All (point, facet) pairs with the facet's centroid within ``bound`` of the point.
+    """All (point, facet) pairs with a centroid of the ``level`` within ``bound`` of the point.
 
     One ball query of the KD-tree per point, with the point's own bound (widened by the
     slack of a reused tree): no repeated K-nearest queries.
     """
     if active.size == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    lists = master.tree.query_ball_point(
-        x[active], bound[active] + master.slack, return_sorted=False
-    )
+    lists = level.tree.query_ball_point(x[active], bound[active] + level.slack, return_sorted=False)
     count = np.fromiter(map(len, lists), dtype=np.int64, count=len(lists))
     fid = np.fromiter(itertools.chain.from_iterable(lists), dtype=np.int64, count=count.sum())
-    return np.repeat(active, count), fid
+    return np.repeat(active, count), level.facet(fid)
 
 
 def _sliding(
@@ -733,31 +866,50 @@ def _sliding(
 ) -> FloatArray:
     """Linearisation matrix ``M`` of the closest points (see the module docstring)."""
     P, fdim = xi.shape
-    # A_ab = a_a . a_b - (x - y) . d(a_a)/d(xi^b),  d(a_a)/d(xi^b) = sum_n d2N_n x_n
-    curv = np.einsum("pnab,png->pabg", d2N, master.nodes[f])
-    A = np.einsum("pag,pbg->pab", a, a) - np.einsum("pg,pabg->pab", r, curv)
+    g = master.gdim
+    # A_ab = a_a . a_b - (x - y) . d(a_a)/d(xi^b),  d(a_a)/d(xi^b) = sum_n d2N_n x_n: zero
+    # on a straight facet but for the bilinear quadrilateral, whose only second derivative
+    # is d2y/ds dt = c3; the curvature term of a quadratic facet from d2N
+    col = [[a[:, i, k] for k in range(g)] for i in range(fdim)]
+    curvature = None
+    if master.kind in QUADRATIC:
+        curv = np.einsum("pnab,png->pabg", d2N, master.nodes[f])
+        curvature = np.einsum("pg,pabg->pab", r, curv)
     M = np.zeros((P, fdim, fdim))
     if fdim == 1:
-        interior = ~vertex
-        A11 = A[:, 0, 0]
-        ok = interior & (A11 != 0)
-        M[ok, 0, 0] = 1.0 / A11[ok]
+        A11 = sum(c * c for c in col[0])
+        if curvature is not None:
+            A11 = A11 - curvature[:, 0, 0]
+        ok = ~vertex & (A11 != 0)
+        M[:, 0, 0] = np.where(ok, 1.0 / np.where(ok, A11, 1.0), 0.0)
         return M
+    A00 = sum(c * c for c in col[0])
+    A11 = sum(c * c for c in col[1])
+    A01 = sum(c0 * c1 for c0, c1 in zip(col[0], col[1], strict=True))
+    if master.kind == "quadrilateral":
+        c3 = master.bilinear[3]
+        A01 = A01 - sum(r[:, k] * c3[k][f] for k in range(g))
+    if curvature is not None:
+        A00 = A00 - curvature[:, 0, 0]
+        A11 = A11 - curvature[:, 1, 1]
+        A01 = A01 - curvature[:, 0, 1]
     interior = (edge < 0) & ~vertex
-    det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+    det = A00 * A11 - A01 * A01
     ok = interior & (det != 0)
-    inv = 1.0 / det[ok]
-    M[ok, 0, 0] = A[ok, 1, 1] * inv
-    M[ok, 1, 1] = A[ok, 0, 0] * inv
-    M[ok, 0, 1] = -A[ok, 0, 1] * inv
-    M[ok, 1, 0] = -A[ok, 1, 0] * inv
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    M[:, 0, 0] = A11 * inv
+    M[:, 1, 1] = A00 * inv
+    M[:, 0, 1] = M[:, 1, 0] = -A01 * inv
     on_edge = (edge >= 0) & ~vertex
     if on_edge.any():
         tangents = np.array([np.subtract(e, s) for _, _, s, e in _EDGES[master.kind]])
-        t = tangents[edge[on_edge]]
-        tAt = np.einsum("pa,pab,pb->p", t, A[on_edge], t)
+        i = np.flatnonzero(on_edge)
+        t0, t1 = tangents[edge[i], 0], tangents[edge[i], 1]
+        tAt = t0 * (A00[i] * t0 + A01[i] * t1) + t1 * (A01[i] * t0 + A11[i] * t1)
         tAt = np.where(tAt != 0, tAt, np.inf)
-        M[on_edge] = t[:, :, None] * t[:, None, :] / tAt[:, None, None]
+        M[i, 0, 0] = t0 * t0 / tAt
+        M[i, 0, 1] = M[i, 1, 0] = t0 * t1 / tAt
+        M[i, 1, 1] = t1 * t1 / tAt
     return M
 
 
@@ -772,7 +924,7 @@ def _concatenate(a: _Pairs, b: _Pairs) -> _Pairs:
 
 
 def _nearest_admissible(
-    master: _Master,
+    level: _TreeLevel,
     x: FloatArray,
     active: IntArray,
     d: FloatArray,
@@ -780,9 +932,10 @@ def _nearest_admissible(
     reach0: float,
     admit: Admit,
 ) -> tuple[IntArray, BoolArray]:
-    """The admissible facet of the nearest centroid of each point ``x[active]``, and
-    whether there is one within ``reach0`` (the K nearest ``d, near`` first, then queries
-    of twice as many neighbours for the points that have none among them)."""
+    """The admissible facet of the nearest centroid of the ``level`` of each point
+    ``x[active]``, and whether there is one within ``reach0`` (the K nearest ``d, near``
+    first, then queries of twice as many neighbours for the points that have none among
+    them)."""
     nearest = np.zeros(active.size, dtype=np.int64)
     found = np.zeros(active.size, dtype=bool)
     rows = np.arange(active.size)
@@ -795,17 +948,50 @@ def _nearest_admissible(
         valid = d <= reach0
         r, c = np.nonzero(valid)
         ok = np.zeros(d.shape, dtype=bool)
-        ok[r, c] = admit(active[rows[r]], near[r, c])
+        ok[r, c] = admit(active[rows[r]], level.facet(near[r, c]))
         has = ok.any(axis=1)
-        nearest[rows[has]] = near[has, ok[has].argmax(axis=1)]
+        nearest[rows[has]] = level.facet(near[has, ok[has].argmax(axis=1)])
         found[rows[has]] = True
         # the points with no admissible facet among k neighbours all within reach0
         more = ~has & valid[:, -1]
-        if k >= master.nf or not more.any():
+        if k >= level.n or not more.any():
             return nearest, found
-        rows, start, k = rows[more], k, min(2 * k, master.nf)
-        d, near = master.tree.query(x[active[rows]], k=k, distance_upper_bound=reach0)
+        rows, start, k = rows[more], k, min(2 * k, level.n)
+        d, near = level.tree.query(x[active[rows]], k=k, distance_upper_bound=reach0)
         d, near = d.reshape(rows.size, k), near.reshape(rows.size, k)
+
+
+def _nearest(
+    master: _Master,
+    x: FloatArray,
+    queries: list[tuple[FloatArray, IntArray, float]],
+    admit: Admit | None,
+) -> tuple[IntArray, IntArray]:
+    """The points with a (admissible) centroid within the first bound of some level, and
+    the facet of the nearest such centroid (over the levels) of each.
+
+    ``queries``: per level of ``master.levels``, the distances and indices of the K nearest
+    centroids of each point and the bound of that query."""
+    npts = x.shape[0]
+    best = np.full(npts, np.inf)
+    nearest = np.full(npts, -1, dtype=np.int64)
+    for level, (d, near, reach0) in zip(master.levels, queries, strict=True):
+        rows = np.flatnonzero(d[:, 0] <= reach0)
+        if rows.size == 0:
+            continue
+        if admit is None:
+            facet = level.facet(near[rows, 0].astype(np.int64))
+            dist = d[rows, 0]
+        else:
+            # the bound d1 must come from an admissible facet (a point's own facet is at 0)
+            facet, found = _nearest_admissible(level, x, rows, d[rows], near[rows], reach0, admit)
+            rows, facet = rows[found], facet[found]
+            dist = np.linalg.norm(x[rows] - master.centroid[facet], axis=1)
+        closer = dist < best[rows]
+        best[rows[closer]] = dist[closer]
+        nearest[rows[closer]] = facet[closer]
+    active = np.flatnonzero(nearest >= 0)
+    return active, nearest[active]
 
 
 def _closest_block(
@@ -814,37 +1000,33 @@ def _closest_block(
     """Fill ``out`` (arrays of this block of points) with the closest points of ``x``, over
     the pairs that ``admit`` (block point indices, facets) accepts if it is given."""
     npts = x.shape[0]
-    # the K nearest centroids, where they can hold a facet point within the radius
-    reach0 = (radius + master.R_max + 2.0 * master.slack) * (1 + 1e-12)
-    K = min(_K[master.gdim], master.nf)
-    d, near = master.tree.query(x, k=K, distance_upper_bound=reach0)
-    d, near = d.reshape(npts, K), near.reshape(npts, K)
-    active = np.flatnonzero(d[:, 0] <= reach0)
+    # per level, the K nearest centroids, where they can hold a facet point within the radius
+    queries = []
+    for level in master.levels:
+        reach0 = (radius + level.R + 2.0 * level.slack) * (1 + 1e-12)
+        K = min(_K[master.gdim], level.n)
+        d, near = level.tree.query(x, k=K, distance_upper_bound=reach0)
+        queries.append((d.reshape(npts, K), near.reshape(npts, K), reach0))
+    active, nearest = _nearest(master, x, queries, admit)
     if active.size == 0:
         return
-    d, near = d[active], near[active].astype(np.int64)
-    if admit is None:
-        nearest = near[:, 0]
-    else:
-        # the bound d1 must come from an admissible facet (a point's own facet is at 0)
-        nearest, found = _nearest_admissible(master, x, active, d, near, reach0, admit)
-        active, d, near, nearest = active[found], d[found], near[found], nearest[found]
-        if active.size == 0:
-            return
     # an upper bound of the distance: the exact distance to the facet of the nearest centroid
     first = master.project(x[active], nearest, np.arange(active.size), active.size)
     d1 = np.full(npts, np.inf)
     d1[active] = first.dist
     reach = np.minimum(d1, radius)
-    # candidates: the centroids within reach + R_max, from the K found (a ball query for the
-    # points whose K-th neighbour is within it: they may have more)
-    bound = (reach + master.R_max) * (1 + 1e-12)
-    within = d <= (bound[active] + master.slack)[:, None]
-    cut = within[:, -1] if K < master.nf else np.zeros(active.size, dtype=bool)
-    rows, cols = np.nonzero(within & ~cut[:, None])
-    pid_ball, fid_ball = _candidates(master, x, bound, active[cut])
-    pid = np.concatenate([active[rows], pid_ball])
-    fid = np.concatenate([near[rows, cols], fid_ball])
+    # candidates: per level, the centroids within reach + R, from the K found (a ball query
+    # for the points whose K-th neighbour is within it: they may have more)
+    pid, fid = [], []
+    for level, (d, near, _) in zip(master.levels, queries, strict=True):
+        bound = (reach + level.R) * (1 + 1e-12)
+        within = d[active] <= (bound[active] + level.slack)[:, None]
+        cut = within[:, -1] if d.shape[1] < level.n else np.zeros(active.size, dtype=bool)
+        rows, cols = np.nonzero(within & ~cut[:, None])
+        pid_ball, fid_ball = _candidates(level, x, bound, active[cut])
+        pid += [active[rows], pid_ball]
+        fid += [level.facet(near[active[rows], cols].astype(np.int64)), fid_ball]
+    pid, fid = np.concatenate(pid), np.concatenate(fid)
     lower = master.lower_bound(x, fid, pid)
     keep = lower - 1e-9 * master.size[fid] <= reach[pid] * (1 + 1e-9)
     if admit is not None:
@@ -856,28 +1038,44 @@ def _closest_block(
     pid, fid = pid[keep], fid[keep]
     pairs = _concatenate(master.project(x[pid], fid, pid, npts), first)
     pid, fid = np.concatenate([pid, active]), np.concatenate([fid, nearest])
+    _select(master, x, radius, out, pid, fid, pairs)
 
+
+def _select(
+    master: _Master,
+    x: FloatArray,
+    radius: float,
+    out: Projection,
+    pid: IntArray,
+    fid: IntArray,
+    pairs: _Pairs,
+) -> None:
+    """Fill ``out`` with the closest point of each point ``x[pid]`` among its projected pairs
+    ``(pid, fid)`` (their projections ``pairs``), with the tie-break of :func:`closest_points`;
+    the points farther than ``radius`` from all their pairs are left unpaired."""
+    npts = x.shape[0]
     # minimum per point; ties (shared edges and vertices) go to the best-aligned normal
     dmin = np.full(npts, np.inf)
     np.minimum.at(dmin, pid, pairs.dist)
     tie = pairs.dist <= dmin[pid] + _TIE * (dmin[pid] + 2.0 * master.size[fid])
     e = np.flatnonzero(tie)
-    pe, fe, xi = pid[e], fid[e], pairs.xi[e]
+    pe = pid[e]
+    # a point with one pair within the tie tolerance takes it; the others break the tie
+    several = np.bincount(pe, minlength=npts)[pe] > 1
+    k = np.flatnonzero(~several)
+    if several.any():
+        tied = np.flatnonzero(several)
+        k = np.concatenate([k, tied[_tie_break(master, x, e[tied], pe[tied], fid, pairs)]])
+    e, pe = e[k], pe[k]
+    fe, xi = fid[e], pairs.xi[e]
     N, dN, d2N = shape_functions(master.nn, master.gdim, xi)
     X = master.nodes[fe]
     y = np.einsum("pn,png->pg", N, X)
     r = x[pe] - y
-    a = np.einsum("pna,png->pag", dN, X)
+    a = _tangents(dN, X)
     nu = _unit_normal(a)
     dist = np.linalg.norm(r, axis=1)
-    align = np.divide(np.abs(_dot(nu, r)), dist, out=np.zeros_like(dist), where=dist > 0)
-    # equal alignments: the nearer centroid, then the lower facet index
-    c = x[pe] - master.centroid[fe]
-    order = np.lexsort((fe, _dot(c, c), -align, pe))
-    head = np.ones(order.size, dtype=bool)
-    head[1:] = pe[order[1:]] != pe[order[:-1]]
-    k = order[head]
-    k = k[dist[k] <= radius]
+    k = np.flatnonzero(dist <= radius)
     p, f = pe[k], fe[k]
     out.facet[p] = f
     out.xi[p] = xi[k]
@@ -889,6 +1087,31 @@ def _closest_block(
     out.sliding[p] = _sliding(
         master, xi[k], a[k], r[k], d2N[k], f, pairs.edge[best], pairs.vertex[best]
     )
+
+
+def _tie_break(
+    master: _Master,
+    x: FloatArray,
+    e: IntArray,
+    pe: IntArray,
+    fid: IntArray,
+    pairs: _Pairs,
+) -> IntArray:
+    """Positions in ``e`` of the winners among the tied pairs ``e`` (of the points ``pe``,
+    several per point): the normal most aligned with ``x - y``, then the nearer centroid,
+    then the lower facet index."""
+    fe, xi = fid[e], pairs.xi[e]
+    N, dN, _ = shape_functions(master.nn, master.gdim, xi)
+    X = master.nodes[fe]
+    r = x[pe] - np.einsum("pn,png->pg", N, X)
+    nu = _unit_normal(_tangents(dN, X))
+    dist = np.linalg.norm(r, axis=1)
+    align = np.divide(np.abs(_dot(nu, r)), dist, out=np.zeros_like(dist), where=dist > 0)
+    c = x[pe] - master.centroid[fe]
+    order = np.lexsort((fe, _dot(c, c), -align, pe))
+    head = np.ones(order.size, dtype=bool)
+    head[1:] = pe[order[1:]] != pe[order[:-1]]
+    return order[head]
 
 
 def _check_self_contact(self_contact: SelfContact, npts: int, nf: int, gdim: int) -> None:
@@ -963,26 +1186,33 @@ def closest_points(
 
     Notes
     -----
-    Candidate search: a KD-tree of the facet centroids (the mean of the nodes; of a
-    quadratic facet, of its Bernstein control points, whose convex hull holds it); every
-    facet point is within ``R_f`` (the largest node, or control point, distance from the
-    centroid) of it, ``R_max = max R_f``. With ``d1 <= d0`` the exact distance of ``x`` to
-    the facet of its nearest centroid (``d0`` away, a query bounded by ``radius + R_max``),
-    the closest point is within ``r = min(d1, radius)`` of ``x``, so its facet has its
-    centroid within ``r + R_max`` (one ball query per point, with the point's own ``r``: the
-    work follows ``r``, not the search radius). The facets whose distance lower bound (node
+    Candidate search: KD-trees of the facet centroids (the mean of the nodes; of a quadratic
+    facet, of its Bernstein control points, whose convex hull holds it). Every facet point is
+    within ``R_f`` (the largest node, or control point, distance from the centroid) of it.
+    The facets are sorted by ``R_f`` into levels (radius ratio 4 between levels, the first up
+    to twice the median ``R_f``; an even mesh has one level), each with its KD-tree and its
+    largest radius ``R``. With ``d1 <= d0`` the exact distance of ``x`` to the facet of its
+    nearest centroid (``d0`` away over the levels, queries bounded by ``radius + R``), the
+    closest point is within ``r = min(d1, radius)`` of ``x``, so its facet has its centroid
+    within ``r + R`` of it in its level (one ball query per point and level, with the point's
+    own ``r``: the work follows ``r``, not the search radius, and a few large facets do not
+    widen the queries among the small ones). The facets whose distance lower bound (node
     sphere and slab along the normal at the centre) exceeds ``r`` are dropped, the others
-    projected exactly. Points with ``d0 > radius + R_max`` get ``facet = -1`` at once. The
-    KD-tree is reused from one call to the next while the master nodes (same array shape)
-    have moved less than ``0.25 R_max``, the bounds being widened by that movement. On a
-    master of over ``2^14`` facets the points are searched in the order of the cells of a
-    ``64^gdim`` grid over them (the results are returned in the order given): neighbouring
+    projected exactly. Points with ``d0 > radius + R`` in every level get ``facet = -1`` at
+    once. The KD-trees are reused from one call to the next while the master nodes (same
+    array shape) have moved less than ``0.25 R``, the bounds being widened by that movement.
+    On a master of over ``2^14`` facets the points are searched in the order of the cells of
+    a ``64^gdim`` grid over them (the results are returned in the order given): neighbouring
     points query the same branches of the tree and gather the same facets' data while they
     are in cache.
 
+    Self-contact on a surface of over 1024 facets: the points are searched by bins of their
+    normal, each against the facets of the bins that may face it only (see
+    :func:`_by_direction`); the admissible pairs, so the results, are those of one search.
+
     The work of a point grows with its distance ``D`` from the master surface, not with the
     search radius: its candidates are the facets with a centroid within ``min(D, radius) +
-    R_max`` (about ``D R_max / h^2`` of them on a surface of facet size ``h``).
+    R`` (about ``D R / h^2`` of them on a surface of facet size ``h``).
 
     When several facets are at the same distance up to ``1e-10 (distance + facet size)``
     (the point projects onto a shared edge or vertex), the facet whose normal is the most
@@ -1027,6 +1257,23 @@ def closest_points(
         return out
     if self_contact is not None:
         _check_self_contact(self_contact, npts, nf, gdim)
+        if nf > _DIRECTIONS_MIN:
+            _by_direction(points, nodes, radius, self_contact, out)
+            return out
+    _search(points, nodes, radius, trees if trees is not None else TreeCache(), self_contact, out)
+    return out
+
+
+def _search(
+    points: FloatArray,
+    nodes: FloatArray,
+    radius: float,
+    trees: TreeCache,
+    self_contact: SelfContact | None,
+    out: Projection,
+) -> None:
+    """Fill ``out`` with the closest points of :func:`closest_points` (checked input)."""
+    npts, nf = points.shape[0], nodes.shape[0]
     master = _Master(nodes, trees)
     # on a large master the points in the order of a grid of cells (neighbours searched
     # together: the KD-tree and the gathers of facet data stay in cache), results scattered
@@ -1044,4 +1291,3 @@ def closest_points(
     if order is not None:
         for k in _FIELDS:
             getattr(out, k)[order] = getattr(work, k)
-    return out
