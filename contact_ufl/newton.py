@@ -630,7 +630,7 @@ class NewtonSolver:
         if self.comm.allreduce(revisits, MPI.LOR):
             return (
                 "the contact pairing or status cycles: an iterate returns to the contact state "
-                "of an earlier one (active-set cycling)"
+                "of an earlier one (active-set cycling)" + self._normal_hint()
             )
         changed = np.array([a != b for a, b in zip(signatures, signatures[1:], strict=False)])
         changes = int(np.count_nonzero(self.comm.allreduce(changed.astype(np.int64), MPI.SUM)))
@@ -653,6 +653,26 @@ class NewtonSolver:
             else ""
         )
         return f"the residual does not converge (no inverted element, no contact cycling){fell}"
+
+    def _normal_hint(self) -> str:
+        """The hint for active-set cycling where a pair could have the smoothed master
+        normal and has the facet one (a solid master of a degree-1 displacement; the same on
+        every rank: the pairs are)."""
+        faceted = [
+            str(c.pair.master)
+            for c in self.problem.contacts
+            if not c.pair.on_obstacle
+            and c.pair.master_normal == "facet"
+            and not (c.master.two_sided or c.pair.self_contact)
+            and c.V.ufl_element().embedded_superdegree == 1
+        ]
+        if not faceted:
+            return ""
+        return (
+            f"; the master surface (tag {', '.join(faceted)}) has the facet normal, which jumps "
+            'at every facet edge: master_normal="smoothed" in its ContactPair removes those '
+            "jumps (continuous normal from facet to facet)"
+        )
 
     def _newton(self) -> tuple[int, int]:
         """One SNES solve from :attr:`x`: converged reason and iterations."""

@@ -21,13 +21,16 @@ def test_force_driven_record():
 
 
 def test_deep_indentation_record():
-    """The Hertz half disc pressed down by half its radius (coarse mesh, 4 steps, 3
-    cut-backs) stops before the end: the record keeps the accepted steps, names the step
-    and the DIVERGED_* reasons of the failed tries, and has one failure per cut-back."""
-    record = hard_cases.run_case(hard_cases.deep_indentation(0.05, steps=4, max_cutbacks=3))
+    """The Hertz half disc pressed down by half its radius with the facet master normal
+    asked for (coarse mesh, 4 steps, 3 cut-backs) stops before the end: the record keeps the
+    accepted steps, names the step and the DIVERGED_* reasons of the failed tries, and has
+    one failure per cut-back; the diagnosis points to the smoothed normal."""
+    case = hard_cases.deep_indentation(0.05, steps=4, max_cutbacks=3, master_normal="facet")
+    record = hard_cases.run_case(case)
     assert record["status"] == "stopped" and not record["all_converged"]
     assert 0.0 < record["t_reached"] < 1.0
     assert "did not converge" in record["error"]
+    assert 'master_normal="smoothed"' in record["diagnosis"]
     assert f"from t = {record['t_reached']:.6g}" in record["error"]
     assert record["steps"] >= 1 and record["cutbacks"] == len(record["failures"]) >= 4
     assert all(f["reason"].startswith("DIVERGED") for f in record["failures"])

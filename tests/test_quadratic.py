@@ -214,6 +214,14 @@ def test_unsupported_pairs(scene, degree, changes, message):
         ContactProblem(with_pair(scene, **changes), degree=degree, verbose=False)
 
 
+def test_default_master_normal_with_degree_2_is_the_facet_normal(scene):
+    """With a degree-2 displacement the default master normal is the quadratic facet's (the
+    smoothed one would be refused): the 2D pair builds."""
+    assert scene.contacts[0].master_normal is None
+    problem = ContactProblem(scene, degree=2, verbose=False)
+    assert problem.contacts[0].pair.master_normal == "facet"
+
+
 def test_linear_displacement_on_curved_geometry_is_rejected():
     """A degree-1 displacement on a degree-2 (curved) mesh: its facets are not given by
     displacement dofs."""

@@ -1,5 +1,6 @@
 """The smoothed master normal of 3D master surfaces: the fans of the facet nodes, the normal's
-continuity across facet edges, its NumPy twin against UFL, and the bound on the fan size."""
+continuity across facet edges, its NumPy twin against UFL, and the bound on the fan size; and
+the default master normal (smoothed in 2D, facet in 3D)."""
 
 import dataclasses
 
@@ -18,6 +19,8 @@ from contact_ufl.contact.master import (
     node_fans,
     smoothed_normals_3d,
 )
+from contact_ufl.contact.obstacles import RigidPlane
+from contact_ufl.contact.pair import ContactPair
 from contact_ufl.contact.projection import shape_functions
 from contact_ufl.errors import ContactInputError
 from contact_ufl.layout import StackedLayout
@@ -196,3 +199,37 @@ def test_smoothed_normal_twin_is_the_ufl_normal(cell):
 
     assert integral(twin) < 1e-24
     assert integral(facet) > 1e-6
+
+
+def test_default_master_normal_rule():
+    """``master_normal=None`` (the default) is the smoothed normal on a 2D solid master of
+    a degree-1 displacement, the facet normal in 3D, with degree 2, on a membrane, in
+    self-contact and on an obstacle; an explicit choice is kept."""
+    pair = ContactPair(1, 2)
+    assert pair.master_normal is None
+    assert pair.resolved_master_normal(2, 1, False) == "smoothed"
+    assert pair.resolved_master_normal(3, 1, False) == "facet"
+    assert pair.resolved_master_normal(2, 2, False) == "facet"
+    assert pair.resolved_master_normal(2, 1, True) == "facet"
+    assert ContactPair(1, 1).resolved_master_normal(2, 1, False) == "facet"
+    plane = RigidPlane((0.0, 0.0), (0.0, 1.0))
+    assert ContactPair(1, plane).resolved_master_normal(2, 1, False) == "facet"
+    for normal in ("facet", "smoothed"):
+        explicit = ContactPair(1, 2, master_normal=normal)
+        assert explicit.resolved_master_normal(2, 1, False) == normal
+        assert explicit.resolved_master_normal(3, 1, False) == normal
+    with pytest.raises(
+        ContactInputError, match="master_normal must be 'facet', 'smoothed' or None"
+    ):
+        ContactPair(1, 2, master_normal="nodal").validate(MPI.COMM_WORLD)
+
+
+@pytest.mark.parametrize("dim, expected", [(2, "smoothed"), (3, "facet")])
+def test_default_master_normal_of_a_problem(dim, expected):
+    """A problem resolves the default: its pair has the smoothed normal in 2D (gathering the
+    two neighbours of each segment: 4 nodes a point) and the facet normal in 3D."""
+    problem = ContactProblem(curved_pair(dim), verbose=False)
+    contact = problem.contacts[0]
+    assert contact.pair.master_normal == expected
+    assert contact.master.smoothed == (expected == "smoothed")
+    assert contact.master.nx == (4 if dim == 2 else contact.master.nn)

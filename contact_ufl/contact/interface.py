@@ -24,6 +24,8 @@ the problem maps them to the unknowns through the chain operator (:mod:`contact_
 
 from __future__ import annotations
 
+import dataclasses
+
 import basix
 import dolfinx
 import numpy as np
@@ -97,6 +99,7 @@ class ContactInterface:
         mesh = V.mesh
         comm = mesh.comm
         pair.validate(comm)
+        pair = with_master_normal(pair, u, facet_tags, master_u, master_facet_tags)
         self.u, self.V, self.pair = u, V, pair
         self.gdim = mesh.geometry.dim
         degree = V.ufl_element().embedded_superdegree
@@ -419,6 +422,26 @@ def check_degrees(
         "needs a degree-1 displacement: with degree 2 the master normal is that of the "
         'quadratic facet (master_normal="facet")',
     )
+
+
+def with_master_normal(
+    pair: ContactPair,
+    u: dolfinx.fem.Function,
+    facet_tags: dolfinx.mesh.MeshTags,
+    master_u: dolfinx.fem.Function | None,
+    master_facet_tags: dolfinx.mesh.MeshTags | None,
+) -> ContactPair:
+    """``pair`` with its master normal resolved (:meth:`.ContactPair.resolved_master_normal`:
+    the default ``None`` becomes ``"smoothed"`` or ``"facet"``)."""
+    master_u = u if master_u is None else master_u
+    tags = facet_tags if master_facet_tags is None else master_facet_tags
+    mesh = master_u.function_space.mesh
+    normal = pair.resolved_master_normal(
+        mesh.geometry.dim,
+        master_u.function_space.ufl_element().embedded_superdegree,
+        tags.dim == mesh.topology.dim,
+    )
+    return dataclasses.replace(pair, master_normal=normal)
 
 
 def default_eps(slave: SlaveSurface, modulus: float | None) -> float:

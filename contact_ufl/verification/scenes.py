@@ -363,6 +363,13 @@ def hertz_2d_driven(
         Initial gap between the disc and the block.
     h_contact
         Element size near the contact (0.2 far from it).
+
+    Notes
+    -----
+    The pair has the facet master normal (``master_normal="facet"``, not the 2D default):
+    with the smoothed normal the force-driven scene (h = 0.02, 2 steps, a contact zone of 4
+    to 8 points) took a cut-back at t = 1 (inverted elements in the Newton iterates) and
+    16 Newton iterations in its last step, against 7 and 4 with no cut-back.
     """
     if driven_by not in ("force", "displacement"):
         raise ValueError(f"driven_by must be 'force' or 'displacement', not {driven_by!r}")
@@ -379,7 +386,7 @@ def hertz_2d_driven(
     return Scene.from_mesh_data(
         mesh,
         bodies=[Body("cylinder", steel), Body("block", steel)],
-        contacts=[ContactPair("cylinder_contact", "block_contact")],
+        contacts=[ContactPair("cylinder_contact", "block_contact", master_normal="facet")],
         dirichlet=supports,
         loads=loads,
     )
