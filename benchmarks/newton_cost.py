@@ -8,7 +8,7 @@ made, so the set-up is not counted):
   steps), ``h_contact`` from 0.02 down to 0.0025;
 * 3D two-beam scene (:func:`contact_ufl.verification.scenes.beams`, hexahedra, three load
   steps to a third of the demo's load);
-* 3D Hertz, sphere on a block (:func:`contact_ufl.verification.scenes.hertz_3d`, P2
+* 3D Hertz, sphere on a block (:func:`contact_ufl.verification.scenes.hertz_3d`, P1
   tetrahedra, two load steps), ``h_contact`` 0.025 and 0.0125 (the benchmark's meshes).
 
 Each scene is solved again as a *bulk* problem on the same mesh with the contact pair removed
