@@ -205,6 +205,7 @@ class NewtonSolver:
         self._T_wide = None  # the superset operator of the solver matrix's pattern
         self._wide_keys = None  # sorted (row, column) keys of the couplings of the pattern
         self._wide_now = 0  # number of keys of the last superset (this rank)
+        self._wide_current = None  # sorted keys of the last superset operator
         self._gathers = None  # the parts of the problem that gather, and their gathers
         self._grow = True  # the pattern must grow before the next factorisation
         self.pattern_slack = 0.5
@@ -305,8 +306,12 @@ class NewtonSolver:
         """Where the current pairing's ``T`` is not within the solver matrix's pattern (or
         there is none yet): the superset operator of the pattern to add (collective)."""
         parts, gathers = self._gathers
-        if self._wide_keys is not None:
-            keys, wide = self._gather_keys(gathers), self._wide_keys
+        if self._wide_current is not None:
+            # within the *last* superset operator, not the union of those met: T^T K T is
+            # within the pattern of one operator that holds T, while a T whose rows gather
+            # from two different earlier operators couples columns that no single one of
+            # them couples (a new nonzero outside the pattern)
+            keys, wide = self._gather_keys(gathers), self._wide_current
             inside = len(keys) == 0 or (
                 len(wide) > 0 and bool(np.all(np.isin(keys, wide, assume_unique=True)))
             )
@@ -318,6 +323,7 @@ class NewtonSolver:
         ]
         self._T_wide = self._chain_operator(wide)
         keys = self._gather_keys(wide)
+        self._wide_current = keys
         self._wide_now = len(keys)
         old = self._wide_keys
         self._wide_keys = keys if old is None else np.union1d(old, keys)
@@ -436,7 +442,7 @@ class NewtonSolver:
         union, now = self.comm.allreduce(np.array([len(self._wide_keys), self._wide_now]))
         if union <= (1.0 + self.pattern_slack) * now:
             return
-        self._wide_keys = None
+        self._wide_keys = self._wide_current = None
         self._widen()
         J = self._grown_matrix(new=True)
         J.zeroEntries()
