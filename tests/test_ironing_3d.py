@@ -117,3 +117,17 @@ def test_no_published_numbers_are_invented():
     assert IRONING_3D["forces"] == {}
     assert IRONING_3D["status"].startswith("curves only")
     assert len(IRONING_3D["sources"]) >= 3
+
+
+def test_frictional_pressing_keeps_the_solver_pattern():
+    """Regression: the 3D ironing with mu = 0.3 on the quick mesh, pressed in 0.1 steps past
+    the seventh, where a pairing whose gathers lay in the union of two earlier patterns (but
+    in neither alone) put a new nonzero outside the solver matrix's pattern and stopped the
+    run. Every step converges, without cut-back."""
+    from contact_ufl.problem import ContactProblem
+
+    scene = scenes.ironing_3d(mu=0.3, h_die=0.6, h_slab=0.75)
+    problem = ContactProblem(scene, verbose=False, petsc_options={"snes_max_it": 40})
+    problem.solve(num_steps=8, t_end=0.8, max_cutbacks=0)
+    assert len(problem.history.steps) == 8
+    assert not problem.history.cutbacks
