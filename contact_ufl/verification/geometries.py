@@ -144,6 +144,12 @@ def _bbox(dim: int, tag: int) -> npt.NDArray[np.float64]:
     return np.asarray(gmsh.model.getBoundingBox(dim, tag)).reshape(2, 3)
 
 
+def _extent(dim: int, tag: int) -> npt.NDArray[np.float64]:
+    """Extent of the bounding box of an entity along each axis."""
+    lo, hi = _bbox(dim, tag)
+    return hi - lo
+
+
 def _flat(tag: int, tol: float) -> tuple[int, float] | None:
     """``(axis, coordinate)`` if the surface ``tag`` lies in a plane normal to an axis."""
     lo, hi = _bbox(2, tag)
@@ -172,9 +178,95 @@ def _divisions(length: float, h: float) -> int:
     return max(1, int(math.floor(length / h + 0.5)))
 
 
+def _generate(dim: int, order: int = 1) -> None:
+    """Mesh the model in dimension ``dim``, then raise it to the geometry ``order``."""
+    gmsh.model.mesh.generate(dim)
+    if order > 1:
+        gmsh.model.mesh.setOrder(order)
+
+
+def _sizes_per_body(dim: int, sizes: list[tuple[float, list[int]]]) -> None:
+    """A constant element size in each body: ``sizes`` lists ``(h, entities)`` of dimension
+    ``dim``; their minimum is the background field."""
+    _set_background([_restricted(_constant(h), dim, entities) for h, entities in sizes])
+
+
+def _structured(volumes: list[int], divisions: Callable[[int], int]) -> None:
+    """Transfinite hexahedra in ``volumes``: ``divisions(curve)`` element edges on each of
+    their curves, their faces recombined."""
+    for curve in _boundary(3, volumes, 1):
+        gmsh.model.mesh.setTransfiniteCurve(curve, divisions(curve) + 1)
+    for face in _boundary(3, volumes, 2):
+        gmsh.model.mesh.setTransfiniteSurface(face)
+        gmsh.model.mesh.setRecombine(2, face)
+    for volume in volumes:
+        gmsh.model.mesh.setTransfiniteVolume(volume)
+
+
+def _sort_faces(
+    volume: int, tol: float, names: dict[str, list[int]], curved: str, flat: tuple[str, ...]
+) -> None:
+    """Append each face of ``volume`` to a list of ``names``: a curved face to ``curved``, a
+    plane face normal to axis ``k`` to ``flat[k]``."""
+    for face in _boundary(3, [volume], 2):
+        plane = _flat(face, tol)
+        names[curved if plane is None else flat[plane[0]]].append(face)
+
+
+@dataclass(frozen=True)
+class _Grading:
+    """Element sizes graded about the point of first contact of two bodies: ``h_contact``
+    within ``refine_radius * radius`` of it (the master body ``master_ratio`` times coarser
+    there), growing to ``h_far`` over a further ``radius``."""
+
+    h_contact: float
+    h_far: float
+    master_ratio: float
+    refine_radius: float
+
+    def set_background(
+        self, distance: int, radius: float, dim: int, upper: list[int], lower: list[int]
+    ) -> None:
+        """The graded sizes about the ``distance`` field, in the ``upper`` (slave) and
+        ``lower`` (master) entities of dimension ``dim``, as the background field."""
+        d_min = self.refine_radius * radius
+        d_max = d_min + radius
+        fine = _threshold(distance, self.h_contact, self.h_far, d_min, d_max)
+        coarse = _threshold(distance, self.master_ratio * self.h_contact, self.h_far, d_min, d_max)
+        _set_background([_restricted(fine, dim, upper), _restricted(coarse, dim, lower)])
+
+
 # --------------------------------------------------------------------------------------------
 # 2D: half disc on a block (flat or curved top)
 # --------------------------------------------------------------------------------------------
+
+
+def _disc_sizes(
+    radius: float,
+    block: tuple[float, float],
+    h_contact: float | None,
+    h_far: float | None,
+    master_ratio: float,
+    refine_radius: float,
+    gap: float,
+    order: int,
+) -> tuple[_Grading, float, float]:
+    """The checked sizes of the half disc on a block (:func:`hertz_2d`): the grading (its
+    defaults filled in), the width and the height of the block."""
+    h_contact = 0.02 * radius if h_contact is None else h_contact
+    h_far = 0.2 * radius if h_far is None else h_far
+    width, height = block
+    _check_positive(
+        radius=radius,
+        width=width,
+        height=height,
+        h_contact=h_contact,
+        h_far=h_far,
+        master_ratio=master_ratio,
+        refine_radius=refine_radius,
+    )
+    _check_common(gap, order)
+    return _Grading(h_contact, h_far, master_ratio, refine_radius), width, height
 
 
 def _disc_on_block(
@@ -183,10 +275,7 @@ def _disc_on_block(
     width: float,
     height: float,
     lower_radius: float | None,
-    h_contact: float,
-    h_far: float,
-    master_ratio: float,
-    refine_radius: float,
+    grading: _Grading,
     order: int,
     x_disc: float = 0.0,
 ) -> None:
@@ -241,14 +330,8 @@ def _disc_on_block(
     )
     distance = gmsh.model.mesh.field.add("Distance")
     gmsh.model.mesh.field.setNumbers(distance, "PointsList", [p_bottom])
-    d_min = refine_radius * R
-    d_max = d_min + R
-    upper = _threshold(distance, h_contact, h_far, d_min, d_max)
-    lower = _threshold(distance, master_ratio * h_contact, h_far, d_min, d_max)
-    _set_background([_restricted(upper, 2, [disc]), _restricted(lower, 2, [block])])
-    gmsh.model.mesh.generate(2)
-    if order > 1:
-        gmsh.model.mesh.setOrder(order)
+    grading.set_background(distance, R, 2, [disc], [block])
+    _generate(2, order)
 
 
 def hertz_2d(
@@ -307,34 +390,11 @@ def hertz_2d(
         (lower arc, 11), ``"cylinder_top"`` (diameter, 12), ``"block_contact"`` (top edge, 13),
         ``"block_bottom"`` (14), ``"block_sides"`` (left and right, 15).
     """
-    h_contact = 0.02 * radius if h_contact is None else h_contact
-    h_far = 0.2 * radius if h_far is None else h_far
-    width, height = block
-    _check_positive(
-        radius=radius,
-        width=width,
-        height=height,
-        h_contact=h_contact,
-        h_far=h_far,
-        master_ratio=master_ratio,
-        refine_radius=refine_radius,
-    )
-    _check_common(gap, order)
+    sizes = radius, block, h_contact, h_far, master_ratio, refine_radius, gap, order
+    grading, width, height = _disc_sizes(*sizes)
 
     def build() -> None:
-        _disc_on_block(
-            radius,
-            gap,
-            width,
-            height,
-            None,
-            h_contact,
-            h_far,
-            master_ratio,
-            refine_radius,
-            order,
-            x_disc,
-        )
+        _disc_on_block(radius, gap, width, height, None, grading, order, x_disc)
 
     return generate_mesh(comm, "hertz_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
 
@@ -376,20 +436,9 @@ def curved_2d(
     MeshData
         The names and values of :func:`hertz_2d`; ``"block_contact"`` is the top arc.
     """
-    h_contact = 0.02 * radius if h_contact is None else h_contact
-    h_far = 0.2 * radius if h_far is None else h_far
+    sizes = radius, block, h_contact, h_far, master_ratio, refine_radius, gap, order
+    grading, width, height = _disc_sizes(*sizes)
     lower_radius = 3.0 * radius if lower_radius is None else lower_radius
-    width, height = block
-    _check_positive(
-        radius=radius,
-        width=width,
-        height=height,
-        h_contact=h_contact,
-        h_far=h_far,
-        master_ratio=master_ratio,
-        refine_radius=refine_radius,
-    )
-    _check_common(gap, order)
     R2 = abs(lower_radius)
     if not 0.5 * width < R2:
         raise ValueError(f"need width / 2 < |lower_radius|, got {width}, {lower_radius}")
@@ -399,18 +448,7 @@ def curved_2d(
         raise ValueError("the top arc of the lower body goes below its bottom: increase height")
 
     def build() -> None:
-        _disc_on_block(
-            radius,
-            gap,
-            width,
-            height,
-            lower_radius,
-            h_contact,
-            h_far,
-            master_ratio,
-            refine_radius,
-            order,
-        )
+        _disc_on_block(radius, gap, width, height, lower_radius, grading, order)
 
     return generate_mesh(comm, "curved_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
 
@@ -508,15 +546,8 @@ def patch_2d(
             tdim=2,
         )
         # interior sizes of the unstructured triangles
-        _set_background(
-            [
-                _restricted(_constant(h_upper), 2, [up]),
-                _restricted(_constant(h_lower), 2, [lo]),
-            ]
-        )
-        gmsh.model.mesh.generate(2)
-        if order > 1:
-            gmsh.model.mesh.setOrder(order)
+        _sizes_per_body(2, [(h_upper, [up]), (h_lower, [lo])])
+        _generate(2, order)
 
     return generate_mesh(comm, "patch_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
 
@@ -590,14 +621,7 @@ def patch_3d(
         fu, fl = classify(up, gap), classify(lo, -height)
         if cell == "hexahedron":
             for volume, h in ((up, h_upper), (lo, h_lower)):
-                for c in _boundary(3, [volume], 1):
-                    lo_, hi_ = _bbox(1, c)
-                    n = _divisions(float(np.max(hi_ - lo_)), h)
-                    gmsh.model.mesh.setTransfiniteCurve(c, n + 1)
-                for face in _boundary(3, [volume], 2):
-                    gmsh.model.mesh.setTransfiniteSurface(face)
-                    gmsh.model.mesh.setRecombine(2, face)
-                gmsh.model.mesh.setTransfiniteVolume(volume)
+                _structured([volume], lambda c, h=h: _divisions(float(np.max(_extent(1, c))), h))
         _add_groups(
             [
                 ("upper", 3, [up]),
@@ -606,26 +630,16 @@ def patch_3d(
                 ("lower_contact", 2, [fl["z1"]]),
                 ("upper_top", 2, [fu["z1"]]),
                 ("lower_bottom", 2, [fl["z0"]]),
-                ("upper_x0", 2, [fu["x0"]]),
-                ("lower_x0", 2, [fl["x0"]]),
-                ("upper_y0", 2, [fu["y0"]]),
-                ("lower_y0", 2, [fl["y0"]]),
-                ("upper_x1", 2, [fu["x1"]]),
-                ("lower_x1", 2, [fl["x1"]]),
-                ("upper_y1", 2, [fu["y1"]]),
-                ("lower_y1", 2, [fl["y1"]]),
+            ]
+            + [
+                (f"{body}_{side}", 2, [faces[side]])
+                for side in ("x0", "y0", "x1", "y1")
+                for body, faces in (("upper", fu), ("lower", fl))
             ],
             tdim=3,
         )
-        _set_background(
-            [
-                _restricted(_constant(h_upper), 3, [up]),
-                _restricted(_constant(h_lower), 3, [lo]),
-            ]
-        )
-        gmsh.model.mesh.generate(3)
-        if order > 1:
-            gmsh.model.mesh.setOrder(order)
+        _sizes_per_body(3, [(h_upper, [up]), (h_lower, [lo])])
+        _generate(3, order)
 
     return generate_mesh(comm, "patch_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
 
@@ -737,36 +751,17 @@ def cylinders_3d(
             "upper_ends": [],
             "lower_sides": [],
         }
-        for face in _boundary(3, [up], 2):
-            flat = _flat(face, tol)
-            if flat is not None and flat[0] == 2:
-                names["upper_top"].append(face)
-            elif flat is not None:
-                names["upper_ends"].append(face)
-            else:
-                names["upper_contact"].append(face)
-        for face in _boundary(3, [lo], 2):
-            flat = _flat(face, tol)
-            if flat is not None and flat[0] == 2:
-                names["lower_bottom"].append(face)
-            elif flat is not None:
-                names["lower_sides"].append(face)
-            else:
-                names["lower_contact"].append(face)
+        _sort_faces(up, tol, names, "upper_contact", ("upper_ends", "upper_ends", "upper_top"))
+        sides = ("lower_sides", "lower_sides", "lower_bottom")
+        _sort_faces(lo, tol, names, "lower_contact", sides)
         _add_groups(
             [("upper", 3, [up]), ("lower", 3, [lo])]
             + [(key, 2, value) for key, value in names.items()],
             tdim=3,
         )
-        distance = _distance_to((0.0, 0.0, gap))
-        d_min = refine_radius * R
-        d_max = d_min + R
-        upper = _threshold(distance, h_contact, h_far, d_min, d_max)
-        lower = _threshold(distance, master_ratio * h_contact, h_far, d_min, d_max)
-        _set_background([_restricted(upper, 3, [up]), _restricted(lower, 3, [lo])])
-        gmsh.model.mesh.generate(3)
-        if order > 1:
-            gmsh.model.mesh.setOrder(order)
+        grading = _Grading(h_contact, h_far, master_ratio, refine_radius)
+        grading.set_background(_distance_to((0.0, 0.0, gap)), R, 3, [up], [lo])
+        _generate(3, order)
 
     return generate_mesh(comm, "cylinders_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
 
@@ -829,19 +824,13 @@ def hemisphere_3d(
         names: dict[str, list[int]] = {"indenter_contact": [], "indenter_top": []}
         if quarter:
             names.update({"indenter_x0": [], "indenter_y0": []})
-        for face in _boundary(3, [body], 2):
-            flat = _flat(face, tol)
-            if flat is None:
-                names["indenter_contact"].append(face)
-            else:
-                names[("indenter_x0", "indenter_y0", "indenter_top")[flat[0]]].append(face)
+        flat = ("indenter_x0", "indenter_y0", "indenter_top")
+        _sort_faces(body, tol, names, "indenter_contact", flat)
         _add_groups([("indenter", 3, [body])] + [(k, 2, v) for k, v in names.items()], tdim=3)
         distance = _distance_to((0.0, 0.0, gap))
         d_min = refine_radius * R
         _set_background([_threshold(distance, h_contact, h_far, d_min, d_min + R)])
-        gmsh.model.mesh.generate(3)
-        if order > 1:
-            gmsh.model.mesh.setOrder(order)
+        _generate(3, order)
 
     return generate_mesh(
         comm, "hemisphere_3d", build, 3, _mesh_options(order), msh_file, ghost_mode
@@ -946,7 +935,7 @@ def ironing_2d(
         _set_background(
             [_restricted(_constant(h_punch), 2, [punch]), _restricted(lower, 2, [body])]
         )
-        gmsh.model.mesh.generate(2)
+        _generate(2)
 
     return generate_mesh(comm, "ironing_2d", build, 2, _mesh_options(1), msh_file, ghost_mode)
 
@@ -1007,12 +996,7 @@ def ironing_3d(
             "die_contact": [], "die_top": [], "slab_contact": [], "slab_bottom": [],
             "slab_sides": [], "die_ends": [],
         }  # fmt: skip
-        for face in _boundary(3, [die], 2):
-            flat = _flat(face, tol)
-            if flat is None:
-                names["die_contact"].append(face)
-            else:
-                names["die_top" if flat[0] == 2 else "die_ends"].append(face)
+        _sort_faces(die, tol, names, "die_contact", ("die_ends", "die_ends", "die_top"))
         for face in _boundary(3, [slab_v], 2):
             axis, coord = _flat(face, tol)
             if axis == 2:
@@ -1024,13 +1008,8 @@ def ironing_3d(
             + [(key, 2, value) for key, value in names.items()],
             tdim=3,
         )
-        _set_background(
-            [
-                _restricted(_constant(h_die), 3, [die]),
-                _restricted(_constant(h_slab), 3, [slab_v]),
-            ]
-        )
-        gmsh.model.mesh.generate(3)
+        _sizes_per_body(3, [(h_die, [die]), (h_slab, [slab_v])])
+        _generate(3)
 
     return generate_mesh(comm, "ironing_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)
 
@@ -1153,6 +1132,18 @@ def beams_3d(
                 return f
         raise RuntimeError(f"volume {volume} has no face at x[{axis}] = {coord}")
 
+    def divisions_of(curve: int, sizes: tuple[float, float, float], odd_across: bool) -> int:
+        """Element edges on ``curve`` of element ``sizes`` along the axes."""
+        extent = _extent(1, curve)
+        axis = int(np.argmax(extent))
+        n = _divisions(extent[axis], sizes[axis])
+        if odd_across and axis == 1:
+            # an odd number of master facets across the width: the plane of symmetry
+            # y = width / 2, where the slave sits, is inside a facet and not on an
+            # edge (the faceted master normal jumps there)
+            n += 1 - n % 2
+        return n
+
     def build() -> None:
         occ = gmsh.model.occ
         # each beam in two boxes, so that the contact surfaces are faces of their own
@@ -1175,21 +1166,7 @@ def beams_3d(
             (lower, (h_lower, master_ratio * h_width, g.height / divisions), True),
             (upper, (h_upper, h_width, g.height / divisions), False),
         ):
-            for c in _boundary(3, volumes, 1):
-                extent = np.ptp(_bbox(1, c), axis=0)
-                axis = int(np.argmax(extent))
-                n = _divisions(extent[axis], sizes[axis])
-                if odd_across and axis == 1:
-                    # an odd number of master facets across the width: the plane of symmetry
-                    # y = width / 2, where the slave sits, is inside a facet and not on an
-                    # edge (the faceted master normal jumps there)
-                    n += 1 - n % 2
-                gmsh.model.mesh.setTransfiniteCurve(c, n + 1)
-            for f in _boundary(3, volumes, 2):
-                gmsh.model.mesh.setTransfiniteSurface(f)
-                gmsh.model.mesh.setRecombine(2, f)
-            for v in volumes:
-                gmsh.model.mesh.setTransfiniteVolume(v)
+            _structured(volumes, lambda c, s=sizes, odd=odd_across: divisions_of(c, s, odd))
         _add_groups(
             [
                 ("upper", 3, upper),
@@ -1202,7 +1179,7 @@ def beams_3d(
             ],
             tdim=3,
         )
-        gmsh.model.mesh.generate(3)
+        _generate(3)
 
     return generate_mesh(comm, "beams_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)
 
@@ -1456,9 +1433,7 @@ def sphere_on_block_3d(
                 fields.append(_restricted(coarse_ring, 3, list(pieces)))
         _add_groups(groups, tdim=3)
         _set_background(fields)
-        gmsh.model.mesh.generate(3)
-        if order > 1:
-            gmsh.model.mesh.setOrder(order)
+        _generate(3, order)
 
     return generate_mesh(
         comm, "sphere_on_block_3d", build, 3, _mesh_options(order), msh_file, ghost_mode
