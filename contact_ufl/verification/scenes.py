@@ -17,7 +17,7 @@ from mpi4py import MPI
 from contact_ufl.contact import ContactPair, RigidPlane, RigidSphere
 from contact_ufl.gmshio import MeshData
 from contact_ufl.loads import DeadTraction, Dirichlet, FollowerForce
-from contact_ufl.materials import LinearElastic, NeoHookean
+from contact_ufl.materials import Hyperelastic, LinearElastic, NeoHookean
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.scene import Body, Domain, Scene
 from contact_ufl.verification import geometries
@@ -28,6 +28,18 @@ def rotation_2d(angle: float) -> np.ndarray:
     """The 2x2 rotation matrix of ``angle`` (radians)."""
     c, s = np.cos(angle), np.sin(angle)
     return np.array([[c, -s], [s, c]])
+
+
+def _solids(**materials: Hyperelastic | J2Plasticity) -> list[Body]:
+    """One body per cell group (``group=material``), named after its group."""
+    return [Body(group, material, group) for group, material in materials.items()]
+
+
+def _on_rigid_flat(scene: Scene) -> Scene:
+    """``scene`` with the master surface of its contact pair made the rigid plane ``y = 0``
+    (:class:`~contact_ufl.contact.obstacles.RigidPlane`, normal ``+y``)."""
+    pair = dataclasses.replace(scene.contacts[0], master=RigidPlane((0.0, 0.0), (0.0, 1.0)))
+    return dataclasses.replace(scene, contacts=[pair])
 
 
 @dataclass
@@ -104,34 +116,25 @@ def hertz_2d(
         refine_radius=refine_radius,
         comm=comm,
     )
-    tags = sm.tags
     R = rotation_2d(rotation)
     sm.mesh.geometry.x[:, :2] = sm.mesh.geometry.x[:, :2] @ R.T
-    scene = Scene(
-        sm.mesh,
-        sm.cell_tags,
-        sm.facet_tags,
-        bodies=[
-            Body(tags["cylinder"], NeoHookean(E, nu), "cylinder"),
-            Body(tags["block"], NeoHookean(E_flat, nu_flat), "block"),
-        ],
-        contacts=[
-            ContactPair(
-                tags["cylinder_contact"],
-                tags["block_contact"],
-                eps_N=eps_factor * E / h_contact,
-                mu=mu,
-                quadrature_degree=quadrature_degree,
-            )
-        ],
+    pair = ContactPair(
+        "cylinder_contact",
+        "block_contact",
+        eps_N=eps_factor * E / h_contact,
+        mu=mu,
+        quadrature_degree=quadrature_degree,
+    )
+    scene = Scene.from_mesh_data(
+        sm,
+        bodies=_solids(cylinder=NeoHookean(E, nu), block=NeoHookean(E_flat, nu_flat)),
+        contacts=[pair],
         dirichlet=[
-            Dirichlet(tags["block_bottom"], (0.0, 0.0)),
+            Dirichlet("block_bottom", (0.0, 0.0)),
             Dirichlet(
-                tags["cylinder_top"],
-                lambda t: R @ (shift * max(t - 1.0, 0.0), -depth * min(t, 1.0)),
+                "cylinder_top", lambda t: R @ (shift * max(t - 1.0, 0.0), -depth * min(t, 1.0))
             ),
         ],
-        tags=tags,
     )
     return HertzScene(scene, 1.0, plane_strain_modulus(E, nu, E_flat, nu_flat), h_contact)
 
@@ -309,32 +312,25 @@ def patch(
     else:
         sm = geometries.patch_3d(cell=cell or "tetrahedron", comm=comm, **mesh_options)
         sides = {0: ("upper_x0", "lower_x0"), 1: ("upper_y0", "lower_y0")}
-    tags = sm.tags
     material = NeoHookean(E, nu)
     traction = np.zeros(dim)
     traction[-1] = -pressure
-    supports = [Dirichlet(tags["lower_bottom"], 0.0, component=dim - 1)]
-    supports += [
-        Dirichlet(tags[name], 0.0, component=k) for k, names in sides.items() for name in names
-    ]
-    return Scene(
-        sm.mesh,
-        sm.cell_tags,
-        sm.facet_tags,
-        bodies=[Body(tags["upper"], material, "upper"), Body(tags["lower"], material, "lower")],
-        contacts=[
-            ContactPair(
-                tags["upper_contact"],
-                tags["lower_contact"],
-                eps_N=10.0 * E,
-                mu=mu,
-                quadrature_degree=quadrature_degree,
-                quadrature_subdivisions=subdivisions,
-            )
-        ],
+    supports = [Dirichlet("lower_bottom", 0.0, component=dim - 1)]
+    supports += [Dirichlet(name, 0.0, component=k) for k, names in sides.items() for name in names]
+    pair = ContactPair(
+        "upper_contact",
+        "lower_contact",
+        eps_N=10.0 * E,
+        mu=mu,
+        quadrature_degree=quadrature_degree,
+        quadrature_subdivisions=subdivisions,
+    )
+    return Scene.from_mesh_data(
+        sm,
+        bodies=_solids(upper=material, lower=material),
+        contacts=[pair],
         dirichlet=supports,
-        loads=[DeadTraction(tags["upper_top"], lambda t: traction * t)],
-        tags=tags,
+        loads=[DeadTraction("upper_top", lambda t: traction * t)],
     )
 
 
@@ -445,17 +441,13 @@ def curved_pair(
     else:
         sm = geometries.cylinders_3d(h_contact=0.15, h_far=0.4, order=order, comm=comm)
         names = ("upper", "lower", "upper_contact", "lower_contact")
-    tags = sm.tags
-    return Scene(
-        sm.mesh,
-        sm.cell_tags,
-        sm.facet_tags,
+    return Scene.from_mesh_data(
+        sm,
         bodies=[
-            Body(tags[names[0]], NeoHookean(E, nu), "upper"),
-            Body(tags[names[1]], NeoHookean(E, nu), "lower"),
+            Body(names[0], NeoHookean(E, nu), "upper"),
+            Body(names[1], NeoHookean(E, nu), "lower"),
         ],
-        contacts=[ContactPair(tags[names[2]], tags[names[3]], eps_N=eps_N)],
-        tags=tags,
+        contacts=[ContactPair(names[2], names[3], eps_N=eps_N)],
     )
 
 
@@ -551,33 +543,23 @@ def ironing(
     default (the punch slides over many master vertices).
     """
     sm = geometries.ironing_2d(h_punch=h_punch, h_block=h_block, comm=comm)
-    tags = sm.tags
     E_block, E_punch, nu = 6.896e8, 6.896e9, 0.32
-    return Scene(
-        sm.mesh,
-        sm.cell_tags,
-        sm.facet_tags,
-        bodies=[
-            Body(tags["punch"], NeoHookean(E_punch, nu), "punch"),
-            Body(tags["block"], NeoHookean(E_block, nu), "block"),
-        ],
-        contacts=[
-            ContactPair(
-                tags["punch_contact"],
-                tags["block_contact"],
-                eps_N=E_block / h_block,
-                mu=mu,
-                search_radius=1.0,
-                master_normal=master_normal,
-            )
-        ],
+    pair = ContactPair(
+        "punch_contact",
+        "block_contact",
+        eps_N=E_block / h_block,
+        mu=mu,
+        search_radius=1.0,
+        master_normal=master_normal,
+    )
+    return Scene.from_mesh_data(
+        sm,
+        bodies=_solids(punch=NeoHookean(E_punch, nu), block=NeoHookean(E_block, nu)),
+        contacts=[pair],
         dirichlet=[
-            Dirichlet(tags["block_bottom"], (0.0, 0.0)),
-            Dirichlet(
-                tags["punch_top"], lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0))
-            ),
+            Dirichlet("block_bottom", (0.0, 0.0)),
+            Dirichlet("punch_top", lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0))),
         ],
-        tags=tags,
     )
 
 
@@ -619,37 +601,26 @@ def ironing_3d(
     if slave not in ("slab", "die"):
         raise ValueError(f"slave must be 'slab' or 'die', got {slave!r}")
     sm = geometries.ironing_3d(h_die=h_die, h_slab=h_slab, comm=comm)
-    tags = sm.tags
     E_slab = 1.0
-    surfaces = [tags["slab_contact"], tags["die_contact"]]
+    surfaces = ["slab_contact", "die_contact"]
     if slave == "die":
         surfaces.reverse()
-    return Scene(
-        sm.mesh,
-        sm.cell_tags,
-        sm.facet_tags,
-        bodies=[
-            Body(tags["die"], NeoHookean(1000.0 * E_slab, 0.499), "die"),
-            Body(tags["slab"], NeoHookean(E_slab, 0.3), "slab"),
-        ],
-        contacts=[
-            ContactPair(
-                *surfaces,
-                eps_N=E_slab / h_slab,
-                mu=mu,
-                search_radius=1.0,
-                quadrature_degree=quadrature_degree,
-                master_normal=master_normal,
-            )
-        ],
+    pair = ContactPair(
+        *surfaces,
+        eps_N=E_slab / h_slab,
+        mu=mu,
+        search_radius=1.0,
+        quadrature_degree=quadrature_degree,
+        master_normal=master_normal,
+    )
+    return Scene.from_mesh_data(
+        sm,
+        bodies=_solids(die=NeoHookean(1000.0 * E_slab, 0.499), slab=NeoHookean(E_slab, 0.3)),
+        contacts=[pair],
         dirichlet=[
-            Dirichlet(tags["slab_bottom"], (0.0, 0.0, 0.0)),
-            Dirichlet(
-                tags["die_top"],
-                lambda t: (slide * max(t - 1.0, 0.0), 0.0, -depth * min(t, 1.0)),
-            ),
+            Dirichlet("slab_bottom", (0.0, 0.0, 0.0)),
+            Dirichlet("die_top", lambda t: (slide * max(t - 1.0, 0.0), 0.0, -depth * min(t, 1.0))),
         ],
-        tags=tags,
     )
 
 
@@ -739,33 +710,25 @@ def beams(
     """
     geometry = geometry or geometries.BeamPair()
     sm = geometries.beams_3d(geometry, divisions=divisions, comm=comm)
-    tags = sm.tags
     material = NeoHookean(E, nu)
     EI = E * geometry.width * geometry.height**3 / 12.0
     P_end = load * EI / geometry.length**2
     h = geometry.height / divisions
-    scene = Scene(
-        sm.mesh,
-        sm.cell_tags,
-        sm.facet_tags,
-        bodies=[Body(tags["upper"], material, "upper"), Body(tags["lower"], material, "lower")],
-        contacts=[
-            ContactPair(
-                tags["upper_contact"],
-                tags["lower_contact"],
-                eps_N=eps_factor * E / h,
-                mu=mu,
-                search_radius=geometry.gap + geometry.height,
-                quadrature_degree=3,
-                quadrature_rule="lobatto",
-            )
-        ],
-        dirichlet=[
-            Dirichlet(tags["upper_clamp"], (0.0, 0.0, 0.0)),
-            Dirichlet(tags["lower_clamp"], (0.0, 0.0, 0.0)),
-        ],
-        loads=[FollowerForce(tags["upper_tip"], lambda t: P_end * t, (0.0, 0.0, -1.0))],
-        tags=tags,
+    pair = ContactPair(
+        "upper_contact",
+        "lower_contact",
+        eps_N=eps_factor * E / h,
+        mu=mu,
+        search_radius=geometry.gap + geometry.height,
+        quadrature_degree=3,
+        quadrature_rule="lobatto",
+    )
+    scene = Scene.from_mesh_data(
+        sm,
+        bodies=_solids(upper=material, lower=material),
+        contacts=[pair],
+        dirichlet=[Dirichlet(clamp, (0.0, 0.0, 0.0)) for clamp in ("upper_clamp", "lower_clamp")],
+        loads=[FollowerForce("upper_tip", lambda t: P_end * t, (0.0, 0.0, -1.0))],
     )
     return BeamsScene(scene, geometry, E, nu, load)
 
@@ -786,10 +749,7 @@ def hertz_on_rigid_flat(
     involves it); ``E* = E / (1 - nu^2)`` (Johnson 1985, 4.2, with a rigid flat).
     """
     hertz = hertz_2d(h_contact=h_contact, depth=depth, E=E, nu=nu, comm=comm)
-    scene = hertz.scene
-    pair = dataclasses.replace(scene.contacts[0], master=RigidPlane((0.0, 0.0), (0.0, 1.0)))
-    scene = dataclasses.replace(scene, contacts=[pair])
-    return HertzScene(scene, 1.0, E / (1.0 - nu**2), h_contact)
+    return HertzScene(_on_rigid_flat(hertz.scene), 1.0, E / (1.0 - nu**2), h_contact)
 
 
 def block_under_circle(
@@ -842,9 +802,7 @@ def pushed_block_on_plane(
     lower block stays, clamped and unloaded (no pair involves it). With ``nu > 0`` the
     pressed block widens on the rigid flat, so its edges slip already while it is pressed;
     with ``nu = 0`` it sticks everywhere until the push nears ``mu`` times the load."""
-    scene = pushed_block(mu=mu, pressure=pressure, push=push, nu=nu, comm=comm)
-    pair = dataclasses.replace(scene.contacts[0], master=RigidPlane((0.0, 0.0), (0.0, 1.0)))
-    return dataclasses.replace(scene, contacts=[pair])
+    return _on_rigid_flat(pushed_block(mu=mu, pressure=pressure, push=push, nu=nu, comm=comm))
 
 
 def on_meshes_of_their_own(scene: Scene) -> Scene:
