@@ -2,10 +2,12 @@
 
 import gc
 
+import numpy as np
 import pytest
 from mpi4py import MPI
 
 from contact_ufl.problem import ContactProblem
+from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import scenes
 
 
@@ -27,6 +29,29 @@ def hertz_sequence():
 def hertz_moderate(hertz_sequence):
     """Hertz at a/h ~ 10 (the accuracy target mesh)."""
     return hertz_sequence[-1]
+
+
+def assert_taylor_slopes(
+    problem,
+    dz,
+    steps,
+    slope: float = 2.0,
+    tol: float = 0.01,
+    unchanged: bool = True,
+    zeroth: bool = False,
+):
+    """Run the Taylor test of ``problem`` along ``dz`` with the ``steps``; assert that every
+    slope of the remainder is ``slope`` within ``tol``, with ``unchanged`` that no point
+    changed facet or contact status over the steps, and with ``zeroth`` that the zeroth-order
+    remainder falls with slope 1 (within 0.05). Returns the result."""
+    result = taylor_test(problem, dz, steps)
+    if unchanged:
+        assert not result.facets_changed and not result.active_changed
+    if zeroth:
+        zeroth_slopes = np.diff(np.log(result.zeroth)) / np.diff(np.log(result.h))
+        assert np.all(np.abs(zeroth_slopes - 1.0) < 0.05)
+    assert np.all(np.abs(result.slopes - slope) < tol), result.slopes
+    return result
 
 
 def tagged_unit_square(n: int = 4, cell_type=None):
