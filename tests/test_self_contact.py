@@ -5,6 +5,7 @@ import basix.ufl
 import dolfinx
 import numpy as np
 import pytest
+from conftest import assert_taylor_slopes
 from mpi4py import MPI
 from scipy.spatial import ConvexHull
 
@@ -14,7 +15,6 @@ from contact_ufl.contact.projection import SelfContact, closest_points
 from contact_ufl.contact.search import release_master_side
 from contact_ufl.errors import ContactInputError
 from contact_ufl.problem import ContactProblem
-from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import scenes
 from contact_ufl.verification.geometries import tag_single_body
 from contact_ufl.verification.taylor_cases import sliding_direction
@@ -225,11 +225,19 @@ def _slot_mesh(comm: MPI.Comm, nx: int = 20, ny: int = 10) -> dolfinx.mesh.Mesh:
     keep = ~((j == ny // 2) & (i >= nx // 4) & (i < 3 * nx // 4))
     n0 = j[keep] * (nx + 1) + i[keep]
     cells = np.stack([n0, n0 + 1, n0 + nx + 1, n0 + nx + 2], axis=1)
+    return _mesh_from_rank_0(comm, cells, x, "quadrilateral")
+
+
+def _mesh_from_rank_0(
+    comm: MPI.Comm, cells: np.ndarray, x: np.ndarray, cell_type: str
+) -> dolfinx.mesh.Mesh:
+    """The P1 mesh of ``cells`` (rows of indices into the points ``x``; the points no cell
+    uses are dropped), given on rank 0 and distributed with shared-facet ghosts."""
     used = np.unique(cells)
     cells, x = np.searchsorted(used, cells), x[used]
     if comm.rank != 0:
-        cells, x = np.empty((0, 4), np.int64), np.empty((0, 2))
-    element = basix.ufl.element("Lagrange", "quadrilateral", 1, shape=(2,))
+        cells, x = np.empty((0, cells.shape[1]), np.int64), np.empty((0, x.shape[1]))
+    element = basix.ufl.element("Lagrange", cell_type, 1, shape=(x.shape[1],))
     partitioner = dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet, 2)
     return dolfinx.mesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
 
@@ -273,9 +281,37 @@ def _point_tractions(problem: ContactProblem) -> tuple[np.ndarray, np.ndarray, n
     c = problem.contacts[0]
     proj = c.kinematics.projection
     t_N = c.normal.traction_at_points(proj)
-    X = c.slave.X.reshape(-1, 2)
+    X = c.slave.X.reshape(-1, problem.gdim)
     gathered = problem.comm.allgather((X, proj.facet >= 0, t_N))
     return tuple(np.concatenate([g[k] for g in gathered]) for k in range(3))
+
+
+def _contact_resultant(problem: ContactProblem) -> np.ndarray:
+    """The contact residual summed over the nodes of the (one) body, on all ranks."""
+    R = problem.contact_residual()
+    local = R.array[problem.block_rows(0)].reshape(-1, problem.gdim).sum(axis=0)
+    return problem.comm.allreduce(local, MPI.SUM)
+
+
+def _mirror_image(X: np.ndarray, mirror: np.ndarray) -> np.ndarray:
+    """For each point of ``mirror`` (the mirror images of the points ``X``) the index of the
+    point of ``X`` at it (asserted to be there)."""
+    image = np.argmin(np.linalg.norm(X[:, None] - mirror[None], axis=2), axis=0)
+    np.testing.assert_allclose(X[image], mirror, atol=1e-12)
+    return image
+
+
+def _iterations(problem: ContactProblem) -> list[int]:
+    """Newton iterations of the accepted steps."""
+    return [s.newton_iterations for s in problem.history.steps]
+
+
+def _assert_same_run(alone: ContactProblem, problem: ContactProblem, quantity, rel: float):
+    """``alone`` (one rank) and ``problem``: the same ``quantity(problem)`` to ``rel`` of its
+    norm, and the same Newton iterations."""
+    a, b = quantity(alone), quantity(problem)
+    np.testing.assert_allclose(a, b, rtol=0, atol=rel * np.linalg.norm(a))
+    assert _iterations(alone) == _iterations(problem)
 
 
 @pytest.fixture(scope="module")
@@ -288,7 +324,7 @@ def test_slot_closes_on_itself(closed_slot):
     is the slave, the upper face its master), the block is in equilibrium, the contact
     forces on the one body cancel (property (e)) and the result is symmetric about x = 1."""
     problem = closed_slot
-    assert [s.newton_iterations for s in problem.history.steps] == [3, 3, 4, 4]
+    assert _iterations(problem) == [3, 3, 4, 4]
     assert problem.active_points() >= 12
     # equilibrium: the two supports' reactions balance (the contact forces are internal)
     top = problem.reaction(2)
@@ -296,19 +332,14 @@ def test_slot_closes_on_itself(closed_slot):
     assert np.linalg.norm(problem.reaction([1, 2])) < 1e-12 * np.linalg.norm(top)
     # property (e): the contact residual sums to zero over the body (slave and master sides
     # on the same body), while its slave side alone does not
-    R = problem.contact_residual()
-    local = R.array[problem.block_rows(0)].reshape(-1, 2).sum(axis=0)
-    resultant = problem.comm.allreduce(local, MPI.SUM)
     slave_side = problem.contact_force()
     assert slave_side[1] < -0.05
-    assert np.linalg.norm(resultant) < 1e-12 * np.linalg.norm(slave_side)
+    assert np.linalg.norm(_contact_resultant(problem)) < 1e-12 * np.linalg.norm(slave_side)
     # one pass: only the lower face's points are paired; symmetric tractions about x = 1
     X, paired, t_N = _point_tractions(problem)
     assert np.all(np.isclose(X[paired, 1], 0.5))
     assert np.count_nonzero(t_N > 0) >= 12
-    mirror = np.stack([2.0 - X[:, 0], X[:, 1]], axis=1)
-    image = np.argmin(np.linalg.norm(X[:, None] - mirror[None], axis=2), axis=0)
-    np.testing.assert_allclose(X[image], mirror, atol=1e-12)
+    image = _mirror_image(X, np.stack([2.0 - X[:, 0], X[:, 1]], axis=1))
     np.testing.assert_allclose(t_N[image], t_N, rtol=0, atol=1e-9 * t_N.max())
 
 
@@ -320,9 +351,7 @@ def test_slot_self_contact_equals_the_two_surface_pair(closed_slot):
     slot's ends: by 1% of the peak at the edge of the contact zone, 2e-5 of the total force
     (measured 1.6e-5)."""
     classical = _solved(MPI.COMM_WORLD, self_contact=False)
-    assert [s.newton_iterations for s in classical.history.steps] == [
-        s.newton_iterations for s in closed_slot.history.steps
-    ]
+    assert _iterations(classical) == _iterations(closed_slot)
     assert classical.active_points() == closed_slot.active_points()
     a, b = closed_slot.reaction(2), classical.reaction(2)
     assert np.linalg.norm(a - b) < 5e-5 * np.linalg.norm(b)
@@ -337,12 +366,7 @@ def test_slot_self_contact_equals_the_two_surface_pair(closed_slot):
 
 def test_slot_same_result_on_any_number_of_ranks(closed_slot):
     """One rank and this communicator's ranks: the same reaction and Newton iterations."""
-    alone = _solved(MPI.COMM_SELF)
-    a, b = alone.reaction(2), closed_slot.reaction(2)
-    np.testing.assert_allclose(a, b, rtol=0, atol=1e-10 * np.linalg.norm(a))
-    assert [s.newton_iterations for s in alone.history.steps] == [
-        s.newton_iterations for s in closed_slot.history.steps
-    ]
+    _assert_same_run(_solved(MPI.COMM_SELF), closed_slot, lambda p: p.reaction(2), 1e-10)
 
 
 def test_self_contact_of_a_flat_face_is_refused():
@@ -376,9 +400,7 @@ def test_taylor_of_the_closed_slot(closed_slot):
     deforms the block and changes the multipliers."""
     problem = closed_slot
     dz = sliding_direction(problem, 1, np.zeros(2), amplitude=0.02, multiplier=0.01)
-    result = taylor_test(problem, dz, [1e-3 * 2.0**-k for k in range(4)])
-    assert not result.facets_changed and not result.active_changed
-    assert np.all(np.abs(result.slopes - 2.0) < 0.01), result.slopes
+    assert_taylor_slopes(problem, dz, [1e-3 * 2.0**-k for k in range(4)])
 
 
 def _slot_mesh_3d(comm: MPI.Comm, nx: int = 20, ny: int = 2, nz: int = 10) -> dolfinx.mesh.Mesh:
@@ -395,13 +417,7 @@ def _slot_mesh_3d(comm: MPI.Comm, nx: int = 20, ny: int = 2, nz: int = 10) -> do
     n0 = k[keep] * sz + j[keep] * sy + i[keep]
     corners = [0, 1, sy, sy + 1]
     cells = np.stack([n0 + c for c in corners] + [n0 + sz + c for c in corners], axis=1)
-    used = np.unique(cells)
-    cells, x = np.searchsorted(used, cells), x[used]
-    if comm.rank != 0:
-        cells, x = np.empty((0, 8), np.int64), np.empty((0, 3))
-    element = basix.ufl.element("Lagrange", "hexahedron", 1, shape=(3,))
-    partitioner = dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet, 2)
-    return dolfinx.mesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
+    return _mesh_from_rank_0(comm, cells, x, "hexahedron")
 
 
 def test_slot_closes_on_itself_in_3d():
@@ -433,25 +449,16 @@ def test_slot_closes_on_itself_in_3d():
     )
     problem = ContactProblem(scene, verbose=False)
     problem.solve(num_steps=4)
-    assert [s.newton_iterations for s in problem.history.steps] == [3, 3, 4, 4]
+    assert _iterations(problem) == [3, 3, 4, 4]
     assert problem.active_points() >= 60
     top = problem.reaction(2)
     assert top[2] < -0.05
     assert np.linalg.norm(problem.reaction([1, 2, 4])) < 1e-12 * np.linalg.norm(top)
-    R = problem.contact_residual()
-    local = R.array[problem.block_rows(0)].reshape(-1, 3).sum(axis=0)
-    resultant = problem.comm.allreduce(local, MPI.SUM)
     slave_side = problem.contact_force()
     assert slave_side[2] < -0.01
-    assert np.linalg.norm(resultant) < 1e-12 * np.linalg.norm(slave_side)
-    c = problem.contacts[0]
-    t_N = c.normal.traction_at_points(c.kinematics.projection)
-    X = c.slave.X.reshape(-1, 3)
-    gathered = problem.comm.allgather((X, t_N))
-    X, t_N = (np.concatenate([g[k] for g in gathered]) for k in range(2))
-    mirror = X * [-1.0, 1.0, 1.0] + [2.0, 0.0, 0.0]
-    image = np.argmin(np.linalg.norm(X[:, None] - mirror[None], axis=2), axis=0)
-    np.testing.assert_allclose(X[image], mirror, atol=1e-12)
+    assert np.linalg.norm(_contact_resultant(problem)) < 1e-12 * np.linalg.norm(slave_side)
+    X, _, t_N = _point_tractions(problem)
+    image = _mirror_image(X, X * [-1.0, 1.0, 1.0] + [2.0, 0.0, 0.0])
     np.testing.assert_allclose(t_N[image], t_N, rtol=0, atol=1e-9 * t_N.max())
 
 
@@ -497,24 +504,16 @@ def test_ring_hole_closes_on_itself(squeezed_ring):
     assert problem.comm.allreduce(int(inner.active().sum())) >= 30
     slave_side = problem.contact_force(2)
     assert slave_side[1] < -0.25
-    R = problem.contact_residual()
-    local = R.array[problem.block_rows(0)].reshape(-1, 2).sum(axis=0)
-    resultant = problem.comm.allreduce(local, MPI.SUM)
     plates_slave_side = problem.contact_force(0) + problem.contact_force(1)
     assert np.linalg.norm(plates_slave_side) < 1e-12 * np.linalg.norm(plates[0])
-    assert np.linalg.norm(resultant) < 1e-12 * np.linalg.norm(slave_side)
+    assert np.linalg.norm(_contact_resultant(problem)) < 1e-12 * np.linalg.norm(slave_side)
     # symmetry about y = 0: u(x, -y) = (u_x, -u_y)(x, y)
     X, U = _displacement(problem)
-    image = np.argmin(np.linalg.norm(X[:, None] - (X * [1.0, -1.0])[None], axis=2), axis=0)
-    np.testing.assert_allclose(X[image], X * [1.0, -1.0], atol=1e-12)
+    image = _mirror_image(X, X * [1.0, -1.0])
     asymmetry = np.abs(U[image] * [1.0, -1.0] - U).max()
     assert asymmetry < 2e-4 * np.abs(U).max()
 
 
 def test_ring_same_result_on_any_number_of_ranks(squeezed_ring):
     alone = _ring_problem(MPI.COMM_SELF)
-    a, b = alone.contact_force(2), squeezed_ring.contact_force(2)
-    np.testing.assert_allclose(a, b, rtol=0, atol=1e-9 * np.linalg.norm(a))
-    assert [s.newton_iterations for s in alone.history.steps] == [
-        s.newton_iterations for s in squeezed_ring.history.steps
-    ]
+    _assert_same_run(alone, squeezed_ring, lambda p: p.contact_force(2), 1e-9)
