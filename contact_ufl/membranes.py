@@ -429,7 +429,21 @@ class MembraneNeoHookean:
 
 
 @dataclass(frozen=True)
-class MembraneSVK:
+class _IsotropicMembrane:
+    """A membrane (string) law given by Young's modulus ``E`` and Poisson's ratio ``nu``
+    (``-1 < nu < 1/2``) of its small-strain limit and its reference thickness ``t0``."""
+
+    E: float
+    nu: float
+    thickness: float
+
+    def __post_init__(self) -> None:
+        _check_positive(E=self.E, thickness=self.thickness)
+        lame_parameters(self.E, self.nu)  # the range of nu
+
+
+@dataclass(frozen=True)
+class MembraneSVK(_IsotropicMembrane):
     """Saint Venant-Kirchhoff membrane (string) in plane stress, the thickness condensed.
 
     With ``psi = lambda/2 (tr E)^2 + mu E:E`` and the transverse shears zero, ``S33 = lambda
@@ -442,20 +456,9 @@ class MembraneSVK:
 
     Parameters
     ----------
-    E, nu
-        Young's modulus and Poisson's ratio (``-1 < nu < 1/2``).
-    thickness
-        Reference thickness ``t0`` (a string: cross-section area per unit depth).
+    E, nu, thickness
+        As in :class:`MembraneCompressibleNeoHookean`.
     """
-
-    E: float
-    nu: float
-    thickness: float
-
-    def __post_init__(self) -> None:
-        _check_positive(E=self.E, thickness=self.thickness)
-        if not -1.0 < self.nu < 0.5:
-            raise ValueError(f"Poisson's ratio must lie in (-1, 0.5), got nu = {self.nu}")
 
     def thickness_stretch(self, u: Expr, n0: Expr) -> Expr:
         """``l3 = sqrt(1 + 2 E33)``, ``E33 = -nu/(1 - nu) tr E_s``."""
@@ -470,7 +473,7 @@ class MembraneSVK:
 
 
 @dataclass(frozen=True)
-class MembraneCompressibleNeoHookean:
+class MembraneCompressibleNeoHookean(_IsotropicMembrane):
     """Compressible Neo-Hookean membrane (string) in plane stress, the thickness condensed.
 
     ``psi = mu/2 (I1 - 3 - 2 ln J) + lambda/4 (J^2 - 1 - 2 ln J)`` per unit volume (the
@@ -489,14 +492,6 @@ class MembraneCompressibleNeoHookean:
     thickness
         Reference thickness ``t0`` (a string: cross-section area per unit depth).
     """
-
-    E: float
-    nu: float
-    thickness: float
-
-    def __post_init__(self) -> None:
-        _check_positive(E=self.E, thickness=self.thickness)
-        lame_parameters(self.E, self.nu)
 
     def thickness_stretch(self, u: Expr, n0: Expr) -> Expr:
         """``l3 = sqrt((2 mu + lambda) / (2 mu + lambda J_s^2))``."""
