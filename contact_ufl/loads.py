@@ -50,7 +50,20 @@ class Dirichlet:
 
 
 @dataclass(frozen=True)
-class DeadTraction:
+class _DeadLoad:
+    """A load of fixed direction and magnitude per unit reference measure (area or volume)
+    on the entities ``tag``: its ``value`` (or a callable of ``t``)."""
+
+    tag: int | str
+    value: Value
+
+    def virtual_work(self, u, v, measure, constant):
+        """External virtual work ``int value . v`` over the tagged entities of ``measure``."""
+        return ufl.dot(constant, v) * measure(self.tag)
+
+
+@dataclass(frozen=True)
+class DeadTraction(_DeadLoad):
     """Nominal (first Piola) traction per unit reference area, fixed in direction (dead).
 
     Parameters
@@ -60,18 +73,13 @@ class DeadTraction:
     value
         Traction vector ``T`` (force per unit reference area), or a callable of ``t``. A
         resultant ``P`` spread over a reference area ``A0`` is ``T = P / A0``.
+
+    Its external virtual work is ``int T . v dS_o``.
     """
-
-    tag: int | str
-    value: Value
-
-    def virtual_work(self, u, v, ds, constant):
-        """External virtual work ``int T . v dS_o``."""
-        return ufl.dot(constant, v) * ds(self.tag)
 
 
 @dataclass(frozen=True)
-class BodyForce:
+class BodyForce(_DeadLoad):
     """Dead body force per unit reference volume (``rho_0 f`` of ``formulation.md``).
 
     Parameters
@@ -80,14 +88,9 @@ class BodyForce:
         Cell tag of the loaded body, or the name of its physical group.
     value
         Force vector per unit reference volume, or a callable of ``t``.
+
+    Its external virtual work is ``int rho_0 f . v dOmega_o``.
     """
-
-    tag: int | str
-    value: Value
-
-    def virtual_work(self, u, v, dx, constant):
-        """External virtual work ``int rho_0 f . v dOmega_o``."""
-        return ufl.dot(constant, v) * dx(self.tag)
 
 
 def deformation_gradient(u: dolfinx.fem.Function) -> ufl.core.expr.Expr:
