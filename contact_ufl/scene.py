@@ -163,17 +163,8 @@ class Domain:
     ) -> Domain:
         """The domain on a mesh read by :mod:`contact_ufl.gmshio` (tags by name or
         integer)."""
-        return cls(
-            data.mesh,
-            data.cell_tags,
-            data.facet_tags,
-            list(bodies),
-            list(dirichlet),
-            list(loads),
-            tags=data.tags,
-            groups=dict(data.groups),
-            name=name,
-        )
+        parts = {"bodies": list(bodies), "dirichlet": list(dirichlet), "loads": list(loads)}
+        return cls(**_mesh_fields(data), **parts, name=name)
 
     @property
     def membrane(self) -> bool:
@@ -464,17 +455,8 @@ class Scene:
     ) -> Scene:
         """The one-mesh scene on a mesh read by :mod:`contact_ufl.gmshio` (tags by name or
         integer)."""
-        return cls(
-            data.mesh,
-            data.cell_tags,
-            data.facet_tags,
-            list(bodies),
-            list(contacts),
-            list(dirichlet),
-            list(loads),
-            tags=data.tags,
-            groups=dict(data.groups),
-        )
+        parts = {"bodies": list(bodies), "dirichlet": list(dirichlet), "loads": list(loads)}
+        return cls(**_mesh_fields(data), **parts, contacts=list(contacts))
 
     # -- the domains ------------------------------------------------------------------
     @property
@@ -603,6 +585,18 @@ class Scene:
             part.validate()
         for pair in self.contacts:
             pair.validate(comm)
+
+
+def _mesh_fields(data: MeshData) -> dict[str, Any]:
+    """The mesh, tags and groups of ``data`` as the fields of a :class:`Domain` or a
+    :class:`Scene`."""
+    return {
+        "mesh": data.mesh,
+        "cell_tags": data.cell_tags,
+        "facet_tags": data.facet_tags,
+        "tags": data.tags,
+        "groups": dict(data.groups),
+    }
 
 
 def _resolver(lookup, errors: list[str]):
