@@ -224,6 +224,14 @@ class _Grading:
     master_ratio: float
     refine_radius: float
 
+    def __post_init__(self) -> None:
+        _check_positive(
+            h_contact=self.h_contact,
+            h_far=self.h_far,
+            master_ratio=self.master_ratio,
+            refine_radius=self.refine_radius,
+        )
+
     def set_background(
         self, distance: int, radius: float, dim: int, upper: list[int], lower: list[int]
     ) -> None:
@@ -256,17 +264,10 @@ def _disc_sizes(
     h_contact = 0.02 * radius if h_contact is None else h_contact
     h_far = 0.2 * radius if h_far is None else h_far
     width, height = block
-    _check_positive(
-        radius=radius,
-        width=width,
-        height=height,
-        h_contact=h_contact,
-        h_far=h_far,
-        master_ratio=master_ratio,
-        refine_radius=refine_radius,
-    )
+    _check_positive(radius=radius, width=width, height=height)
+    grading = _Grading(h_contact, h_far, master_ratio, refine_radius)
     _check_common(gap, order)
-    return _Grading(h_contact, h_far, master_ratio, refine_radius), width, height
+    return grading, width, height
 
 
 def _disc_on_block(
@@ -708,17 +709,8 @@ def cylinders_3d(
     h_far = 0.25 * R if h_far is None else h_far
     lower_radius = 3.0 * R if lower_radius is None else lower_radius
     wx, wy, height = (2.0 * R, 1.5 * length, 0.5 * R) if block is None else block
-    _check_positive(
-        radius=R,
-        length=length,
-        wx=wx,
-        wy=wy,
-        height=height,
-        h_contact=h_contact,
-        h_far=h_far,
-        master_ratio=master_ratio,
-        refine_radius=refine_radius,
-    )
+    _check_positive(radius=R, length=length, wx=wx, wy=wy, height=height)
+    grading = _Grading(h_contact, h_far, master_ratio, refine_radius)
     _check_common(gap, order)
     _check_positive(lower_radius=lower_radius)
     R2 = lower_radius
@@ -759,7 +751,6 @@ def cylinders_3d(
             + [(key, 2, value) for key, value in names.items()],
             tdim=3,
         )
-        grading = _Grading(h_contact, h_far, master_ratio, refine_radius)
         grading.set_background(_distance_to((0.0, 0.0, gap)), R, 3, [up], [lo])
         _generate(3, order)
 
