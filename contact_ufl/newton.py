@@ -156,7 +156,14 @@ class NewtonSolver:
     snes
         The PETSc SNES.
     fallback_linesearch
-        Line search of the second try of a failed Newton solve (see :meth:`solve_step`).
+        Line search of the try of a failed Newton solve after the predicted one (see
+        :meth:`solve_step`).
+    predictor
+        Where a step may start from the *predicted* state, the converged state plus the last
+        converged step's increment scaled to the step (the same equations, another first
+        iterate; see :meth:`solve_step`): ``"retry"`` (default) in a try after the
+        full-step Newton from the converged state failed, ``"first"`` in the first try, or
+        ``None`` (never).
     close_gaps
         Whether a failed step whose start has a contact pair with no point in contact is
         tried once more after a closing iterate (see :meth:`solve_step`).
@@ -226,6 +233,9 @@ class NewtonSolver:
         #: try a closing iterate where a pair has no point in contact (:meth:`solve_step`)
         self.close_gaps = True
         self._pieces = None  # (piece, its pairs) of the pieces free in some direction
+        #: where a step starts from the last converged increment (:meth:`solve_step`)
+        self.predictor: str | None = "retry"
+        self._increment = None  # (t_from, t_to, x_to, x_to - x_from) of the last solve
         problem._solver = self  # the solver of the problem's results that need T
 
     def _create_snes(self, options: dict, prefix: str) -> PETSc.SNES:
@@ -481,13 +491,25 @@ class NewtonSolver:
         """Solve for pseudo-time ``t`` from the current state (a step begun by
         :meth:`ContactProblem.begin_step <contact_ufl.problem.ContactProblem.begin_step>`).
 
-        Newton takes full steps first. Where that fails, the step is solved again from the
-        same start, before the caller cuts it back:
+        Newton takes full steps first. Where that fails, the step is solved again, before
+        the caller cuts it back:
 
-        1. with the backtracking line search :attr:`fallback_linesearch` (``None``: not
-           tried): a semismooth Newton can cycle between contact or stick/slip states, or
-           overshoot into inverted elements;
-        2. where a contact pair has no point in contact at the start (:attr:`close_gaps`):
+        1. with full steps from the *predicted* state (:attr:`predictor` ``"retry"``, where
+           the step begins at the end of the last converged step): the start plus that
+           step's increment of the unknowns (displacements and multipliers) times the
+           ratio of the step sizes. In a steady process (sliding) a step repeats the last
+           one, and the predicted state holds the contact and stick/slip status of the
+           solution much better than the start: in the 2D ironing with mu = 0.3 (quick
+           mesh, steps of 0.1, half a master facet) the full-step Newton from the start
+           (residual 3.4e9 at t = 1.2) turned the 16 sticking points to slip in its first
+           iterate and then swung 16 to 21 contact statuses per iterate on the punch's
+           front, for 40 iterates; from the predicted state (residual 1.2e8) it converged
+           in 9. With the predictor the quick run takes no cut-back (3 before) and the same
+           forces (6e-10 of the largest);
+        2. from the start, with the backtracking line search :attr:`fallback_linesearch`
+           (``None``: not tried): a semismooth Newton can cycle between contact or
+           stick/slip states, or overshoot into inverted elements;
+        3. where a contact pair has no point in contact at the start (:attr:`close_gaps`):
            after one *closing* iterate, in which the open points of such a pair within
            twice the nearest open gap, or within a tenth of the slave mesh size, count as in
            contact (a patch of points around the nearest one, not a single point about
@@ -502,21 +524,35 @@ class NewtonSolver:
         support along some axis, no point in contact on any of its pairs, and a net force
         along that axis above the absolute tolerance, so that the Newton equation has no
         solution), the step begins with the closing iterate on its pairs instead of
-        reaching it after two failed tries; the line-search try follows if that fails.
+        reaching it after failed tries; the line-search try follows if that fails (no
+        predicted try). With :attr:`predictor` ``"first"`` the first try starts from the
+        predicted state (2D ironing, mu = 0.3, quick: 1168 Newton iterations against 1259
+        with ``"retry"``, the same forces to 6e-10; it changes the iterations of every
+        step, ``"retry"`` only those of steps whose first try failed).
 
         Returns
         -------
         converged, Newton iterations (of all tries), SNES converged reason (name)
         """
+        if self.predictor not in (None, "first", "retry"):
+            raise ValueError(f"predictor must be 'retry', 'first' or None, got {self.predictor!r}")
+        t0 = self.problem.t
         self.problem.set_time(t)
         fem_petsc.assign(self.problem.unknowns, self.x)
         self._shrink_pattern()
         start = self.x.copy()
+        if self.predictor == "first":
+            self._predict(t0, t)
         loose = self._loose_pairs() if self.close_gaps else []
         if loose:  # no Newton step without contact: close first
             reason, its = self._closed_newton(loose)
         else:
             reason, its = self._newton()
+        if reason <= 0 and self.predictor == "retry" and not loose:
+            start.copy(self.x)
+            if self._predict(t0, t):
+                reason, more = self._newton()
+                its += more
         linesearch = self.snes.getLineSearch()
         primary = linesearch.getType()
         if reason <= 0 and self.fallback_linesearch not in (None, primary):
@@ -535,8 +571,29 @@ class NewtonSolver:
                 its += more
         self._state = None
         self._set_state(self.x)
+        if reason > 0:
+            increment = self.x.copy()
+            increment.axpy(-1.0, start)
+            self._increment = (t0, t, self.x.copy(), increment)
         names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
         return reason > 0, its, names.get(reason, str(reason))
+
+    def _predict(self, t0: float, t: float) -> bool:
+        """Move :attr:`x`, the start of the step from ``t0`` to ``t``, to the predicted
+        state ``x + (t - t0) / (t_to - t_from) dx``, where the last converged step (from
+        ``t_from`` to ``t_to``, increment ``dx``) ended at this start (collective).
+        Returns whether it did."""
+        if self._increment is None:
+            return False
+        t_from, t_to, x_to, dx = self._increment
+        if abs(t_to - t0) > 1e-12 * max(abs(t0), 1.0):
+            return False
+        diff = self.x.copy()
+        diff.axpy(-1.0, x_to)
+        if diff.norm() > 0.0:
+            return False
+        self.x.axpy((t - t0) / (t_to - t_from), dx)
+        return True
 
     def _open_pairs(self) -> list:
         """The contact pairs with no point in contact at :attr:`x` (collective)."""
