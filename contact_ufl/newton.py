@@ -521,15 +521,17 @@ class NewtonSolver:
            it use the contact law again (points in tension are released), so the solution
            is that of the same equations.
 
-        Where the start shows such a body (:meth:`_loose_pairs`: a piece of a mesh with no
-        support along some axis, no point in contact on any of its pairs, and a net force
-        along that axis above the absolute tolerance, so that the Newton equation has no
-        solution), the step begins with the closing iterate on its pairs instead of
-        reaching it after failed tries; the line-search try follows if that fails (no
-        predicted try). With :attr:`predictor` ``"first"`` the first try starts from the
-        predicted state (2D ironing, mu = 0.3, quick: 1168 Newton iterations against 1259
-        with ``"retry"``, the same forces to 6e-10; it changes the iterations of every
-        step, ``"retry"`` only those of steps whose first try failed).
+        Where the start shows such a body (:meth:`_loose_pairs`: a piece of a mesh with a
+        rigid mode no support holds, a translation or a rotation, no point in contact on
+        any of its pairs, and a net load along its free modes above the absolute
+        tolerance, so that the Newton equation has no solution), the step begins with the
+        closing iterate on its pairs instead of reaching it after failed tries; the
+        line-search try follows if that fails (no predicted try).
+
+        With :attr:`predictor` ``"first"`` the first try starts from the predicted state
+        (2D ironing, mu = 0.3, quick: 1168 Newton iterations against 1259 with
+        ``"retry"``, the same forces to 6e-10); it changes the iterations of every step,
+        ``"retry"`` only those of steps whose first try failed.
 
         Returns
         -------
@@ -613,16 +615,17 @@ class NewtonSolver:
 
     def _loose_pairs(self) -> list:
         """The contact pairs to close before the first try (collective): the pairs with no
-        point in contact at :attr:`x` on a piece held by no point in contact, free to
-        translate along a direction in which the residual at :attr:`x` has a net force
-        above the absolute tolerance (:mod:`contact_ufl.free_bodies`): there the tangent is
-        singular and the Newton equation has no solution."""
+        point in contact at :attr:`x` on a piece held by no point in contact, with free
+        rigid modes (translations, rotations) along which the residual at :attr:`x` has a
+        net load (force, moment over the piece's size) above the absolute tolerance
+        (:mod:`contact_ufl.free_bodies`): there the tangent is singular and the Newton
+        equation has no solution."""
         problem = self.problem
         if self._pieces is None:
             self._pieces = [
                 (piece, on)
                 for piece in free_bodies.pieces(problem)
-                if piece.free.any() and (on := free_bodies.pairs_on(problem, piece))
+                if len(piece.modes) and (on := free_bodies.pairs_on(problem, piece))
             ]
         if not self._pieces:
             return []
@@ -636,8 +639,7 @@ class NewtonSolver:
         for piece, on in self._pieces:
             if np.any(counts[on] > 0):
                 continue  # a point in contact holds the piece
-            force = free_bodies.net_force(problem, residual, piece)
-            if np.any(piece.free & (np.abs(force) > atol)):
+            if free_bodies.net_free_load(problem, residual, piece) > atol:
                 loose.update(on)
         return [c for k, c in enumerate(problem.contacts) if k in loose]
 

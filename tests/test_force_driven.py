@@ -222,3 +222,32 @@ def test_membrane_pressed_onto_a_block_from_a_gap(dim):
         lam = c.multiplier_at_points()
         error = np.abs(lam / (p * s ** (dim - 1)) - 1.0).max(initial=0.0)
         assert problem.comm.allreduce(error, MPI.MAX) < 1e-12
+
+
+def test_free_bodies_find_the_turn_about_the_disc_centre():
+    """The force-driven disc's free rigid modes (:mod:`contact_ufl.free_bodies`): with its
+    axis held only the vertical translation; with the top alone held horizontally also a
+    turn about a point of the top's line y = 1. A residual of the turn's pattern (forces
+    ``(-(y - 1), x)`` at the disc's nodes) loads the free modes only where the turn is free
+    (the vertical part of it nearly cancels: the disc is nearly symmetric)."""
+    from contact_ufl import free_bodies
+
+    loads = {}
+    for held in (True, False):
+        scene = hertz_scene("force", 8e7)
+        if not held:
+            scene.dirichlet[:] = [d for d in scene.dirichlet if d.tag != CYLINDER_AXIS]
+        problem = cu.ContactProblem(scene, verbose=False)
+        disc, block = free_bodies.pieces(problem)
+        assert list(disc.free) == [False, True] and not block.free.any()
+        assert len(block.modes) == 0
+        assert disc.rotates != held and len(disc.modes) == (1 if held else 2)
+        if not held:
+            assert disc.turning_point()[1] == pytest.approx(1.0, abs=1e-10)
+        x = problem.V.tabulate_dof_coordinates()[:, :2]
+        turn = np.stack([-(x[:, 1] - 1.0), x[:, 0]], axis=1)
+        residual = np.zeros(problem.solver.x.getLocalSize())
+        owned = problem.V.dofmap.index_map.size_local
+        residual[: 2 * owned] = turn[:owned].ravel()
+        loads[held] = free_bodies.net_free_load(problem, residual, disc)
+    assert loads[True] < 1e-2 * loads[False]
