@@ -621,13 +621,7 @@ class NewtonSolver:
         (:mod:`contact_ufl.free_bodies`): there the tangent is singular and the Newton
         equation has no solution."""
         problem = self.problem
-        if self._pieces is None:
-            self._pieces = [
-                (piece, on)
-                for piece in free_bodies.pieces(problem)
-                if len(piece.modes) and (on := free_bodies.pairs_on(problem, piece))
-            ]
-        if not self._pieces:
+        if not self._free_pieces():
             return []
         self._state = None  # the search at the step's time (a rigid obstacle moves)
         residual = self.evaluate_residual(self.x).array_r
@@ -679,7 +673,40 @@ class NewtonSolver:
         """Why the last Newton solve failed, at its last iterate (collective): inverted
         elements (and where), contact pairing or status that cycles between iterates, or a
         residual that stalls with neither (a limit point, or a singular tangent); otherwise
-        how far the residual fell and in how many iterates the contact state changed."""
+        how far the residual fell and in how many iterates the contact state changed. Where
+        a piece of a mesh with contact pairs is free to turn (no support holds a rotation,
+        :mod:`contact_ufl.free_bodies`), the diagnosis says so and where it turns."""
+        return self._diagnosis() + self._turning_hint()
+
+    def _free_pieces(self) -> list:
+        """(piece, its pairs) of the pieces with a free rigid mode and contact pairs."""
+        if self._pieces is None:
+            problem = self.problem
+            self._pieces = [
+                (piece, on)
+                for piece in free_bodies.pieces(problem)
+                if len(piece.modes) and (on := free_bodies.pairs_on(problem, piece))
+            ]
+        return self._pieces
+
+    def _turning_hint(self) -> str:
+        """The hint for a piece free to turn (the same on every rank)."""
+        hints = []
+        for piece, on in self._free_pieces():
+            if not piece.rotates:
+                continue
+            point = piece.turning_point()
+            about = "" if point is None else " about (" + ", ".join(f"{v:.3g}" for v in point) + ")"
+            pairs = ", ".join(str(self.problem.contacts[k].pair.slave) for k in on)
+            hints.append(
+                f"; the body with the contact pair(s) of slave surface {pairs} is free to turn"
+                f"{about}: no support holds that rotation, only the contact, which a "
+                "frictionless contact of a curved surface may not (the tangent is then near "
+                "singular): hold it by a support"
+            )
+        return "".join(hints)
+
+    def _diagnosis(self) -> str:
         from contact_ufl.results import inverted_cell_centres
 
         centres = inverted_cell_centres(self.problem)

@@ -251,3 +251,21 @@ def test_free_bodies_find_the_turn_about_the_disc_centre():
         residual[: 2 * owned] = turn[:owned].ravel()
         loads[held] = free_bodies.net_free_load(problem, residual, disc)
     assert loads[True] < 1e-2 * loads[False]
+
+
+@pytest.mark.parametrize("held", [True, False])
+def test_a_failed_step_says_the_disc_is_free_to_turn(held):
+    """A step that cannot converge (Newton held to 2 iterations): without the axis support
+    the diagnosis says the disc is free to turn, about a point of its top's line y = 1;
+    with it, not."""
+    scene = hertz_scene("force", 8e7)
+    if not held:
+        scene.dirichlet[:] = [d for d in scene.dirichlet if d.tag != CYLINDER_AXIS]
+    problem = cu.ContactProblem(scene, verbose=False)
+    problem.solver.snes.setTolerances(max_it=2)
+    with pytest.raises(cu.ConvergenceError) as error:
+        problem.solve(num_steps=1, max_cutbacks=0)
+    turns = "of slave surface 11 is free to turn about ("
+    assert (turns in str(error.value)) != held
+    if not held:
+        assert ", 1): no support holds that rotation" in problem.history.cutbacks[-1].why
