@@ -15,10 +15,13 @@ residual has a net load along a free mode (a force, or a moment over the piece's
 Newton equation has no solution: the step cannot converge until the contact closes
 (:meth:`contact_ufl.newton.NewtonSolver.solve_step` then starts with its closing iterate).
 
-A free rotation held only by contact is not flagged: a frictionless contact of a curved
-surface may hold it only through the facets of the discrete surface (the disc turning
-about its centre slides over itself), with a tangent near singular; hold it by a support
-(:func:`contact_ufl.verification.scenes.hertz_2d_driven` holds the disc's axis).
+A free mode held by a point in contact starts no closing iterate. A rotation held only by
+contact may still be held poorly: a frictionless contact of a curved surface holds it only
+through the facets of the discrete surface (the disc turning about its centre slides over
+itself), with a tangent near singular. The diagnosis of a failed step then says that the
+body is free to turn, and about which point (:meth:`contact_ufl.newton.NewtonSolver.diagnose`);
+hold it by a support (:func:`contact_ufl.verification.scenes.hertz_2d_driven` holds the
+disc's axis).
 """
 
 from __future__ import annotations
