@@ -156,7 +156,14 @@ class NewtonSolver:
     snes
         The PETSc SNES.
     fallback_linesearch
-        Line search of the second try of a failed Newton solve (see :meth:`solve_step`).
+        Line search of the try of a failed Newton solve after the predicted one (see
+        :meth:`solve_step`).
+    predictor
+        Where a step may start from the *predicted* state, the converged state plus the last
+        converged step's increment scaled to the step (the same equations, another first
+        iterate; see :meth:`solve_step`): ``"retry"`` (default) in a try after the
+        full-step Newton from the converged state failed, ``"first"`` in the first try, or
+        ``None`` (never).
     close_gaps
         Whether a failed step whose start has a contact pair with no point in contact is
         tried once more after a closing iterate (see :meth:`solve_step`).
@@ -226,6 +233,9 @@ class NewtonSolver:
         #: try a closing iterate where a pair has no point in contact (:meth:`solve_step`)
         self.close_gaps = True
         self._pieces = None  # (piece, its pairs) of the pieces free in some direction
+        #: where a step starts from the last converged increment (:meth:`solve_step`)
+        self.predictor: str | None = "retry"
+        self._increment = None  # (t_from, t_to, x_to, x_to - x_from) of the last solve
         problem._solver = self  # the solver of the problem's results that need T
 
     def _create_snes(self, options: dict, prefix: str) -> PETSc.SNES:
@@ -481,13 +491,26 @@ class NewtonSolver:
         """Solve for pseudo-time ``t`` from the current state (a step begun by
         :meth:`ContactProblem.begin_step <contact_ufl.problem.ContactProblem.begin_step>`).
 
-        Newton takes full steps first. Where that fails, the step is solved again from the
-        same start, before the caller cuts it back:
+        Newton takes full steps first. Where that fails, the step is solved again, before
+        the caller cuts it back:
 
-        1. with the backtracking line search :attr:`fallback_linesearch` (``None``: not
-           tried): a semismooth Newton can cycle between contact or stick/slip states, or
-           overshoot into inverted elements;
-        2. where a contact pair has no point in contact at the start (:attr:`close_gaps`):
+        1. with full steps from the *predicted* state (:attr:`predictor` ``"retry"``, where
+           the step begins at the end of the last converged step): the start plus that
+           step's increment of the unknowns (displacements and multipliers) times the
+           ratio of the step sizes. In a steady process (sliding) a step repeats the last
+           one, and the predicted state holds the contact and stick/slip status of the
+           solution much better than the start: in the 2D ironing with mu = 0.3 (quick
+           mesh, steps of 0.1, half a master facet) the full-step Newton from the start
+           (residual 3.4e9 at t = 1.2) turned the 16 sticking points to slip in its first
+           iterate, then swung 16 to 21 contact statuses per iterate on the punch's front
+           until an iterate inverted elements (iterate 10), and the backtracking try fell
+           only to 5.4e4 in 40 iterates; from the predicted state (residual 1.2e8) it
+           converged in 9. With the predictor the quick run takes no cut-back (3 before)
+           and the same forces (6e-10 of the largest);
+        2. from the start, with the backtracking line search :attr:`fallback_linesearch`
+           (``None``: not tried): a semismooth Newton can cycle between contact or
+           stick/slip states, or overshoot into inverted elements;
+        3. where a contact pair has no point in contact at the start (:attr:`close_gaps`):
            after one *closing* iterate, in which the open points of such a pair within
            twice the nearest open gap, or within a tenth of the slave mesh size, count as in
            contact (a patch of points around the nearest one, not a single point about
@@ -498,25 +521,41 @@ class NewtonSolver:
            it use the contact law again (points in tension are released), so the solution
            is that of the same equations.
 
-        Where the start shows such a body (:meth:`_loose_pairs`: a piece of a mesh with no
-        support along some axis, no point in contact on any of its pairs, and a net force
-        along that axis above the absolute tolerance, so that the Newton equation has no
-        solution), the step begins with the closing iterate on its pairs instead of
-        reaching it after two failed tries; the line-search try follows if that fails.
+        Where the start shows such a body (:meth:`_loose_pairs`: a piece of a mesh with a
+        rigid mode no support holds, a translation or a rotation, no point in contact on
+        any of its pairs, and a net load along its free modes above the absolute
+        tolerance, so that the Newton equation has no solution), the step begins with the
+        closing iterate on its pairs instead of reaching it after failed tries; the
+        line-search try follows if that fails (no predicted try).
+
+        With :attr:`predictor` ``"first"`` the first try starts from the predicted state
+        (2D ironing, mu = 0.3, quick: 1168 Newton iterations against 1259 with
+        ``"retry"``, the same forces to 6e-10); it changes the iterations of every step,
+        ``"retry"`` only those of steps whose first try failed.
 
         Returns
         -------
         converged, Newton iterations (of all tries), SNES converged reason (name)
         """
+        if self.predictor not in (None, "first", "retry"):
+            raise ValueError(f"predictor must be 'retry', 'first' or None, got {self.predictor!r}")
+        t0 = self.problem.t
         self.problem.set_time(t)
         fem_petsc.assign(self.problem.unknowns, self.x)
         self._shrink_pattern()
         start = self.x.copy()
+        if self.predictor == "first":
+            self._predict(t0, t)
         loose = self._loose_pairs() if self.close_gaps else []
         if loose:  # no Newton step without contact: close first
             reason, its = self._closed_newton(loose)
         else:
             reason, its = self._newton()
+        if reason <= 0 and self.predictor == "retry" and not loose:
+            start.copy(self.x)
+            if self._predict(t0, t):
+                reason, more = self._newton()
+                its += more
         linesearch = self.snes.getLineSearch()
         primary = linesearch.getType()
         if reason <= 0 and self.fallback_linesearch not in (None, primary):
@@ -535,8 +574,29 @@ class NewtonSolver:
                 its += more
         self._state = None
         self._set_state(self.x)
+        if reason > 0:
+            increment = self.x.copy()
+            increment.axpy(-1.0, start)
+            self._increment = (t0, t, self.x.copy(), increment)
         names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
         return reason > 0, its, names.get(reason, str(reason))
+
+    def _predict(self, t0: float, t: float) -> bool:
+        """Move :attr:`x`, the start of the step from ``t0`` to ``t``, to the predicted
+        state ``x + (t - t0) / (t_to - t_from) dx``, where the last converged step (from
+        ``t_from`` to ``t_to``, increment ``dx``) ended at this start (collective).
+        Returns whether it did."""
+        if self._increment is None:
+            return False
+        t_from, t_to, x_to, dx = self._increment
+        if abs(t_to - t0) > 1e-12 * max(abs(t0), 1.0):
+            return False
+        diff = self.x.copy()
+        diff.axpy(-1.0, x_to)
+        if diff.norm() > 0.0:
+            return False
+        self.x.axpy((t - t0) / (t_to - t_from), dx)
+        return True
 
     def _open_pairs(self) -> list:
         """The contact pairs with no point in contact at :attr:`x` (collective)."""
@@ -555,18 +615,13 @@ class NewtonSolver:
 
     def _loose_pairs(self) -> list:
         """The contact pairs to close before the first try (collective): the pairs with no
-        point in contact at :attr:`x` on a piece held by no point in contact, free to
-        translate along a direction in which the residual at :attr:`x` has a net force
-        above the absolute tolerance (:mod:`contact_ufl.free_bodies`): there the tangent is
-        singular and the Newton equation has no solution."""
+        point in contact at :attr:`x` on a piece held by no point in contact, with free
+        rigid modes (translations, rotations) along which the residual at :attr:`x` has a
+        net load (force, moment over the piece's size) above the absolute tolerance
+        (:mod:`contact_ufl.free_bodies`): there the tangent is singular and the Newton
+        equation has no solution."""
         problem = self.problem
-        if self._pieces is None:
-            self._pieces = [
-                (piece, on)
-                for piece in free_bodies.pieces(problem)
-                if piece.free.any() and (on := free_bodies.pairs_on(problem, piece))
-            ]
-        if not self._pieces:
+        if not self._free_pieces():
             return []
         self._state = None  # the search at the step's time (a rigid obstacle moves)
         residual = self.evaluate_residual(self.x).array_r
@@ -578,8 +633,7 @@ class NewtonSolver:
         for piece, on in self._pieces:
             if np.any(counts[on] > 0):
                 continue  # a point in contact holds the piece
-            force = free_bodies.net_force(problem, residual, piece)
-            if np.any(piece.free & (np.abs(force) > atol)):
+            if free_bodies.net_free_load(problem, residual, piece) > atol:
                 loose.update(on)
         return [c for k, c in enumerate(problem.contacts) if k in loose]
 
@@ -619,7 +673,40 @@ class NewtonSolver:
         """Why the last Newton solve failed, at its last iterate (collective): inverted
         elements (and where), contact pairing or status that cycles between iterates, or a
         residual that stalls with neither (a limit point, or a singular tangent); otherwise
-        how far the residual fell and in how many iterates the contact state changed."""
+        how far the residual fell and in how many iterates the contact state changed. Where
+        a piece of a mesh with contact pairs is free to turn (no support holds a rotation,
+        :mod:`contact_ufl.free_bodies`), the diagnosis says so and where it turns."""
+        return self._diagnosis() + self._turning_hint()
+
+    def _free_pieces(self) -> list:
+        """(piece, its pairs) of the pieces with a free rigid mode and contact pairs."""
+        if self._pieces is None:
+            problem = self.problem
+            self._pieces = [
+                (piece, on)
+                for piece in free_bodies.pieces(problem)
+                if len(piece.modes) and (on := free_bodies.pairs_on(problem, piece))
+            ]
+        return self._pieces
+
+    def _turning_hint(self) -> str:
+        """The hint for a piece free to turn (the same on every rank)."""
+        hints = []
+        for piece, on in self._free_pieces():
+            if not piece.rotates:
+                continue
+            point = piece.turning_point()
+            about = "" if point is None else " about (" + ", ".join(f"{v:.3g}" for v in point) + ")"
+            pairs = ", ".join(str(self.problem.contacts[k].pair.slave) for k in on)
+            hints.append(
+                f"; the body with the contact pair(s) of slave surface {pairs} is free to turn"
+                f"{about}: no support holds that rotation, only the contact, which a "
+                "frictionless contact of a curved surface may not (the tangent is then near "
+                "singular): hold it by a support"
+            )
+        return "".join(hints)
+
+    def _diagnosis(self) -> str:
         from contact_ufl.results import inverted_cell_centres
 
         centres = inverted_cell_centres(self.problem)

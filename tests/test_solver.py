@@ -20,8 +20,10 @@ def hertz_problem(**options):
 
 
 def test_diverging_step_is_cut_back():
-    """Three Newton iterations cannot do the whole load in one step: the step is halved."""
+    """Three Newton iterations cannot do the whole load in one step: the step is halved
+    (no predicted try, which would add its iterations to the steps after a failed try)."""
     problem = hertz_problem(snes_max_it=3)
+    problem.solver.predictor = None
     history = problem.solve(num_steps=1)
     assert len(history.cutbacks) >= 1
     assert history.cutbacks[0][0] == pytest.approx(1.0)
@@ -153,3 +155,33 @@ def test_rebuilt_solver_pattern_gives_the_same_solution():
     (kept, x_kept), (rebuilt, x_rebuilt) = results
     assert rebuilt > kept  # the negative slack rebuilt the pattern at every step
     np.testing.assert_allclose(x_rebuilt, x_kept, rtol=0, atol=1e-10 * np.abs(x_kept).max())
+
+
+def test_a_failed_first_try_is_tried_again_from_the_predicted_state():
+    """Hertz in steps of 0.25, Newton held to 3 iterations after the first step: from the
+    converged state the steps to 0.5 and 1.0 need 4 and are cut back without the predicted
+    try; from the predicted state (the last step's increment once more) they converge in 3,
+    with no cut-back and the same force. With the predicted state first, every step takes
+    at most 3."""
+    forces, counts = {}, {}
+    for predictor in (None, "retry", "first"):
+        problem = hertz_problem()
+        problem.solver.predictor = predictor
+        problem.solve(num_steps=1, t_end=0.25)
+        problem.solver.snes.setTolerances(max_it=3)
+        problem.solve(num_steps=3, t_end=1.0)
+        forces[predictor] = problem.contact_force()[1]
+        counts[predictor] = [r.newton_iterations for r in problem.history.steps[1:]]
+        cutbacks = problem.history.cutbacks
+        assert bool(cutbacks) == (predictor is None), predictor
+    assert counts["retry"] == [6, 3, 6]  # the failed try's 3 iterations, then 3
+    assert max(counts["first"]) <= 3
+    assert forces["retry"] == pytest.approx(forces[None], rel=1e-8)
+    assert forces["first"] == pytest.approx(forces[None], rel=1e-8)
+
+
+def test_an_unknown_predictor_is_refused():
+    problem = hertz_problem()
+    problem.solver.predictor = "linear"
+    with pytest.raises(ValueError, match="predictor must be 'retry', 'first' or None"):
+        problem.solve(num_steps=1)

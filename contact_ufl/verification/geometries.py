@@ -279,10 +279,12 @@ def _disc_on_block(
     grading: _Grading,
     order: int,
     x_disc: float = 0.0,
+    axis: bool = False,
 ) -> None:
     """Build and mesh the half disc over a block with a flat (``lower_radius`` None) or arc top.
 
-    The disc's centre is at ``(x_disc, R + gap)``."""
+    The disc's centre is at ``(x_disc, R + gap)``; with ``axis``, the disc's vertical radius
+    from its lowest point to its centre is a line of the mesh (group ``"cylinder_axis"``)."""
     geo = gmsh.model.geo
     R, a = radius, 0.5 * width
     yc = R + gap
@@ -293,8 +295,12 @@ def _disc_on_block(
     p_right = geo.addPoint(x_disc + R, yc, 0.0)
     arc_left = geo.addCircleArc(p_left, c, p_bottom)
     arc_right = geo.addCircleArc(p_bottom, c, p_right)
-    diameter = geo.addLine(p_right, p_left)
-    disc = geo.addPlaneSurface([geo.addCurveLoop([arc_left, arc_right, diameter])])
+    if axis:  # the diameter split at the centre, where the axis ends
+        diameter = [geo.addLine(p_right, c), geo.addLine(c, p_left)]
+        radius_line = geo.addLine(p_bottom, c)
+    else:
+        diameter = [geo.addLine(p_right, p_left)]
+    disc = geo.addPlaneSurface([geo.addCurveLoop([arc_left, arc_right, *diameter])])
     # lower body: [-a, a] x [-height, top(x)]
     q0 = geo.addPoint(-a, -height, 0.0)
     q1 = geo.addPoint(a, -height, 0.0)
@@ -316,17 +322,20 @@ def _disc_on_block(
     left = geo.addLine(q3, q0)
     block = geo.addPlaneSurface([geo.addCurveLoop([bottom, right, *top, left])])
     geo.synchronize()
+    if axis:
+        gmsh.model.mesh.embed(1, [radius_line], 2, disc)
 
     _add_groups(
         [
             ("cylinder", 2, [disc]),
             ("block", 2, [block]),
             ("cylinder_contact", 1, [arc_left, arc_right]),
-            ("cylinder_top", 1, [diameter]),
+            ("cylinder_top", 1, diameter),
             ("block_contact", 1, top),
             ("block_bottom", 1, [bottom]),
             ("block_sides", 1, [left, right]),
-        ],
+        ]
+        + ([("cylinder_axis", 1, [radius_line])] if axis else []),
         tdim=2,
     )
     distance = gmsh.model.mesh.field.add("Distance")
@@ -348,6 +357,7 @@ def hertz_2d(
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
     x_disc: float = 0.0,
+    axis: bool = False,
 ) -> MeshData:
     """Plane Hertz scene: a half disc resting on a rectangular block.
 
@@ -383,19 +393,24 @@ def hertz_2d(
         Ghost mode of the cell partitioner.
     x_disc
         Horizontal position of the disc's centre (and of the refinement).
+    axis
+        Mesh the disc's vertical radius, from its lowest point to its centre, as a line of
+        facets (group ``"cylinder_axis"``, 16; the diameter is then split at the centre):
+        a support there holds the disc's rotation about its centre.
 
     Returns
     -------
     MeshData
         Cell groups ``"cylinder"`` (1), ``"block"`` (2); facet groups ``"cylinder_contact"``
         (lower arc, 11), ``"cylinder_top"`` (diameter, 12), ``"block_contact"`` (top edge, 13),
-        ``"block_bottom"`` (14), ``"block_sides"`` (left and right, 15).
+        ``"block_bottom"`` (14), ``"block_sides"`` (left and right, 15), with ``axis``
+        ``"cylinder_axis"`` (16, interior facets).
     """
     sizes = radius, block, h_contact, h_far, master_ratio, refine_radius, gap, order
     grading, width, height = _disc_sizes(*sizes)
 
     def build() -> None:
-        _disc_on_block(radius, gap, width, height, None, grading, order, x_disc)
+        _disc_on_block(radius, gap, width, height, None, grading, order, x_disc, axis)
 
     return generate_mesh(comm, "hertz_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
 
