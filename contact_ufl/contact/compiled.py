@@ -37,16 +37,17 @@ CDEF = """
 typedef long long i64;
 i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b);
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, double *box, double *size, double *leaf_nodes);
+                 const i64 *a, const i64 *b, double *tree, double *leaf_nodes);
 double largest_change(i64 len, const double *p, const double *q);
 void project_pairs(int kind, int g, int nn, const double *nodes, i64 P, const double *x,
                    const i64 *f, double *xi, double *dist, i64 *edge, unsigned char *vertex);
 int bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const i64 *a, const i64 *b, const double *box, double rmax, i64 npts,
+              const double *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
-              double *dist, i64 *edge, unsigned char *vertex, double *y, double *normal,
-              double *gap, double *distance, double *sliding, int mp, const i64 *pnodes,
-              const double *pnormal, int mf, const i64 *fnodes, const double *axis);
+              double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
+              double *oxi, double *y, double *normal, double *gap, double *distance,
+              double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
+              const i64 *fnodes, const double *axis);
 """
 
 FLAGS = ("-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")

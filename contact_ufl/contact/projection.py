@@ -542,8 +542,7 @@ class _Hierarchy:
         self.b = np.empty(nf + 2, dtype=np.int64)
         p = self._pointers
         self.m = int(self.lib.bvh_build(self.gdim, nf, *p(centroid, self.perm, self.a, self.b)))
-        self.box = np.empty((self.m, 2 * self.gdim))
-        self.size = np.empty(nf)
+        self.tree = np.empty((self.m, 2 * self.gdim + 2))  # boxes and children, packed
         self.leaf_nodes = np.empty_like(nodes)
         self.R_max = 0.0
 
@@ -551,26 +550,33 @@ class _Hierarchy:
         return [_ptr(self, a) for a in arrays]
 
     def refit(self, nodes: FloatArray) -> None:
-        """The boxes, facet radii and leaf-ordered nodes of the current ``nodes``
+        """The boxes, largest facet radius and leaf-ordered nodes of the current ``nodes``
         (C-contiguous)."""
         nf, nn, g = nodes.shape
         p = self._pointers
         self.R_max = float(
             self.lib.bvh_refit(
                 g, nn, nf, *p(nodes, self.perm), self.m,
-                *p(self.a, self.b, self.box, self.size, self.leaf_nodes),
+                *p(self.a, self.b, self.tree, self.leaf_nodes),
             )
         )  # fmt: skip
 
     def query(
-        self, x: FloatArray, radius: float, cap: int, rule: tuple | None = None, out=None
+        self,
+        x: FloatArray,
+        radius: float,
+        cap: int,
+        rule: tuple | None = None,
+        out: Projection | None = None,
+        index: IntArray | None = None,
     ) -> tuple[IntArray, IntArray, _Pairs]:
         """The pairs of each point ``x`` (C-contiguous) within the tie reach of its closest
         facet (at most ``cap`` a point): their number per point, their facets ``(npts,
         cap)`` and their projections ``(npts, cap)``; ``rule``: the arrays of a self-contact
         search (point nodes, point normals, facet nodes, facet centre normals). ``out``: a
-        :class:`Projection` of the points (C-contiguous fields) in which the points with one
-        pair get their closest point (their count set to 0 if it is beyond ``radius``)."""
+        :class:`Projection` (C-contiguous fields) in which each point with one pair gets its
+        closest point, at its row of ``index`` (its count set to 0 if it is beyond
+        ``radius``)."""
         npts, fdim = x.shape[0], self.gdim - 1
         count = np.zeros(npts, dtype=np.int64)
         f = np.empty((npts, cap), dtype=np.int64)
@@ -580,16 +586,18 @@ class _Hierarchy:
         vertex = np.empty((npts, cap), dtype=np.uint8)
         p = self._pointers
         null = self.ffi.NULL
-        final = [null] * 5
+        final = [null] * 8
         if out is not None:
-            final = p(out.y, out.normal, out.gap, out.distance, out.sliding)
+            rows = null if index is None else _ptr(self, index)
+            final = [rows, *p(out.facet, out.xi, out.y, out.normal, out.gap, out.distance)]
+            final.append(_ptr(self, out.sliding))
         contact = [0, null, null, 0, null, null]
         if rule is not None:
             pn, pnormal, fn, axis = rule
             contact = [pn.shape[1], *p(pn, pnormal), fn.shape[1], *p(fn, axis)]
         status = self.lib.bvh_query(
             self.kind, self.gdim, self.nn, *p(self.leaf_nodes, self.perm), self.m,
-            *p(self.a, self.b, self.box), self.R_max, npts, _ptr(self, x), radius, cap,
+            _ptr(self, self.tree), self.R_max, npts, _ptr(self, x), radius, cap,
             *p(count, f, xi, dist, edge, vertex), *final, *contact,
         )  # fmt: skip
         if status != 0:
@@ -1443,28 +1451,12 @@ def _search_compiled(
     nodes = np.ascontiguousarray(nodes)
     tree = trees.hierarchy(nodes)
     rule = None if self_contact is None else _self_contact_arrays(self_contact, nodes)
-    npts = points.shape[0]
     order = _spatial_order(points) if nodes.shape[0] > _SORT else None
     x = points if order is None else np.ascontiguousarray(points[order])
     if rule is not None and order is not None:
         rule = (rule[0][order], rule[1][order], rule[2], rule[3])
-    # the fields C fills for the points with one facet within the tie reach (not xi, facet)
-    work = Projection(
-        facet=out.facet,
-        xi=out.xi,
-        y=np.empty_like(out.y),
-        normal=np.empty_like(out.normal),
-        gap=np.empty(npts),
-        distance=np.empty(npts),
-        sliding=np.empty_like(out.sliding),
-    )
-    count, f, pairs = tree.query(x, radius, _CAP, rule, work)
-    single = np.flatnonzero(count == 1)
-    p = single if order is None else order[single]
-    out.facet[p] = f[single, 0]
-    out.xi[p] = pairs.xi[single, 0]
-    for k in ("y", "normal", "gap", "distance", "sliding"):
-        getattr(out, k)[p] = getattr(work, k)[single]
+    # the points with one facet within the tie reach get their closest point in C
+    count, f, pairs = tree.query(x, radius, _CAP, rule, out, order)
     rows, fid, pairs = _tied_pairs(tree, x, radius, rule, count, f, pairs)
     if rows.size == 0:
         return

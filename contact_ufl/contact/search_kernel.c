@@ -10,8 +10,8 @@
  * are those of the NumPy kernels to the last bit.
  *
  * Tree layout: nodes in preorder; node i is a leaf when a[i] < 0 (its facets are
- * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. box[i] holds
- * (lo_0 .. lo_g-1, hi_0 .. hi_g-1).
+ * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query reads
+ * the packed rows of bvh_refit: (lo_0 .. lo_g-1, hi_0 .. hi_g-1, a, b), one cache line in 3D.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -89,43 +89,37 @@ i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b)
     return count;
 }
 
-/* The boxes of the tree over the facets' points (nodes (n, nn, g); every facet point lies in
- * their convex hull), the facet radii size (n): the largest node distance from the mean
- * of the nodes, and leaf_nodes (n, nn, g): the nodes in the order of perm. Returns the
- * largest radius. */
-double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, double *box, double *size, double *leaf_nodes)
+INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
+                    const i64 *a, const i64 *b, double *tree, double *leaf_nodes)
 {
-    /* the nodes in the order of the leaves (the facets of a leaf contiguous) */
-    for (i64 j = 0; j < n; j++)
-        memcpy(leaf_nodes + j * nn * g, nodes + perm[j] * nn * g, nn * g * sizeof(double));
-    double rmax = 0.0;
-    for (i64 f = 0; f < n; f++) {
-        const double *X = nodes + f * nn * g;
-        double c[3];
+    int W = 2 * g + 2;
+    double r2max = 0.0;
+    for (i64 j = 0; j < n; j++) {
+        const double *X = nodes + perm[j] * nn * g;
+        double *Y = leaf_nodes + j * nn * g, c[3];
+        for (int q = 0; q < nn * g; q++) Y[q] = X[q];
         for (int k = 0; k < g; k++) {
-            double s = X[k] + X[g + k];
-            for (int q = 2; q < nn; q++) s += X[q * g + k];
+            double s = X[k];
+            for (int q = 1; q < nn; q++) s += X[q * g + k];
             c[k] = s / nn;
         }
-        double r2 = 0.0;
         for (int q = 0; q < nn; q++) {
             double d2 = 0.0;
             for (int k = 0; k < g; k++) {
                 double d = X[q * g + k] - c[k];
                 d2 += d * d;
             }
-            if (d2 > r2) r2 = d2;
+            if (d2 > r2max) r2max = d2;
         }
-        size[f] = sqrt(r2);
-        if (size[f] > rmax) rmax = size[f];
     }
     for (i64 i = m - 1; i >= 0; i--) {
-        double *B = box + i * 2 * g;
+        double *B = tree + i * W;
         for (int k = 0; k < g; k++) {
             B[k] = INFINITY;
             B[g + k] = -INFINITY;
         }
+        B[2 * g] = (double)a[i];
+        B[2 * g + 1] = (double)b[i];
         if (a[i] < 0) {
             i64 start = -a[i] - 1;
             for (i64 j = start; j < start + b[i]; j++) {
@@ -138,14 +132,28 @@ double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64
                     }
             }
         } else {
-            const double *L = box + a[i] * 2 * g, *R = box + b[i] * 2 * g;
+            const double *L = tree + a[i] * W, *R = tree + b[i] * W;
             for (int k = 0; k < g; k++) {
                 B[k] = L[k] < R[k] ? L[k] : R[k];
                 B[g + k] = L[g + k] > R[g + k] ? L[g + k] : R[g + k];
             }
         }
     }
-    return rmax;
+    return sqrt(r2max);
+}
+
+/* The tree over the current nodes (n, nn, g) of the facets: tree (m, 2 g + 2) holds per tree
+ * node its box (lo_0 .. lo_g-1, hi_0 .. hi_g-1; every facet point lies in the convex hull of
+ * its nodes) and a, b as doubles; leaf_nodes (n, nn, g) the nodes in the order of perm (the
+ * facets of a leaf contiguous). Returns the largest facet radius (node distance from the
+ * mean of the nodes), or -1 for an unknown facet kind. */
+double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
+                 const i64 *a, const i64 *b, double *tree, double *leaf_nodes)
+{
+    if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    return -1.0;
 }
 
 /* The largest coordinate change between two node arrays of len values. */
@@ -523,19 +531,21 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
  * smallest one, if that smallest one is within reach(radius). count[p] is their number; up
  * to cap of them are written at p * cap of f, xi (fdim per pair), dist, edge, vertex
  * (projection._Pairs). Where one facet is within that reach (count 1) and y is not NULL,
- * the fields of its closest point are written at p of y, normal, gap, distance and sliding
- * (count set to 0 if it is beyond radius). Self-contact (pnodes not NULL): only the admissible facets, with
+ * the fields of its closest point are written at index[p] (p if index is NULL) of facet,
+ * oxi, y, normal, gap, distance and sliding (a projection.Projection; count set to 0 and
+ * the placeholders written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible facets, with
  * pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its normal,
  * fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
  * Returns 0, or -1 when out of memory. */
 INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const i64 *a, const i64 *b, const double *box, double rmax, i64 npts,
+              const double *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
-              double *dist, i64 *edge, unsigned char *vertex, double *y, double *normal,
-              double *gap, double *distance, double *sliding, int mp, const i64 *pnodes,
-              const double *pnormal, int mf, const i64 *fnodes, const double *axis)
+              double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
+              double *oxi, double *y, double *normal, double *gap, double *distance,
+              double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
+              const i64 *fnodes, const double *axis)
 {
-    int fdim = g - 1;
+    int fdim = g - 1, W = 2 * g + 2;
     i64 room = 64;
     hit_t *hits = malloc(room * sizeof(hit_t));
     if (!hits) return -1;
@@ -548,7 +558,7 @@ INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
         i64 nh = 0, top = 0;
         count[p] = 0;
         if (m == 0) continue;
-        double d0 = box_distance2(g, box, xp);
+        double d0 = box_distance2(g, tree, xp);
         if (d0 <= bound2) {
             stack[0] = 0;
             lower[0] = d0;
@@ -558,10 +568,12 @@ INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
             top--;
             i64 i = stack[top];
             if (lower[top] > bound2) continue;
-            if (a[i] >= 0) {
-                double dl = box_distance2(g, box + a[i] * 2 * g, xp);
-                double dr = box_distance2(g, box + b[i] * 2 * g, xp);
-                i64 near = dl <= dr ? a[i] : b[i], far = dl <= dr ? b[i] : a[i];
+            const double *T = tree + i * W;
+            i64 ai = (i64)T[2 * g], bi = (i64)T[2 * g + 1];
+            if (ai >= 0) {
+                double dl = box_distance2(g, tree + ai * W, xp);
+                double dr = box_distance2(g, tree + bi * W, xp);
+                i64 near = dl <= dr ? ai : bi, far = dl <= dr ? bi : ai;
                 double dfar = dl <= dr ? dr : dl, dnear = dl <= dr ? dl : dr;
                 if (top + 2 > STACK) {
                     free(hits);
@@ -577,8 +589,8 @@ INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                 }
                 continue;
             }
-            i64 start = -a[i] - 1;
-            for (i64 j = start; j < start + b[i]; j++) {
+            i64 start = -ai - 1;
+            for (i64 j = start; j < start + bi; j++) {
                 const double *X = leaf_nodes + j * nn * g;
                 {  /* the facet's box before its exact projection */
                     double B[6];
@@ -646,9 +658,21 @@ INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
             /* one facet within the tie reach: the closest point, no tie-break */
             const pair_t *q = &hits[last].q;
             const double *X = leaf_nodes + hits[last].j * nn * g;
-            if (!finish(kind, g, nn, X, xp, q, radius, y + p * g, normal + p * g, gap + p,
-                        distance + p, sliding + p * fdim * fdim))
+            i64 o = index ? index[p] : p;
+            if (finish(kind, g, nn, X, xp, q, radius, y + o * g, normal + o * g, gap + o,
+                       distance + o, sliding + o * fdim * fdim)) {
+                facet[o] = perm[hits[last].j];
+                for (int j = 0; j < fdim; j++) oxi[o * fdim + j] = q->xi[j];
+            } else {
                 count[p] = 0;
+                for (int k2 = 0; k2 < g; k2++) {  /* the placeholders of an unpaired point */
+                    y[o * g + k2] = xp[k2];
+                    normal[o * g + k2] = 0.0;
+                }
+                gap[o] = -INFINITY;
+                distance[o] = INFINITY;
+                for (int j = 0; j < fdim * fdim; j++) sliding[o * fdim * fdim + j] = 0.0;
+            }
         }
     }
     free(hits);
@@ -656,25 +680,26 @@ INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
 }
 
 int bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const i64 *a, const i64 *b, const double *box, double rmax, i64 npts,
+              const double *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
-              double *dist, i64 *edge, unsigned char *vertex, double *y, double *normal,
-              double *gap, double *distance, double *sliding, int mp, const i64 *pnodes,
-              const double *pnormal, int mf, const i64 *fnodes, const double *axis)
+              double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
+              double *oxi, double *y, double *normal, double *gap, double *distance,
+              double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
+              const i64 *fnodes, const double *axis)
 {
     /* one copy of the walk per facet kind, its dimensions constant */
     if (kind == 0)
-        return query(0, 2, 2, leaf_nodes, perm, m, a, b, box, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, y, normal, gap, distance, sliding, mp, pnodes,
-                     pnormal, mf, fnodes, axis);
+        return query(0, 2, 2, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
+                     mp, pnodes, pnormal, mf, fnodes, axis);
     if (kind == 1)
-        return query(1, 3, 3, leaf_nodes, perm, m, a, b, box, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, y, normal, gap, distance, sliding, mp, pnodes,
-                     pnormal, mf, fnodes, axis);
+        return query(1, 3, 3, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
+                     mp, pnodes, pnormal, mf, fnodes, axis);
     if (kind == 2)
-        return query(2, 3, 4, leaf_nodes, perm, m, a, b, box, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, y, normal, gap, distance, sliding, mp, pnodes,
-                     pnormal, mf, fnodes, axis);
+        return query(2, 3, 4, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
+                     mp, pnodes, pnormal, mf, fnodes, axis);
     (void)g;
     (void)nn;
     return -2;
