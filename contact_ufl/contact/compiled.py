@@ -41,7 +41,7 @@ double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64
 double largest_change(i64 len, const double *p, const double *q);
 void project_pairs(int kind, int g, int nn, const double *nodes, i64 P, const double *x,
                    const i64 *f, double *xi, double *dist, i64 *edge, unsigned char *vertex);
-int bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
+i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
               const double *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
               double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,

@@ -545,6 +545,7 @@ class _Hierarchy:
         self.tree = np.empty((self.m, 2 * self.gdim + 2))  # boxes and children, packed
         self.leaf_nodes = np.empty_like(nodes)
         self.R_max = 0.0
+        self.projections = 0
 
     def _pointers(self, *arrays: np.ndarray) -> list:
         return [_ptr(self, a) for a in arrays]
@@ -600,8 +601,12 @@ class _Hierarchy:
             _ptr(self, self.tree), self.R_max, npts, _ptr(self, x), radius, cap,
             *p(count, f, xi, dist, edge, vertex), *final, *contact,
         )  # fmt: skip
-        if status != 0:
+        if status == -1:
             raise MemoryError("the compiled closest-point search ran out of memory")
+        if status < 0:
+            raise ValueError(f"no compiled search for {self.nn}-node facets in {self.gdim}D")
+        #: exact projections made by the last query (the work of its pruning)
+        self.projections = int(status)
         return count, f, _Pairs(xi=xi, dist=dist, edge=edge, vertex=vertex.view(bool))
 
 
@@ -1306,6 +1311,23 @@ def _spatial_order(points: FloatArray) -> IntArray:
     return np.argsort(key, kind="stable")
 
 
+def _cell_order(points: FloatArray) -> IntArray:
+    """An order of the points by the cells of a grid of at most ``2^16`` cells over their
+    bounding box (256^2 in 2D, 32^3 in 3D; lexicographic in the cell coordinates): a linear
+    time (radix) sort of 16-bit keys."""
+    g = points.shape[1]
+    cells = 256 if g == 2 else 32
+    lo = points.min(axis=0)
+    span = float((points.max(axis=0) - lo).max())
+    if not (np.isfinite(span) and span > 0.0):
+        return np.arange(points.shape[0])
+    cell = np.minimum((points - lo) * (cells / span), cells - 1).astype(np.uint16)
+    key = cell[:, 0]
+    for k in range(1, g):
+        key = key * np.uint16(cells) + cell[:, k]
+    return np.argsort(key, kind="stable")
+
+
 def closest_points(
     points: npt.ArrayLike,
     nodes: npt.ArrayLike,
@@ -1411,11 +1433,6 @@ def closest_points(
     if npts == 0 or nf == 0:
         return out
     trees = trees if trees is not None else TreeCache()
-    if _compiled(nn, gdim):
-        if self_contact is not None:
-            _check_self_contact(self_contact, npts, nf, gdim)
-        _search_compiled(points, nodes, radius, trees, self_contact, out)
-        return out
     if self_contact is not None:
         _check_self_contact(self_contact, npts, nf, gdim)
         if nf > _DIRECTIONS_MIN:
@@ -1451,7 +1468,7 @@ def _search_compiled(
     nodes = np.ascontiguousarray(nodes)
     tree = trees.hierarchy(nodes)
     rule = None if self_contact is None else _self_contact_arrays(self_contact, nodes)
-    order = _spatial_order(points) if nodes.shape[0] > _SORT else None
+    order = _cell_order(points) if nodes.shape[0] > _SORT else None
     x = points if order is None else np.ascontiguousarray(points[order])
     if rule is not None and order is not None:
         rule = (rule[0][order], rule[1][order], rule[2], rule[3])
@@ -1481,7 +1498,22 @@ def _search(
     self_contact: SelfContact | None,
     out: Projection,
 ) -> None:
-    """Fill ``out`` with the closest points of :func:`closest_points` (checked input)."""
+    """Fill ``out`` with the closest points of :func:`closest_points` (checked input): by
+    the compiled search for the flat facet kinds (:func:`_compiled`), else in NumPy."""
+    search = _search_compiled if _compiled(*nodes.shape[1:]) else _search_numpy
+    search(points, nodes, radius, trees, self_contact, out)
+
+
+def _search_numpy(
+    points: FloatArray,
+    nodes: FloatArray,
+    radius: float,
+    trees: TreeCache,
+    self_contact: SelfContact | None,
+    out: Projection,
+) -> None:
+    """Fill ``out`` with the closest points of :func:`closest_points` (checked input) by
+    KD-trees of the facet centroids and the NumPy kernels."""
     npts, nf = points.shape[0], nodes.shape[0]
     master = _Master(nodes, trees)
     # on a large master the points in the order of a grid of cells (neighbours searched

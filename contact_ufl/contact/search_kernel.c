@@ -402,13 +402,12 @@ void project_pairs(int kind, int g, int nn, const double *nodes, i64 P, const do
 
 INLINE double box_distance2(int g, const double *B, const double *x)
 {
+    /* branch-free: max(lo - x, x - hi, 0) per coordinate (a box is never inverted) */
     double s = 0.0;
     for (int k = 0; k < g; k++) {
-        double d = B[k] - x[k];
-        if (d < 0.0) {
-            d = x[k] - B[g + k];
-            if (d < 0.0) d = 0.0;
-        }
+        double lo = B[k] - x[k], hi = x[k] - B[g + k];
+        double d = lo > hi ? lo : hi;
+        d = d > 0.0 ? d : 0.0;
         s += d * d;
     }
     return s;
@@ -536,8 +535,8 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
  * the placeholders written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible facets, with
  * pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its normal,
  * fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
- * Returns 0, or -1 when out of memory. */
-INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
+ * Returns the number of exact projections made, or -1 when out of memory. */
+INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
               const double *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
               double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
@@ -546,7 +545,7 @@ INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
               const i64 *fnodes, const double *axis)
 {
     int fdim = g - 1, W = 2 * g + 2;
-    i64 room = 64;
+    i64 room = 64, projected = 0;
     hit_t *hits = malloc(room * sizeof(hit_t));
     if (!hits) return -1;
     i64 stack[STACK];
@@ -609,6 +608,7 @@ INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                     continue;
                 pair_t q;
                 project(kind, X, xp, &q);
+                projected++;
                 if (q.dist > bound) continue;
                 if (nh == room) {
                     /* drop the hits beyond the bound, then grow */
@@ -676,10 +676,10 @@ INLINE int query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
         }
     }
     free(hits);
-    return 0;
+    return projected;
 }
 
-int bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
+i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
               const double *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
               double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
