@@ -89,8 +89,14 @@ def _compiler() -> list[str]:
 
 def _build(library: Path, compiler: list[str]) -> None:
     """Compile the source into ``library`` (a private file, then an atomic rename)."""
-    library.parent.mkdir(parents=True, exist_ok=True)
-    fd, private = tempfile.mkstemp(prefix=library.stem + ".", suffix=".tmp", dir=library.parent)
+    try:
+        library.parent.mkdir(parents=True, exist_ok=True)
+        fd, private = tempfile.mkstemp(prefix=library.stem + ".", suffix=".tmp", dir=library.parent)
+    except OSError as error:
+        raise OSError(
+            f"cannot write the closest-point search kernel to {library.parent} ({error}); "
+            "set CONTACT_UFL_CACHE_DIR to a writable directory"
+        ) from error
     os.close(fd)
     try:
         command = [*compiler, *FLAGS, "-o", private, str(SOURCE), "-lm"]

@@ -1,10 +1,15 @@
 """Closest-point projection of many slave points onto a master surface made of facets.
 
-Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search),
-vectorised over points and facets: the only Python loops run over a fixed small number of
-items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points, levels).
-The hot kernels work on coordinate columns (one 1D gather per node coordinate) rather than on
-rows of 2 or 3 numbers, which NumPy gathers and reduces slowly. Throughput:
+The flat facet kinds (segments, triangles, bilinear quadrilaterals) are searched by a
+compiled kernel (``search_kernel.c``, built on first use by :mod:`.compiled`): a
+bounding-volume hierarchy over the facets walked by branch and bound per point, with the
+exact projections of the NumPy kernels below in C; the tie-break between equidistant facets
+stays in NumPy (:func:`_select`). ``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search.
+The quadratic kinds are searched in NumPy (plus :class:`scipy.spatial.cKDTree` for the
+candidates), vectorised over points and facets: the only Python loops run over a fixed small
+number of items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points,
+levels). The hot kernels work on coordinate columns (one 1D gather per node coordinate) rather
+than on rows of 2 or 3 numbers, which NumPy gathers and reduces slowly. Throughput:
 ``benchmarks/search.py``.
 
 Facet kinds and conventions
@@ -1363,8 +1368,22 @@ def closest_points(
 
     Notes
     -----
-    Candidate search: KD-trees of the facet centroids (the mean of the nodes; of a quadratic
-    facet, of its Bernstein control points, whose convex hull holds it). Every facet point is
+    Flat facets (segments, triangles, bilinear quadrilaterals; unless
+    ``CONTACT_UFL_SEARCH=numpy``): a bounding-volume hierarchy of axis-aligned boxes over the
+    facets' nodes (median splits, 2 to 4 facets a leaf; built once per master shape and
+    kept in ``trees`` while no node has moved more than ``0.25 R_max``, its boxes refitted
+    to the current nodes at every call) is walked per point in C, nearer child first,
+    skipping every box (and facet box) farther than ``r = min(d, radius)`` with ``d`` the
+    smallest exact distance met so far (widened by ``1e-9 (r + 2 R_max)``, beyond the
+    tie tolerance): the work follows the point's distance to the surface, not the radius.
+    The exact projections are those of the NumPy kernels, in the same operations. A point
+    with one facet within that reach gets its closest point, normal, proximity and ``M``
+    from C; the points with several go through the NumPy tie-break below. Self-contact:
+    the inadmissible facets are skipped in the walk (the same rule).
+
+    Candidate search of the quadratic facets (and of all with ``CONTACT_UFL_SEARCH=numpy``):
+    KD-trees of the facet centroids (the mean of the nodes; of a quadratic facet, of its
+    Bernstein control points, whose convex hull holds it). Every facet point is
     within ``R_f`` (the largest node, or control point, distance from the centroid) of it.
     The facets are sorted by ``R_f`` into levels (radius ratio 4 between levels, the first up
     to twice the median ``R_f``; an even mesh has one level), each with its KD-tree and its
