@@ -39,6 +39,8 @@ i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b);
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
                  const i64 *a, const i64 *b, double *tree, double *leaf_nodes);
 double largest_change(i64 len, const double *p, const double *q);
+int same_nodes(i64 n, int width, const double *nodes, const i64 *perm,
+               const double *leaf_nodes);
 void project_pairs(int kind, int g, int nn, const double *nodes, i64 P, const double *x,
                    const i64 *f, double *xi, double *dist, i64 *edge, unsigned char *vertex);
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,

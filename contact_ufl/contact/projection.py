@@ -555,6 +555,13 @@ class _Hierarchy:
     def _pointers(self, *arrays: np.ndarray) -> list:
         return [_ptr(self, a) for a in arrays]
 
+    def fitted(self, nodes: FloatArray) -> bool:
+        """Whether the boxes are those of ``nodes`` (C-contiguous): the nodes of the last
+        refit, to the last bit."""
+        nf, nn, g = nodes.shape
+        p = self._pointers
+        return bool(self.lib.same_nodes(nf, nn * g, *p(nodes, self.perm, self.leaf_nodes)))
+
     def refit(self, nodes: FloatArray) -> None:
         """The boxes, largest facet radius and leaf-ordered nodes of the current ``nodes``
         (C-contiguous)."""
@@ -976,12 +983,16 @@ class TreeCache:
         """The bounding-volume hierarchy of the facets ``nodes`` (C-contiguous), refitted
         to them: the one of an earlier call on a master of the same shape while no node has
         moved more than ``_MOVE R_max`` since it was built (a tree of the earlier order stays
-        exact once refitted, and stays good while the facets barely moved), else a new one."""
+        exact once refitted, and stays good while the facets barely moved; not refitted if
+        no node moved since the last call), else a new one."""
         key = (*nodes.shape, "hierarchy")
         entry = self.entries.get(key)
         tree = None
         if entry is not None:
             built, tree = entry
+            if tree.fitted(nodes):  # the master has not moved since the last search
+                self.entries.move_to_end(key)
+                return tree
             change = tree.lib.largest_change(
                 nodes.size, _ptr(tree, nodes), _ptr(tree, built)
             ) * np.sqrt(nodes.shape[2])

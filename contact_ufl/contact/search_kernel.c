@@ -156,6 +156,17 @@ double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64
     return -1.0;
 }
 
+/* Whether the nodes (n, nn, g) are those of the last bvh_refit (leaf_nodes, in the order of
+ * perm), to the last bit (stops at the first difference). */
+int same_nodes(i64 n, int width, const double *nodes, const i64 *perm,
+               const double *leaf_nodes)
+{
+    for (i64 j = 0; j < n; j++)
+        if (memcmp(nodes + perm[j] * width, leaf_nodes + j * width, width * sizeof(double)))
+            return 0;
+    return 1;
+}
+
 /* The largest coordinate change between two node arrays of len values. */
 double largest_change(i64 len, const double *p, const double *q)
 {
