@@ -69,6 +69,7 @@ def test_work_does_not_grow_with_the_radius():
     assert work[np.inf] < 40
 
 
+@pytest.mark.serial  # it starts Python processes of its own
 def test_build_cache_and_concurrent_builds(tmp_path):
     """Four processes building the kernel at once into an empty cache directory: all load
     it, one library named by the source hash remains, no temporary file is left."""
