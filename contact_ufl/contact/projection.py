@@ -1327,21 +1327,27 @@ def _spatial_order(points: FloatArray) -> IntArray:
     return np.argsort(key, kind="stable")
 
 
+def _spread_bits(v: npt.NDArray[np.uint64]) -> npt.NDArray[np.uint64]:
+    """The 10 low bits of ``v`` spread to every third bit (bit ``i`` to bit ``3 i``)."""
+    v = v & np.uint64(0x3FF)
+    for shift, mask in ((16, 0x030000FF), (8, 0x0300F00F), (4, 0x030C30C3), (2, 0x09249249)):
+        v = (v | (v << np.uint64(shift))) & np.uint64(mask)
+    return v
+
+
 def _cell_order(points: FloatArray) -> IntArray:
-    """An order of the points by the cells of a grid of at most ``2^16`` cells over their
-    bounding box (256^2 in 2D, 32^3 in 3D; lexicographic in the cell coordinates): a linear
-    time (radix) sort of 16-bit keys."""
-    g = points.shape[1]
-    cells = 256 if g == 2 else 32
+    """An order of the points along a Z-order (Morton) curve through the cells of a
+    ``1024^gdim`` grid over their bounding box: the points of a cell, then of its neighbours,
+    come one after the other (they walk the same branches of a tree while it is in cache)."""
     lo = points.min(axis=0)
     span = float((points.max(axis=0) - lo).max())
     if not (np.isfinite(span) and span > 0.0):
         return np.arange(points.shape[0])
-    cell = np.minimum((points - lo) * (cells / span), cells - 1).astype(np.uint16)
-    key = cell[:, 0]
-    for k in range(1, g):
-        key = key * np.uint16(cells) + cell[:, k]
-    return np.argsort(key, kind="stable")
+    cell = np.minimum((points - lo) * (1024.0 / span), 1023.0).astype(np.uint64)
+    key = _spread_bits(cell[:, 0])
+    for k in range(1, points.shape[1]):
+        key |= _spread_bits(cell[:, k]) << np.uint64(k)
+    return np.argsort(key)
 
 
 def closest_points(
@@ -1493,8 +1499,8 @@ def _search_compiled(
     (``search_kernel.c``) finds its closest facet and those within the tie reach of it (the
     exact projections of the NumPy kernels, in C). A point with one facet there gets its
     closest point from C; :func:`_select` picks among the others' pairs (the tie-break).
-    On a master of over ``_SORT`` facets the points are walked in the order of a grid of
-    cells (neighbours walk the same branches while they are in cache)."""
+    On a master of over ``_SORT`` facets the points are walked in a Z-order of cells
+    (:func:`_cell_order`)."""
     nodes = np.ascontiguousarray(nodes)
     tree = trees.hierarchy(nodes)
     rule = None if self_contact is None else _self_contact_arrays(self_contact, nodes)
