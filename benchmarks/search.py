@@ -65,18 +65,33 @@ from coordinate columns. A uniform cell grid before the KD-trees was measured
 faster at radius h in 3D, its build 5 to 10 searches on 1e6 facets) and not kept.
 ``search_before_grid.json`` holds the code before that round run with this script.
 
-The distance sweep shows where the time goes: at a given distance the cost is flat in the
-radius (within the timing noise, e.g. 1e5 triangles at 1 h: 1.2e5 points/s at radii 2 h, 10
-h and infinity), but it falls with the distance (1e5 triangles: 2.5e5 at 0.1 h, 1.2e5 at 1 h,
-2.8e4 at 10 h, 7.7e3 at 50 h; segments 7.2e5 to 2.3e5): a point at distance D has all the
-facets with a centroid within D + R_max as candidates (about D R_max / h^2 on a surface). The
-stages bound any such search from above: on 1e5 triangles one unbounded nearest-centroid
-query per point of the radius sweep's points costs 6 microseconds (the KD-tree visits many
-cells for points off the surface), so the floor is 1.5e5 points/s at infinite radius
-(6.3e5 on 1e4 triangles, 1.7e6 on 1e3); one exact projection per point is 0.2 (triangles) to
-1.5 (quadrilaterals) microseconds. 1e6 points/s per core in 3D is therefore out of reach of a
-KD-tree of centroids driven from NumPy; it needs a compiled traversal (a bounding-volume tree
-with the slab bounds, walked per point).
+Fourth round (issue 12 item 4, the compiled search; README): the flat facet kinds are
+searched by ``search_kernel.c`` (a bounding-volume hierarchy over the facets, refitted per
+search, walked by branch and bound per point: the boxes farther than the best exact distance
+met are skipped, so the work follows the point's distance to the surface, not the radius;
+exact projections in C; the closest point of a point with one facet in reach in C, the
+tie-break in NumPy). ``search_numpy.json``: the NumPy search of the third round
+(``CONTACT_UFL_SEARCH=numpy``), run with this script just before ``search.json`` (now), up to
+1e6 facets. The ``stages`` records are those of the NumPy search (its KD-tree of centroids
+and kernels), kept for comparison: the compiled search does not use them. The third round's
+``search.json`` (CPU points/s at radius h / infinity): 1e4 segments 1.5e6 / 5.5e5; 1e5
+segments 8.1e5 / 3.6e5; 1e4 triangles 3.8e5 / 6.1e4; 1e5 triangles 2.6e5 / 3.3e4; 1e4
+quadrilaterals 3.0e5 / 6.8e4; 1e5 quadrilaterals 2.6e5 / 4.3e4 (graded master 0.034 s,
+self-contact slit 0.11 / 0.25 s).
+
+The distance sweep of the third round showed where the time went: at a given distance the
+cost is flat in the radius (within the timing noise, e.g. 1e5 triangles at 1 h: 1.2e5
+points/s at radii 2 h, 10 h and infinity), but it falls with the distance (1e5 triangles:
+2.5e5 at 0.1 h, 1.2e5 at 1 h, 2.8e4 at 10 h, 7.7e3 at 50 h; segments 7.2e5 to 2.3e5): a
+point at distance D has all the facets with a centroid within D + R_max as candidates (about
+D R_max / h^2 on a surface). The stages bound any such search from above: on 1e5 triangles
+one unbounded nearest-centroid query per point of the radius sweep's points costs 6
+microseconds (the KD-tree visits many cells for points off the surface), so the floor is
+1.5e5 points/s at infinite radius (6.3e5 on 1e4 triangles, 1.7e6 on 1e3); one exact
+projection per point is 0.2 (triangles) to 1.5 (quadrilaterals) microseconds. 1e6 points/s
+per core in 3D is therefore out of reach of a KD-tree of centroids driven from NumPy; it
+needs a compiled traversal (a bounding-volume tree with the slab bounds, walked per point):
+the fourth round.
 """
 
 import os

@@ -1,10 +1,15 @@
 """Closest-point projection of many slave points onto a master surface made of facets.
 
-Pure NumPy (plus :class:`scipy.spatial.cKDTree` for the candidate search),
-vectorised over points and facets: the only Python loops run over a fixed small number of
-items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points, levels).
-The hot kernels work on coordinate columns (one 1D gather per node coordinate) rather than on
-rows of 2 or 3 numbers, which NumPy gathers and reduces slowly. Throughput:
+The flat facet kinds (segments, triangles, bilinear quadrilaterals) are searched by a
+compiled kernel (``search_kernel.c``, built on first use by :mod:`.compiled`): a
+bounding-volume hierarchy over the facets walked by branch and bound per point, with the
+exact projections of the NumPy kernels below in C; the tie-break between equidistant facets
+stays in NumPy (:func:`_select`). ``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search.
+The quadratic kinds are searched in NumPy (plus :class:`scipy.spatial.cKDTree` for the
+candidates), vectorised over points and facets: the only Python loops run over a fixed small
+number of items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points,
+levels). The hot kernels work on coordinate columns (one 1D gather per node coordinate) rather
+than on rows of 2 or 3 numbers, which NumPy gathers and reduces slowly. Throughput:
 ``benchmarks/search.py``.
 
 Facet kinds and conventions
@@ -51,6 +56,7 @@ is on that bound, one that is not clamped is not):
 from __future__ import annotations
 
 import itertools
+import os
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -59,6 +65,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
+from contact_ufl.contact import compiled
 from contact_ufl.contact.curved import (
     CURVED_EDGES,
     bernstein_hull,
@@ -128,6 +135,9 @@ _SORT = 1 << 14  # facets above which the points are ordered by cells
 _DIRECTIONS = {2: 8, 3: 32}  # normal bins of a self-contact search, by dimension
 _DIRECTIONS_MIN = 1 << 10  # facets above which a self-contact search goes by normal bins
 _FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
+#: The facet kinds of the compiled search (kind numbers of ``search_kernel.c``).
+_COMPILED_KINDS = {"segment": 0, "triangle": 1, "quadrilateral": 2}
+_CAP = 4  # pairs per point returned by the compiled query (more: that point is queried again)
 
 #: An admissibility test of (point, facet) pairs: point and facet indices in, mask out.
 Admit = Callable[[IntArray, IntArray], npt.NDArray[np.bool_]]
@@ -468,6 +478,160 @@ def _tree_levels(
     return levels
 
 
+def _centroid_radius(
+    X: list[list[FloatArray]],
+) -> tuple[list[FloatArray], list[list[FloatArray]], FloatArray]:
+    """Centroid columns (the mean of the points), the offsets of the points from it and the
+    radius ``R_f`` (largest offset) of each facet from the coordinate columns ``X[a][k]`` of
+    its hull points: every point of a facet is a convex combination of its hull points (also
+    for the bilinear quadrilateral), so it lies within ``R_f`` of the centroid."""
+    nn, g = len(X), len(X[0])
+    c = []
+    for k in range(g):
+        ck = X[0][k] + X[1][k]
+        for a in range(2, nn):
+            ck += X[a][k]
+        c.append(ck / nn)
+    offsets = [[Xa[k] - c[k] for k in range(g)] for Xa in X]
+    radius2 = sum(dk * dk for dk in offsets[0])
+    for d in offsets[1:]:
+        np.maximum(radius2, sum(dk * dk for dk in d), out=radius2)
+    return c, offsets, np.sqrt(radius2)
+
+
+def _bilinear(X: list[list[FloatArray]]) -> list[list[FloatArray]]:
+    """``y = c0 + s c1 + t c2 + s t c3`` of bilinear quadrilaterals, by coordinate columns."""
+    x0, x1, x2, x3 = X
+    return [
+        x0,
+        [x1[k] - x0[k] for k in range(3)],
+        [x2[k] - x0[k] for k in range(3)],
+        [x0[k] - x1[k] - x2[k] + x3[k] for k in range(3)],
+    ]
+
+
+class _Facets:
+    """The per-facet data that the selection (:func:`_select`) needs, of some facets: their
+    nodes, centroids, radii ``R_f`` and (quadrilaterals) bilinear coefficients, computed as
+    :class:`_Master` computes them."""
+
+    def __init__(self, nodes: FloatArray) -> None:
+        self.nodes = nodes
+        self.nf, self.nn, self.gdim = nodes.shape
+        self.kind = facet_kind(self.nn, self.gdim)
+        X = [
+            [np.ascontiguousarray(nodes[:, a, k]) for k in range(self.gdim)] for a in range(self.nn)
+        ]
+        c, _, self.size = _centroid_radius(X)
+        self.centroid = np.stack(c, axis=1)
+        if self.kind == "quadrilateral":
+            self.bilinear = _bilinear(X)
+
+
+class _Hierarchy:
+    """A bounding-volume hierarchy (axis-aligned boxes) over master facets, in C.
+
+    Built once over the facets' centroids (median splits on the longest axis, two to four
+    facets a leaf: ``O(n log n)``), its boxes refitted over the current nodes at every search
+    (``O(n)``, with a copy of the nodes in the order of the leaves): exact however far the
+    nodes moved since the build (only slower once they moved far).
+    """
+
+    def __init__(self, nodes: FloatArray) -> None:
+        self.ffi, self.lib = compiled.kernel()
+        nf, self.nn, self.gdim = nodes.shape
+        self.kind = _COMPILED_KINDS[facet_kind(self.nn, self.gdim)]
+        centroid = np.ascontiguousarray(nodes.mean(axis=1))
+        self.perm = np.empty(nf, dtype=np.int64)
+        self.a = np.empty(nf + 2, dtype=np.int64)  # leaves of 2 to 4 facets: < nf tree nodes
+        self.b = np.empty(nf + 2, dtype=np.int64)
+        p = self._pointers
+        self.m = int(self.lib.bvh_build(self.gdim, nf, *p(centroid, self.perm, self.a, self.b)))
+        self.tree = np.empty((self.m, 2 * self.gdim + 2))  # boxes and children, packed
+        self.leaf_nodes = np.empty_like(nodes)
+        self.R_max = 0.0
+        self.projections = 0
+
+    def _pointers(self, *arrays: np.ndarray) -> list:
+        return [_ptr(self, a) for a in arrays]
+
+    def fitted(self, nodes: FloatArray) -> bool:
+        """Whether the boxes are those of ``nodes`` (C-contiguous): the nodes of the last
+        refit, to the last bit."""
+        nf, nn, g = nodes.shape
+        p = self._pointers
+        return bool(self.lib.same_nodes(nf, nn * g, *p(nodes, self.perm, self.leaf_nodes)))
+
+    def refit(self, nodes: FloatArray) -> None:
+        """The boxes, largest facet radius and leaf-ordered nodes of the current ``nodes``
+        (C-contiguous)."""
+        nf, nn, g = nodes.shape
+        p = self._pointers
+        self.R_max = float(
+            self.lib.bvh_refit(
+                g, nn, nf, *p(nodes, self.perm), self.m,
+                *p(self.a, self.b, self.tree, self.leaf_nodes),
+            )
+        )  # fmt: skip
+
+    def query(
+        self,
+        x: FloatArray,
+        radius: float,
+        cap: int,
+        rule: tuple | None = None,
+        out: Projection | None = None,
+        index: IntArray | None = None,
+    ) -> tuple[IntArray, IntArray, _Pairs]:
+        """The pairs of each point ``x`` (C-contiguous) within the tie reach of its closest
+        facet (at most ``cap`` a point): their number per point, their facets ``(npts,
+        cap)`` and their projections ``(npts, cap)``; ``rule``: the arrays of a self-contact
+        search (point nodes, point normals, facet nodes, facet centre normals). ``out``: a
+        :class:`Projection` (C-contiguous fields) in which each point with one pair gets its
+        closest point, at its row of ``index`` (its count set to 0 if it is beyond
+        ``radius``)."""
+        npts, fdim = x.shape[0], self.gdim - 1
+        count = np.zeros(npts, dtype=np.int64)
+        f = np.empty((npts, cap), dtype=np.int64)
+        xi = np.empty((npts, cap, fdim))
+        dist = np.empty((npts, cap))
+        edge = np.empty((npts, cap), dtype=np.int64)
+        vertex = np.empty((npts, cap), dtype=np.uint8)
+        p = self._pointers
+        null = self.ffi.NULL
+        final = [null] * 8
+        if out is not None:
+            rows = null if index is None else _ptr(self, index)
+            final = [rows, *p(out.facet, out.xi, out.y, out.normal, out.gap, out.distance)]
+            final.append(_ptr(self, out.sliding))
+        contact = [0, null, null, 0, null, null]
+        if rule is not None:
+            pn, pnormal, fn, axis = rule
+            contact = [pn.shape[1], *p(pn, pnormal), fn.shape[1], *p(fn, axis)]
+        status = self.lib.bvh_query(
+            self.kind, self.gdim, self.nn, *p(self.leaf_nodes, self.perm), self.m,
+            _ptr(self, self.tree), self.R_max, npts, _ptr(self, x), radius, cap,
+            *p(count, f, xi, dist, edge, vertex), *final, *contact,
+        )  # fmt: skip
+        if status == -1:
+            raise MemoryError("the compiled closest-point search ran out of memory")
+        if status < 0:
+            raise ValueError(f"no compiled search for {self.nn}-node facets in {self.gdim}D")
+        #: exact projections made by the last query (the work of its pruning)
+        self.projections = int(status)
+        return count, f, _Pairs(xi=xi, dist=dist, edge=edge, vertex=vertex.view(bool))
+
+
+def _ptr(h: _Hierarchy, array: np.ndarray):
+    """A cffi pointer to the data of a C-contiguous ``array``."""
+    kind = {
+        np.dtype(np.float64): "double[]",
+        np.dtype(np.int64): "i64[]",
+        np.dtype(np.uint8): "unsigned char[]",
+    }[array.dtype]
+    return h.ffi.from_buffer(kind, array, require_writable=False)
+
+
 class _Master:
     """Master facets with the per-facet data of the search and the projections.
 
@@ -494,20 +658,8 @@ class _Master:
         if hull is not nodes:
             X_nodes = X
             X = [[np.ascontiguousarray(hull[:, a, k]) for k in range(g)] for a in range(self.nn)]
-        c = []
-        for k in range(g):
-            ck = X[0][k] + X[1][k]
-            for a in range(2, self.nn):
-                ck += X[a][k]
-            c.append(ck / self.nn)
+        c, offsets, self.size = _centroid_radius(X)
         self.centroid = np.stack(c, axis=1)
-        # every point of a facet is a convex combination of its hull points (also for the
-        # bilinear quadrilateral), so it lies within this radius of the centroid
-        offsets = [[Xa[k] - c[k] for k in range(g)] for Xa in X]
-        radius2 = sum(dk * dk for dk in offsets[0])
-        for d in offsets[1:]:
-            np.maximum(radius2, sum(dk * dk for dk in d), out=radius2)
-        self.size = np.sqrt(radius2)
         self.R_max = float(self.size.max()) if self.nf else 0.0
         trees = trees if trees is not None else TreeCache()
         self.levels = _tree_levels(hull, self.centroid, self.size, trees)
@@ -530,14 +682,7 @@ class _Master:
             inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)  # degenerate: never inside
             self.gram_inv = (g22 * inv, -g12 * inv, g11 * inv)
         elif self.kind == "quadrilateral":
-            # y = c0 + s c1 + t c2 + s t c3, by coordinate columns
-            x0, x1, x2, x3 = X
-            self.bilinear = [
-                x0,
-                [x1[k] - x0[k] for k in range(3)],
-                [x2[k] - x0[k] for k in range(3)],
-                [x0[k] - x1[k] - x2[k] + x3[k] for k in range(3)],
-            ]
+            self.bilinear = _bilinear(X)
 
     def lower_bound(self, x: FloatArray, f: IntArray, pid: IntArray | None = None) -> FloatArray:
         """A lower bound of the distance of the points ``x`` (P, gdim) to the facets ``f``
@@ -831,11 +976,42 @@ class TreeCache:
                 self.entries.move_to_end(key)
                 return tree, move
         tree = cKDTree(centroid)
+        self._keep(key, nodes, tree)
+        return tree, 0.0
+
+    def hierarchy(self, nodes: FloatArray) -> _Hierarchy:
+        """The bounding-volume hierarchy of the facets ``nodes`` (C-contiguous), refitted
+        to them: the one of an earlier call on a master of the same shape while no node has
+        moved more than ``_MOVE R_max`` since it was built (a tree of the earlier order stays
+        exact once refitted, and stays good while the facets barely moved; not refitted if
+        no node moved since the last call), else a new one."""
+        key = (*nodes.shape, "hierarchy")
+        entry = self.entries.get(key)
+        tree = None
+        if entry is not None:
+            built, tree = entry
+            if tree.fitted(nodes):  # the master has not moved since the last search
+                self.entries.move_to_end(key)
+                return tree
+            change = tree.lib.largest_change(
+                nodes.size, _ptr(tree, nodes), _ptr(tree, built)
+            ) * np.sqrt(nodes.shape[2])
+            if change <= _MOVE * tree.R_max:
+                self.entries.move_to_end(key)
+            else:
+                tree = None
+        if tree is None:
+            tree = _Hierarchy(nodes)
+            self._keep(key, nodes, tree)
+        tree.refit(nodes)
+        return tree
+
+    def _keep(self, key: tuple, nodes: FloatArray, tree: object) -> None:
+        """Keep ``tree``, built over ``nodes``, as the most recent entry."""
         self.entries[key] = (nodes.copy(), tree)
         self.entries.move_to_end(key)
         while len(self.entries) > _TREES:
             self.entries.popitem(last=False)
-        return tree, 0.0
 
 
 def _candidates(
@@ -1151,6 +1327,29 @@ def _spatial_order(points: FloatArray) -> IntArray:
     return np.argsort(key, kind="stable")
 
 
+def _spread_bits(v: npt.NDArray[np.uint64]) -> npt.NDArray[np.uint64]:
+    """The 10 low bits of ``v`` spread to every third bit (bit ``i`` to bit ``3 i``)."""
+    v = v & np.uint64(0x3FF)
+    for shift, mask in ((16, 0x030000FF), (8, 0x0300F00F), (4, 0x030C30C3), (2, 0x09249249)):
+        v = (v | (v << np.uint64(shift))) & np.uint64(mask)
+    return v
+
+
+def _cell_order(points: FloatArray) -> IntArray:
+    """An order of the points along a Z-order (Morton) curve through the cells of a
+    ``1024^gdim`` grid over their bounding box: the points of a cell, then of its neighbours,
+    come one after the other (they walk the same branches of a tree while it is in cache)."""
+    lo = points.min(axis=0)
+    span = float((points.max(axis=0) - lo).max())
+    if not (np.isfinite(span) and span > 0.0):
+        return np.arange(points.shape[0])
+    cell = np.minimum((points - lo) * (1024.0 / span), 1023.0).astype(np.uint64)
+    key = _spread_bits(cell[:, 0])
+    for k in range(1, points.shape[1]):
+        key |= _spread_bits(cell[:, k]) << np.uint64(k)
+    return np.argsort(key)
+
+
 def closest_points(
     points: npt.ArrayLike,
     nodes: npt.ArrayLike,
@@ -1186,8 +1385,22 @@ def closest_points(
 
     Notes
     -----
-    Candidate search: KD-trees of the facet centroids (the mean of the nodes; of a quadratic
-    facet, of its Bernstein control points, whose convex hull holds it). Every facet point is
+    Flat facets (segments, triangles, bilinear quadrilaterals; unless
+    ``CONTACT_UFL_SEARCH=numpy``): a bounding-volume hierarchy of axis-aligned boxes over the
+    facets' nodes (median splits, 2 to 4 facets a leaf; built once per master shape and
+    kept in ``trees`` while no node has moved more than ``0.25 R_max``, its boxes refitted
+    to the current nodes at every call) is walked per point in C, nearer child first,
+    skipping every box (and facet box) farther than ``r = min(d, radius)`` with ``d`` the
+    smallest exact distance met so far (widened by ``1e-9 (r + 2 R_max)``, beyond the
+    tie tolerance): the work follows the point's distance to the surface, not the radius.
+    The exact projections are those of the NumPy kernels, in the same operations. A point
+    with one facet within that reach gets its closest point, normal, proximity and ``M``
+    from C; the points with several go through the NumPy tie-break below. Self-contact:
+    the inadmissible facets are skipped in the walk (the same rule).
+
+    Candidate search of the quadratic facets (and of all with ``CONTACT_UFL_SEARCH=numpy``):
+    KD-trees of the facet centroids (the mean of the nodes; of a quadratic facet, of its
+    Bernstein control points, whose convex hull holds it). Every facet point is
     within ``R_f`` (the largest node, or control point, distance from the centroid) of it.
     The facets are sorted by ``R_f`` into levels (radius ratio 4 between levels, the first up
     to twice the median ``R_f``; an even mesh has one level), each with its KD-tree and its
@@ -1255,13 +1468,62 @@ def closest_points(
     )
     if npts == 0 or nf == 0:
         return out
+    trees = trees if trees is not None else TreeCache()
     if self_contact is not None:
         _check_self_contact(self_contact, npts, nf, gdim)
         if nf > _DIRECTIONS_MIN:
             _by_direction(points, nodes, radius, self_contact, out)
             return out
-    _search(points, nodes, radius, trees if trees is not None else TreeCache(), self_contact, out)
+    _search(points, nodes, radius, trees, self_contact, out)
     return out
+
+
+def _compiled(nn: int, gdim: int) -> bool:
+    """Whether the facets of ``nn`` nodes in ``gdim`` go by the compiled search: the flat
+    kinds, unless ``CONTACT_UFL_SEARCH=numpy`` asks for the NumPy search."""
+    if os.environ.get("CONTACT_UFL_SEARCH", "compiled").lower() == "numpy":
+        return False
+    return facet_kind(nn, gdim) in _COMPILED_KINDS
+
+
+def _search_compiled(
+    points: FloatArray,
+    nodes: FloatArray,
+    radius: float,
+    trees: TreeCache,
+    self_contact: SelfContact | None,
+    out: Projection,
+) -> None:
+    """Fill ``out`` with the closest points of :func:`closest_points` (checked input) by
+    the compiled search: a branch-and-bound walk of a bounding-volume hierarchy per point
+    (``search_kernel.c``) finds its closest facet and those within the tie reach of it (the
+    exact projections of the NumPy kernels, in C). A point with one facet there gets its
+    closest point from C; :func:`_select` picks among the others' pairs (the tie-break).
+    On a master of over ``_SORT`` facets the points are walked in a Z-order of cells
+    (:func:`_cell_order`)."""
+    nodes = np.ascontiguousarray(nodes)
+    tree = trees.hierarchy(nodes)
+    rule = None if self_contact is None else _self_contact_arrays(self_contact, nodes)
+    order = _cell_order(points) if nodes.shape[0] > _SORT else None
+    x = points if order is None else np.ascontiguousarray(points[order])
+    if rule is not None and order is not None:
+        rule = (rule[0][order], rule[1][order], rule[2], rule[3])
+    # the points with one facet within the tie reach get their closest point in C
+    count, f, pairs = tree.query(x, radius, _CAP, rule, out, order)
+    rows, fid, pairs = _tied_pairs(tree, x, radius, rule, count, f, pairs)
+    if rows.size == 0:
+        return
+    pid = rows if order is None else order[rows]
+    # the selection over the facets met only (their data computed as _Master does)
+    facets, local = np.unique(fid, return_inverse=True)
+    tied = np.unique(pid)
+    part = Projection(*(getattr(out, k)[tied] for k in _FIELDS))
+    _select(_Facets(nodes[facets]), points[tied], radius, part, np.searchsorted(tied, pid),
+            local, pairs)  # fmt: skip
+    paired = part.facet >= 0
+    part.facet[paired] = facets[part.facet[paired]]
+    for k in _FIELDS:
+        getattr(out, k)[tied] = getattr(part, k)
 
 
 def _search(
@@ -1272,7 +1534,22 @@ def _search(
     self_contact: SelfContact | None,
     out: Projection,
 ) -> None:
-    """Fill ``out`` with the closest points of :func:`closest_points` (checked input)."""
+    """Fill ``out`` with the closest points of :func:`closest_points` (checked input): by
+    the compiled search for the flat facet kinds (:func:`_compiled`), else in NumPy."""
+    search = _search_compiled if _compiled(*nodes.shape[1:]) else _search_numpy
+    search(points, nodes, radius, trees, self_contact, out)
+
+
+def _search_numpy(
+    points: FloatArray,
+    nodes: FloatArray,
+    radius: float,
+    trees: TreeCache,
+    self_contact: SelfContact | None,
+    out: Projection,
+) -> None:
+    """Fill ``out`` with the closest points of :func:`closest_points` (checked input) by
+    KD-trees of the facet centroids and the NumPy kernels."""
     npts, nf = points.shape[0], nodes.shape[0]
     master = _Master(nodes, trees)
     # on a large master the points in the order of a grid of cells (neighbours searched
@@ -1291,3 +1568,52 @@ def _search(
     if order is not None:
         for k in _FIELDS:
             getattr(out, k)[order] = getattr(work, k)
+
+
+def _self_contact_arrays(rule: SelfContact, nodes: FloatArray) -> tuple[np.ndarray, ...]:
+    """The arrays of a compiled self-contact search: point nodes, point normals, facet nodes
+    and the facets' unit normals at their centres (as :class:`_Master` ``.axis``)."""
+    g, nn = nodes.shape[2], nodes.shape[1]
+    X = [[np.ascontiguousarray(nodes[:, a, k]) for k in range(g)] for a in range(nn)]
+    axis = np.stack(_normalise(_centre_normal(X, nn, g)), axis=1)
+    return tuple(
+        np.ascontiguousarray(a, dtype=dtype)
+        for a, dtype in (
+            (rule.point_nodes, np.int64),
+            (rule.point_normals, np.float64),
+            (rule.facet_nodes, np.int64),
+            (axis, np.float64),
+        )
+    )
+
+
+def _tied_pairs(
+    tree: _Hierarchy,
+    x: FloatArray,
+    radius: float,
+    rule: tuple | None,
+    count: IntArray,
+    f: IntArray,
+    pairs: _Pairs,
+) -> tuple[IntArray, IntArray, _Pairs]:
+    """The pairs of the points ``x`` with several facets within the tie reach (``count``,
+    ``f``, ``pairs``: the query's result, at most ``_CAP`` a point; the points with more
+    queried again with room for all): point rows, facets and projections."""
+    fields = ("xi", "dist", "edge", "vertex")
+    kept = (np.arange(_CAP) < count[:, None]) & (count[:, None] > 1)
+    rows, fid = np.nonzero(kept)[0], f[kept]
+    pairs = _Pairs(*(getattr(pairs, k)[kept] for k in fields))
+    more = np.flatnonzero(count > _CAP)
+    if more.size:
+        cap = int(count[more].max())
+        sub = None if rule is None else (rule[0][more], rule[1][more], rule[2], rule[3])
+        count_m, f_m, pairs_m = tree.query(np.ascontiguousarray(x[more]), radius, cap, sub)
+        kept_m = np.arange(cap) < count_m[:, None]
+        keep = np.flatnonzero(count[rows] <= _CAP)
+        rows = np.concatenate([rows[keep], more[np.nonzero(kept_m)[0]]])
+        fid = np.concatenate([fid[keep], f_m[kept_m]])
+        pairs = _concatenate(
+            _Pairs(*(getattr(pairs, k)[keep] for k in fields)),
+            _Pairs(*(getattr(pairs_m, k)[kept_m] for k in fields)),
+        )
+    return rows, fid, pairs

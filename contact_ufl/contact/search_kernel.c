@@ -1,0 +1,717 @@
+/* Closest-point search of contact_ufl: a bounding-volume hierarchy (AABB tree) over the
+ * master facets and a branch-and-bound nearest-facet query per slave point.
+ *
+ * Compiled on first use by contact_ufl.contact.compiled (the system C compiler, loaded with
+ * cffi) and called by contact_ufl.contact.projection for the flat facet kinds:
+ *   kind 0: segment (2 nodes, 2D), 1: triangle (3 nodes, 3D), 2: bilinear quadrilateral
+ *   (4 nodes, 3D, basix order).
+ * The exact projections repeat the operations of the NumPy kernels of projection.py in the
+ * same order (compile with -ffp-contract=off: no fused multiply-add), so that the distances
+ * are those of the NumPy kernels to the last bit.
+ *
+ * Tree layout: nodes in preorder; node i is a leaf when a[i] < 0 (its facets are
+ * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query reads
+ * the packed rows of bvh_refit: (lo_0 .. lo_g-1, hi_0 .. hi_g-1, a, b), one cache line in 3D.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef long long i64;
+
+#define LEAF 4
+#define NEWTON_ITERATIONS 25
+#define NEWTON_TOL 1e-13
+#define STACK 512
+#define INLINE static inline __attribute__((always_inline))
+
+/* -- build ------------------------------------------------------------------------------ */
+
+static void select_nth(i64 *perm, i64 lo, i64 hi, i64 nth, const double *c, int g, int axis)
+{
+    /* reorder perm[lo:hi] so that perm[nth] has the nth key and smaller keys come first */
+    while (hi - lo > 1) {
+        double pivot = c[perm[(lo + hi) / 2] * g + axis];
+        i64 i = lo, j = hi - 1;
+        while (i <= j) {
+            while (c[perm[i] * g + axis] < pivot) i++;
+            while (c[perm[j] * g + axis] > pivot) j--;
+            if (i <= j) {
+                i64 t = perm[i];
+                perm[i] = perm[j];
+                perm[j] = t;
+                i++;
+                j--;
+            }
+        }
+        if (nth <= j)
+            hi = j + 1;
+        else if (nth >= i)
+            lo = i;
+        else
+            return;
+    }
+}
+
+static i64 build_node(int g, const double *c, i64 *perm, i64 lo, i64 hi, i64 *a, i64 *b,
+                      i64 *count)
+{
+    i64 node = (*count)++;
+    if (hi - lo <= LEAF) {
+        a[node] = -(lo + 1);
+        b[node] = hi - lo;
+        return node;
+    }
+    double mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (i64 i = lo; i < hi; i++)
+        for (int k = 0; k < g; k++) {
+            double v = c[perm[i] * g + k];
+            if (v < mn[k]) mn[k] = v;
+            if (v > mx[k]) mx[k] = v;
+        }
+    int axis = 0;
+    for (int k = 1; k < g; k++)
+        if (mx[k] - mn[k] > mx[axis] - mn[axis]) axis = k;
+    i64 mid = (lo + hi) / 2;
+    select_nth(perm, lo, hi, mid, c, g, axis);
+    a[node] = build_node(g, c, perm, lo, mid, a, b, count);
+    b[node] = build_node(g, c, perm, mid, hi, a, b, count);
+    return node;
+}
+
+/* Build the tree over n facets of centroids c (n, g); perm (n) is filled, a and b (at
+ * least n + 1 entries: the leaves hold 2 to 4 facets) too. Returns the number of tree nodes. */
+i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b)
+{
+    i64 count = 0;
+    for (i64 i = 0; i < n; i++) perm[i] = i;
+    if (n > 0) build_node(g, c, perm, 0, n, a, b, &count);
+    return count;
+}
+
+INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
+                    const i64 *a, const i64 *b, double *tree, double *leaf_nodes)
+{
+    int W = 2 * g + 2;
+    double r2max = 0.0;
+    for (i64 j = 0; j < n; j++) {
+        const double *X = nodes + perm[j] * nn * g;
+        double *Y = leaf_nodes + j * nn * g, c[3];
+        for (int q = 0; q < nn * g; q++) Y[q] = X[q];
+        for (int k = 0; k < g; k++) {
+            double s = X[k];
+            for (int q = 1; q < nn; q++) s += X[q * g + k];
+            c[k] = s / nn;
+        }
+        for (int q = 0; q < nn; q++) {
+            double d2 = 0.0;
+            for (int k = 0; k < g; k++) {
+                double d = X[q * g + k] - c[k];
+                d2 += d * d;
+            }
+            if (d2 > r2max) r2max = d2;
+        }
+    }
+    for (i64 i = m - 1; i >= 0; i--) {
+        double *B = tree + i * W;
+        for (int k = 0; k < g; k++) {
+            B[k] = INFINITY;
+            B[g + k] = -INFINITY;
+        }
+        B[2 * g] = (double)a[i];
+        B[2 * g + 1] = (double)b[i];
+        if (a[i] < 0) {
+            i64 start = -a[i] - 1;
+            for (i64 j = start; j < start + b[i]; j++) {
+                const double *X = leaf_nodes + j * nn * g;
+                for (int q = 0; q < nn; q++)
+                    for (int k = 0; k < g; k++) {
+                        double v = X[q * g + k];
+                        if (v < B[k]) B[k] = v;
+                        if (v > B[g + k]) B[g + k] = v;
+                    }
+            }
+        } else {
+            const double *L = tree + a[i] * W, *R = tree + b[i] * W;
+            for (int k = 0; k < g; k++) {
+                B[k] = L[k] < R[k] ? L[k] : R[k];
+                B[g + k] = L[g + k] > R[g + k] ? L[g + k] : R[g + k];
+            }
+        }
+    }
+    return sqrt(r2max);
+}
+
+/* The tree over the current nodes (n, nn, g) of the facets: tree (m, 2 g + 2) holds per tree
+ * node its box (lo_0 .. lo_g-1, hi_0 .. hi_g-1; every facet point lies in the convex hull of
+ * its nodes) and a, b as doubles; leaf_nodes (n, nn, g) the nodes in the order of perm (the
+ * facets of a leaf contiguous). Returns the largest facet radius (node distance from the
+ * mean of the nodes), or -1 for an unknown facet kind. */
+double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
+                 const i64 *a, const i64 *b, double *tree, double *leaf_nodes)
+{
+    if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    return -1.0;
+}
+
+/* Whether the nodes (n, nn, g) are those of the last bvh_refit (leaf_nodes, in the order of
+ * perm), to the last bit (stops at the first difference). */
+int same_nodes(i64 n, int width, const double *nodes, const i64 *perm,
+               const double *leaf_nodes)
+{
+    for (i64 j = 0; j < n; j++)
+        if (memcmp(nodes + perm[j] * width, leaf_nodes + j * width, width * sizeof(double)))
+            return 0;
+    return 1;
+}
+
+/* The largest coordinate change between two node arrays of len values. */
+double largest_change(i64 len, const double *p, const double *q)
+{
+    double m = 0.0;
+    for (i64 i = 0; i < len; i++) {
+        double d = fabs(p[i] - q[i]);
+        if (d > m) m = d;
+    }
+    return m;
+}
+
+/* -- exact projections (the NumPy kernels' operations, in their order) ------------------- */
+
+typedef struct {
+    double xi[2];
+    double dist;
+    i64 edge;
+    int vertex;
+} pair_t;
+
+/* straight edges: start node, end node, xi at start, xi at end (projection._EDGES) */
+static const int SEG_EDGES[1][2] = {{0, 1}};
+static const double SEG_XI[1][2][2] = {{{0.0, 0.0}, {1.0, 0.0}}};
+static const int TRI_EDGES[3][2] = {{0, 1}, {1, 2}, {0, 2}};
+static const double TRI_XI[3][2][2] = {
+    {{0.0, 0.0}, {1.0, 0.0}}, {{1.0, 0.0}, {0.0, 1.0}}, {{0.0, 0.0}, {0.0, 1.0}}};
+static const int QUAD_EDGES[4][2] = {{0, 1}, {1, 3}, {2, 3}, {0, 2}};
+static const double QUAD_XI[4][2][2] = {{{0.0, 0.0}, {1.0, 0.0}},
+                                        {{1.0, 0.0}, {1.0, 1.0}},
+                                        {{0.0, 1.0}, {1.0, 1.0}},
+                                        {{0.0, 0.0}, {0.0, 1.0}}};
+
+INLINE double sum_sq(int g, const double *w)
+{
+    /* sum(w[k] * w[k] for k in range(1, g)) + w[0] * w[0], as projection._edges */
+    double s = w[1] * w[1];
+    for (int k = 2; k < g; k++) s += w[k] * w[k];
+    return s + w[0] * w[0];
+}
+
+INLINE double sum_prod(int g, const double *v, const double *w)
+{
+    double s = v[1] * w[1];
+    for (int k = 2; k < g; k++) s += v[k] * w[k];
+    return s + v[0] * w[0];
+}
+
+INLINE void edges(int g, int ne, const int (*E)[2], const double (*XI)[2][2], int fdim,
+                  const double *X, const double *x, pair_t *out)
+{
+    double best_d = 0.0, best_u = 0.0;
+    int best_k = 0;
+    for (int n = 0; n < ne; n++) {
+        const double *A = X + E[n][0] * g, *B = X + E[n][1] * g;
+        double e[3], r[3], w[3];
+        for (int k = 0; k < g; k++) {
+            e[k] = B[k] - A[k];
+            r[k] = x[k] - A[k];
+        }
+        double ee = sum_sq(g, e), re = sum_prod(g, r, e);
+        double u = re / (ee > 0 ? ee : 1.0);
+        u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+        for (int k = 0; k < g; k++) w[k] = r[k] - u * e[k];
+        double d = sqrt(sum_sq(g, w));
+        if (n == 0 || d < best_d) {
+            best_d = d;
+            best_u = u;
+            best_k = n;
+        }
+    }
+    for (int j = 0; j < fdim; j++)
+        out->xi[j] = XI[best_k][0][j] + best_u * (XI[best_k][1][j] - XI[best_k][0][j]);
+    out->dist = best_d;
+    out->edge = best_k;
+    out->vertex = best_u == 0.0 || best_u == 1.0;
+}
+
+INLINE double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+INLINE void triangle(const double *X, const double *x, pair_t *out)
+{
+    /* the projection on the plane where it is inside, else the closest point of the edges
+     * (projection._triangle_interior replaces the edges' result where it is inside) */
+    double a1[3], a2[3], r[3];
+    for (int k = 0; k < 3; k++) {
+        a1[k] = X[3 + k] - X[k];
+        a2[k] = X[6 + k] - X[k];
+        r[k] = x[k] - X[k];
+    }
+    double g11 = dot3(a1, a1), g12 = dot3(a1, a2), g22 = dot3(a2, a2);
+    double det = g11 * g22 - g12 * g12;
+    int ok = det > 1e-14 * g11 * g22;
+    double inv = ok ? 1.0 / det : 0.0;
+    double i11 = g22 * inv, i12 = -g12 * inv, i22 = g11 * inv;
+    double b1 = r[0] * a1[0] + r[1] * a1[1] + r[2] * a1[2];
+    double b2 = r[0] * a2[0] + r[1] * a2[1] + r[2] * a2[2];
+    double xi1 = i11 * b1 + i12 * b2, xi2 = i12 * b1 + i22 * b2;
+    if (xi1 > 0.0 && xi2 > 0.0 && xi1 + xi2 < 1.0) {
+        double w[3];
+        for (int k = 0; k < 3; k++) w[k] = r[k] - xi1 * a1[k] - xi2 * a2[k];
+        out->xi[0] = xi1;
+        out->xi[1] = xi2;
+        out->dist = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        out->edge = -1;
+        out->vertex = 0;
+    } else {
+        edges(3, 3, TRI_EDGES, TRI_XI, 2, X, x, out);
+    }
+}
+
+INLINE void quad_residual(const double (*c)[3], const double *x, double s, double t, double *r)
+{
+    for (int k = 0; k < 3; k++) r[k] = x[k] - (c[0][k] + s * c[1][k] + t * c[2][k] + s * t * c[3][k]);
+}
+
+INLINE double clip01(double v) { return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v); }
+
+/* projection._quad_newton for one pair: xi in/out, returns the distance; conv, pd out */
+static double quad_newton(const double (*c)[3], const double *x, double *xi, int *conv, int *pd)
+{
+    double s = xi[0], t = xi[1], a1[3], a2[3], r[3], rn[3];
+    *conv = 0;
+    for (int it = 0; it < NEWTON_ITERATIONS; it++) {
+        for (int k = 0; k < 3; k++) {
+            a1[k] = c[1][k] + t * c[3][k];
+            a2[k] = c[2][k] + s * c[3][k];
+        }
+        quad_residual(c, x, s, t, r);
+        double g1 = -dot3(r, a1), g2 = -dot3(r, a2);
+        double h11 = dot3(a1, a1), h22 = dot3(a2, a2), h12gn = dot3(a1, a2);
+        double h12 = h12gn - dot3(r, c[3]);
+        double det = h11 * h22 - h12 * h12;
+        if (det <= 1e-12 * h11 * h22) h12 = h12gn;
+        det = h11 * h22 - h12 * h12;
+        if (!(det > 0)) det = INFINITY;
+        double step1 = -(h22 * g1 - h12 * g2) / det, step2 = -(h11 * g2 - h12 * g1) / det;
+        int fix1 = (s <= 0.0 && g1 > 0.0) || (s >= 1.0 && g1 < 0.0);
+        int fix2 = (t <= 0.0 && g2 > 0.0) || (t >= 1.0 && g2 < 0.0);
+        if (fix1 != fix2) {
+            step1 = fix1 ? 0.0 : -g1 / (h11 > 0 ? h11 : INFINITY);
+            step2 = fix2 ? 0.0 : -g2 / (h22 > 0 ? h22 : INFINITY);
+        }
+        if (fix1 && fix2) step1 = step2 = 0.0;
+        double f0 = dot3(r, r);
+        double ns = clip01(s + step1), nt = clip01(t + step2);
+        for (int h = 0; h < 3; h++) {
+            quad_residual(c, x, ns, nt, rn);
+            if (!(dot3(rn, rn) > f0 * (1 + 1e-10))) break;
+            step1 *= 0.5;
+            step2 *= 0.5;
+            ns = clip01(s + step1);
+            nt = clip01(t + step2);
+        }
+        double ds = fabs(ns - s), dt = fabs(nt - t);
+        int done = (ds > dt ? ds : dt) <= NEWTON_TOL;
+        s = ns;
+        t = nt;
+        if (done) {
+            *conv = 1;
+            break;
+        }
+    }
+    for (int k = 0; k < 3; k++) {
+        a1[k] = c[1][k] + t * c[3][k];
+        a2[k] = c[2][k] + s * c[3][k];
+    }
+    quad_residual(c, x, s, t, r);
+    double h11 = dot3(a1, a1), h22 = dot3(a2, a2);
+    double h12 = dot3(a1, a2) - dot3(r, c[3]);
+    *pd = h11 > 0 && h11 * h22 - h12 * h12 > 0;
+    xi[0] = s;
+    xi[1] = t;
+    return sqrt(dot3(r, r));
+}
+
+INLINE int inner(const double *xi) { return xi[0] > 0.0 && xi[0] < 1.0 && xi[1] > 0.0 && xi[1] < 1.0; }
+
+static void quadrilateral(const double *X, const double *x, pair_t *out)
+{
+    static const double starts[4][2] = {{0.25, 0.25}, {0.75, 0.25}, {0.25, 0.75}, {0.75, 0.75}};
+    edges(3, 4, QUAD_EDGES, QUAD_XI, 2, X, x, out);
+    double c[4][3];
+    for (int k = 0; k < 3; k++) {
+        c[0][k] = X[k];
+        c[1][k] = X[3 + k] - X[k];
+        c[2][k] = X[6 + k] - X[k];
+        c[3][k] = X[k] - X[3 + k] - X[6 + k] + X[9 + k];
+    }
+    double xi[2] = {0.5, 0.5};
+    int conv, pd;
+    double dist = quad_newton(c, x, xi, &conv, &pd);
+    if (!conv || (inner(xi) && !pd)) {
+        for (int j = 0; j < 4; j++) {
+            double xr[2] = {starts[j][0], starts[j][1]};
+            int conv_r, pd_r;
+            double dist_r = quad_newton(c, x, xr, &conv_r, &pd_r);
+            if (inner(xr) && (!inner(xi) || dist_r < dist)) {
+                xi[0] = xr[0];
+                xi[1] = xr[1];
+                dist = dist_r;
+            }
+        }
+    }
+    if (inner(xi) && dist < out->dist) {
+        out->xi[0] = xi[0];
+        out->xi[1] = xi[1];
+        out->dist = dist;
+        out->edge = -1;
+        out->vertex = 0;
+    }
+}
+
+INLINE void project(int kind, const double *X, const double *x, pair_t *out)
+{
+    if (kind == 0) {
+        edges(2, 1, SEG_EDGES, SEG_XI, 1, X, x, out);
+        out->edge = -1;
+    } else if (kind == 1) {
+        triangle(X, x, out);
+    } else {
+        quadrilateral(X, x, out);
+    }
+}
+
+/* Exact projections of the pairs (x[p], facet f[p]) (a test and fallback entry point). */
+void project_pairs(int kind, int g, int nn, const double *nodes, i64 P, const double *x,
+                   const i64 *f, double *xi, double *dist, i64 *edge, unsigned char *vertex)
+{
+    int fdim = g - 1;
+    for (i64 p = 0; p < P; p++) {
+        pair_t q;
+        project(kind, nodes + f[p] * nn * g, x + p * g, &q);
+        for (int j = 0; j < fdim; j++) xi[p * fdim + j] = q.xi[j];
+        dist[p] = q.dist;
+        edge[p] = q.edge;
+        vertex[p] = (unsigned char)q.vertex;
+    }
+}
+
+/* -- branch-and-bound query -------------------------------------------------------------- */
+
+INLINE double box_distance2(int g, const double *B, const double *x)
+{
+    /* branch-free: max(lo - x, x - hi, 0) per coordinate (a box is never inverted) */
+    double s = 0.0;
+    for (int k = 0; k < g; k++) {
+        double lo = B[k] - x[k], hi = x[k] - B[g + k];
+        double d = lo > hi ? lo : hi;
+        d = d > 0.0 ? d : 0.0;
+        s += d * d;
+    }
+    return s;
+}
+
+/* the distance below which a facet may tie with the closest one at distance v (wider than
+ * the tie tolerance 1e-10 (v + 2 R_f) of projection._select) */
+INLINE double reach(double v, double rmax) { return v + 1e-9 * (v + 2.0 * rmax); }
+
+typedef struct {
+    i64 j; /* position in the leaves */
+    pair_t q;
+} hit_t;
+
+/* The closest point of x on the facet X at q.xi and what projection._select computes of it:
+ * y (g), the unit normal nu (g), gap -nu . (x - y), distance |x - y| and the linearisation
+ * M (fdim, fdim; projection._sliding). Returns whether the distance is within radius. */
+INLINE int finish(int kind, int g, int nn, const double *X, const double *x, const pair_t *q,
+                  double radius, double *y, double *nu, double *gap, double *distance,
+                  double *M)
+{
+    double N[4], dN[2][4], a[2][3] = {{0.0}}, r[3];
+    int fdim = g - 1;
+    if (kind == 0) {
+        double u = q->xi[0];
+        N[0] = 1.0 - u;
+        N[1] = u;
+        dN[0][0] = -1.0;
+        dN[0][1] = 1.0;
+    } else if (kind == 1) {
+        N[0] = 1.0 - q->xi[0] - q->xi[1];
+        N[1] = q->xi[0];
+        N[2] = q->xi[1];
+        dN[0][0] = -1.0, dN[0][1] = 1.0, dN[0][2] = 0.0;
+        dN[1][0] = -1.0, dN[1][1] = 0.0, dN[1][2] = 1.0;
+    } else {
+        double s = q->xi[0], t = q->xi[1];
+        N[0] = (1 - s) * (1 - t), N[1] = s * (1 - t), N[2] = (1 - s) * t, N[3] = s * t;
+        dN[0][0] = t - 1.0, dN[0][1] = 1.0 - t, dN[0][2] = -t, dN[0][3] = t;
+        dN[1][0] = s - 1.0, dN[1][1] = -s, dN[1][2] = 1.0 - s, dN[1][3] = s;
+    }
+    for (int k = 0; k < g; k++) {
+        double v = N[0] * X[k];
+        for (int n = 1; n < nn; n++) v += N[n] * X[n * g + k];
+        y[k] = v;
+        r[k] = x[k] - v;
+        for (int al = 0; al < fdim; al++) {
+            double w = dN[al][0] * X[k];
+            for (int n = 1; n < nn; n++) w += dN[al][n] * X[n * g + k];
+            a[al][k] = w;
+        }
+    }
+    double n3[3], len2 = 0.0;
+    if (g == 2) {
+        n3[0] = a[0][1];
+        n3[1] = -a[0][0];
+    } else {
+        n3[0] = a[0][1] * a[1][2] - a[0][2] * a[1][1];
+        n3[1] = a[0][2] * a[1][0] - a[0][0] * a[1][2];
+        n3[2] = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    }
+    for (int k = 0; k < g; k++) len2 += n3[k] * n3[k];
+    double len = sqrt(len2), rr = 0.0, nr = 0.0;
+    for (int k = 0; k < g; k++) {
+        nu[k] = len > 0 ? n3[k] / len : 0.0;
+        rr += r[k] * r[k];
+        nr += nu[k] * r[k];
+    }
+    *distance = sqrt(rr);
+    if (!(*distance <= radius)) return 0;
+    *gap = -nr;
+    if (fdim == 1) {
+        double A11 = a[0][0] * a[0][0] + a[0][1] * a[0][1];
+        M[0] = !q->vertex && A11 != 0 ? 1.0 / A11 : 0.0;
+        return 1;
+    }
+    double A00 = dot3(a[0], a[0]), A11 = dot3(a[1], a[1]), A01 = dot3(a[0], a[1]);
+    if (kind == 2) {
+        double c3[3];
+        for (int k = 0; k < 3; k++) c3[k] = X[k] - X[3 + k] - X[6 + k] + X[9 + k];
+        A01 -= dot3(r, c3);
+    }
+    M[0] = M[1] = M[2] = M[3] = 0.0;
+    if (q->vertex) return 1;
+    if (q->edge < 0) {
+        double det = A00 * A11 - A01 * A01;
+        if (det != 0) {
+            double inv = 1.0 / det;
+            M[0] = A11 * inv;
+            M[3] = A00 * inv;
+            M[1] = M[2] = -A01 * inv;
+        }
+        return 1;
+    }
+    const double(*XI)[2][2] = kind == 1 ? TRI_XI : QUAD_XI;
+    double t0 = XI[q->edge][1][0] - XI[q->edge][0][0], t1 = XI[q->edge][1][1] - XI[q->edge][0][1];
+    double tAt = t0 * (A00 * t0 + A01 * t1) + t1 * (A01 * t0 + A11 * t1);
+    if (tAt != 0) {
+        M[0] = t0 * t0 / tAt;
+        M[1] = M[2] = t0 * t1 / tAt;
+        M[3] = t1 * t1 / tAt;
+    }
+    return 1;
+}
+
+/* Self-contact admissibility (projection.SelfContact.admissible): the facet shares no node
+ * number with the point's facet and its centre normal opposes the point's normal. */
+INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, int mf,
+                      const i64 *fnodes, const double *axis)
+{
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < mf; j++)
+            if (pnodes[i] == fnodes[j]) return 0;
+    double s = 0.0;
+    for (int k = 0; k < g; k++) s += pnormal[k] * axis[k];
+    return s < 0.0;
+}
+
+/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose exact distance is within reach() of the
+ * smallest one, if that smallest one is within reach(radius). count[p] is their number; up
+ * to cap of them are written at p * cap of f, xi (fdim per pair), dist, edge, vertex
+ * (projection._Pairs). Where one facet is within that reach (count 1) and y is not NULL,
+ * the fields of its closest point are written at index[p] (p if index is NULL) of facet,
+ * oxi, y, normal, gap, distance and sliding (a projection.Projection; count set to 0 and
+ * the placeholders written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible facets, with
+ * pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its normal,
+ * fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
+ * Returns the number of exact projections made, or -1 when out of memory. */
+INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
+              const double *tree, double rmax, i64 npts,
+              const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
+              double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
+              double *oxi, double *y, double *normal, double *gap, double *distance,
+              double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
+              const i64 *fnodes, const double *axis)
+{
+    int fdim = g - 1, W = 2 * g + 2;
+    i64 room = 64, projected = 0;
+    hit_t *hits = malloc(room * sizeof(hit_t));
+    if (!hits) return -1;
+    i64 stack[STACK];
+    double lower[STACK];
+    for (i64 p = 0; p < npts; p++) {
+        const double *xp = x + p * g;
+        double best = INFINITY;
+        double bound = reach(radius, rmax), bound2 = bound * bound;
+        i64 nh = 0, top = 0;
+        count[p] = 0;
+        if (m == 0) continue;
+        double d0 = box_distance2(g, tree, xp);
+        if (d0 <= bound2) {
+            stack[0] = 0;
+            lower[0] = d0;
+            top = 1;
+        }
+        while (top > 0) {
+            top--;
+            i64 i = stack[top];
+            if (lower[top] > bound2) continue;
+            const double *T = tree + i * W;
+            i64 ai = (i64)T[2 * g], bi = (i64)T[2 * g + 1];
+            if (ai >= 0) {
+                double dl = box_distance2(g, tree + ai * W, xp);
+                double dr = box_distance2(g, tree + bi * W, xp);
+                i64 near = dl <= dr ? ai : bi, far = dl <= dr ? bi : ai;
+                double dfar = dl <= dr ? dr : dl, dnear = dl <= dr ? dl : dr;
+                if (top + 2 > STACK) {
+                    free(hits);
+                    return -1;
+                }
+                if (dfar <= bound2) {
+                    stack[top] = far;
+                    lower[top++] = dfar;
+                }
+                if (dnear <= bound2) {
+                    stack[top] = near;
+                    lower[top++] = dnear;
+                }
+                continue;
+            }
+            i64 start = -ai - 1;
+            for (i64 j = start; j < start + bi; j++) {
+                const double *X = leaf_nodes + j * nn * g;
+                {  /* the facet's box before its exact projection */
+                    double B[6];
+                    for (int k = 0; k < g; k++) {
+                        B[k] = B[g + k] = X[k];
+                        for (int q = 1; q < nn; q++) {
+                            double v = X[q * g + k];
+                            if (v < B[k]) B[k] = v;
+                            if (v > B[g + k]) B[g + k] = v;
+                        }
+                    }
+                    if (box_distance2(g, B, xp) > bound2) continue;
+                }
+                if (pnodes && !admissible(g, mp, pnodes + p * mp, pnormal + p * g, mf,
+                                          fnodes + perm[j] * mf, axis + perm[j] * g))
+                    continue;
+                pair_t q;
+                project(kind, X, xp, &q);
+                projected++;
+                if (q.dist > bound) continue;
+                if (nh == room) {
+                    /* drop the hits beyond the bound, then grow */
+                    i64 k = 0;
+                    for (i64 h = 0; h < nh; h++)
+                        if (hits[h].q.dist <= bound) hits[k++] = hits[h];
+                    nh = k;
+                    if (nh == room) {
+                        hit_t *more = realloc(hits, 2 * room * sizeof(hit_t));
+                        if (!more) {
+                            free(hits);
+                            return -1;
+                        }
+                        hits = more;
+                        room *= 2;
+                    }
+                }
+                hits[nh].j = j;
+                hits[nh].q = q;
+                nh++;
+                if (q.dist < best) {
+                    best = q.dist;
+                    double r = reach(best < radius ? best : radius, rmax);
+                    if (r < bound) {
+                        bound = r;
+                        bound2 = r * r;
+                    }
+                }
+            }
+        }
+        i64 k = 0, last = 0;
+        for (i64 h = 0; h < nh; h++) {
+            if (hits[h].q.dist > bound) continue;
+            last = h;
+            if (k < cap) {
+                i64 o = p * cap + k;
+                f[o] = perm[hits[h].j];
+                for (int j = 0; j < fdim; j++) xi[o * fdim + j] = hits[h].q.xi[j];
+                dist[o] = hits[h].q.dist;
+                edge[o] = hits[h].q.edge;
+                vertex[o] = (unsigned char)hits[h].q.vertex;
+            }
+            k++;
+        }
+        count[p] = k;
+        if (k == 1 && y) {
+            /* one facet within the tie reach: the closest point, no tie-break */
+            const pair_t *q = &hits[last].q;
+            const double *X = leaf_nodes + hits[last].j * nn * g;
+            i64 o = index ? index[p] : p;
+            if (finish(kind, g, nn, X, xp, q, radius, y + o * g, normal + o * g, gap + o,
+                       distance + o, sliding + o * fdim * fdim)) {
+                facet[o] = perm[hits[last].j];
+                for (int j = 0; j < fdim; j++) oxi[o * fdim + j] = q->xi[j];
+            } else {
+                count[p] = 0;
+                for (int k2 = 0; k2 < g; k2++) {  /* the placeholders of an unpaired point */
+                    y[o * g + k2] = xp[k2];
+                    normal[o * g + k2] = 0.0;
+                }
+                gap[o] = -INFINITY;
+                distance[o] = INFINITY;
+                for (int j = 0; j < fdim * fdim; j++) sliding[o * fdim * fdim + j] = 0.0;
+            }
+        }
+    }
+    free(hits);
+    return projected;
+}
+
+i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
+              const double *tree, double rmax, i64 npts,
+              const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
+              double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
+              double *oxi, double *y, double *normal, double *gap, double *distance,
+              double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
+              const i64 *fnodes, const double *axis)
+{
+    /* one copy of the walk per facet kind, its dimensions constant */
+    if (kind == 0)
+        return query(0, 2, 2, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
+                     mp, pnodes, pnormal, mf, fnodes, axis);
+    if (kind == 1)
+        return query(1, 3, 3, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
+                     mp, pnodes, pnormal, mf, fnodes, axis);
+    if (kind == 2)
+        return query(2, 3, 4, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
+                     mp, pnodes, pnormal, mf, fnodes, axis);
+    (void)g;
+    (void)nn;
+    return -2;
+}

@@ -1,0 +1,101 @@
+"""The compiled closest-point search (``search_kernel.c``): the same closest points as the
+NumPy search, work that does not grow with the search radius, and its build cache."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_quads
+from test_search_exact import near_and_far
+
+from contact_ufl.contact import compiled, projection
+from contact_ufl.contact.projection import TreeCache, closest_points
+
+FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
+
+
+@pytest.mark.parametrize(
+    ("make", "nf"),
+    [(segment_polyline, 300), (triangle_soup, 200), (warped_quads, 60), (wavy_quads, 400)],
+    ids=["segments", "triangles", "quadrilaterals", "quad-grid"],
+)
+@pytest.mark.parametrize("radius", [np.inf, 0.05])
+def test_compiled_equals_numpy(make, nf, radius, monkeypatch):
+    """The compiled search and the NumPy one (``CONTACT_UFL_SEARCH=numpy``) find the same
+    facets and, to round-off, the same closest points."""
+    rng = np.random.default_rng(nf + 11)
+    nodes = make(rng, nf)
+    points = near_and_far(rng, nodes, 400)
+    fast = closest_points(points, nodes, radius)
+    monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
+    slow = closest_points(points, nodes, radius)
+    np.testing.assert_array_equal(fast.facet, slow.facet)
+    assert 0 < np.count_nonzero(fast.facet >= 0)
+    paired = fast.facet >= 0
+    for k in FIELDS:
+        np.testing.assert_allclose(
+            getattr(fast, k)[paired], getattr(slow, k)[paired], rtol=0, atol=1e-12
+        )
+
+
+def test_work_does_not_grow_with_the_radius():
+    """On a flat grid of 20,000 triangles, points 0.01 to 3 facet sizes above it: the exact
+    projections per point of an infinite radius are those of a radius of a few facets, and
+    a few per point (the branch and bound prunes by the best distance met, not the radius)."""
+    m = 100
+    s = np.linspace(0.0, 1.0, m + 1)
+    X, Y = np.meshgrid(s, s, indexing="ij")
+    V = np.stack([X, Y, np.zeros_like(X)], axis=-1)
+    lower = np.stack([V[:-1, :-1], V[1:, :-1], V[:-1, 1:]], axis=2).reshape(-1, 3, 3)
+    upper = np.stack([V[1:, :-1], V[1:, 1:], V[:-1, 1:]], axis=2).reshape(-1, 3, 3)
+    nodes = np.concatenate([lower, upper])
+    rng = np.random.default_rng(5)
+    h = 1.0 / m
+    points = np.column_stack(
+        [rng.uniform(0.1, 0.9, (2000, 2)), h * 10.0 ** rng.uniform(-2, 0.5, 2000)]
+    )
+    work = {}
+    for radius in (5 * h, 50 * h, np.inf):
+        trees = TreeCache()
+        proj = closest_points(points, nodes, radius, trees)
+        assert np.all(proj.facet >= 0)
+        (entry,) = trees.entries.values()
+        work[radius] = entry[1].projections / len(points)
+    assert work[np.inf] <= 1.2 * work[5 * h]
+    assert work[np.inf] < 40
+
+
+@pytest.mark.serial  # it starts Python processes of its own
+def test_build_cache_and_concurrent_builds(tmp_path):
+    """Four processes building the kernel at once into an empty cache directory: all load
+    it, one library named by the source hash remains, no temporary file is left."""
+    env = {**os.environ, "CONTACT_UFL_CACHE_DIR": str(tmp_path)}
+    code = "from contact_ufl.contact import compiled; compiled.kernel(); print('ok')"
+    runs = [
+        subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE, text=True)
+        for _ in range(4)
+    ]
+    outputs = [run.communicate(timeout=300)[0].strip() for run in runs]
+    assert outputs == ["ok"] * 4
+    files = sorted(p.name for p in tmp_path.iterdir())
+    assert len(files) == 1 and files[0].startswith("search_kernel_") and files[0].endswith(".so")
+
+
+def test_no_compiler_is_a_clear_error(monkeypatch):
+    """Without any C compiler the error names what is missing."""
+    monkeypatch.setenv("CC", "no-such-compiler")
+    monkeypatch.setattr(compiled.shutil, "which", lambda name: None)
+    with pytest.raises(compiled.CompilerNotFound, match="C compiler"):
+        compiled._compiler()
+
+
+def test_numpy_search_on_request(monkeypatch):
+    """``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search (no compiled kernel used)."""
+    assert projection._compiled(3, 3)
+    monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
+    assert not projection._compiled(3, 3)
+    assert not projection._compiled(6, 3)  # quadratic facets: NumPy in any case
