@@ -168,20 +168,27 @@ def test_fan_columns_are_the_facets_beside():
     assert fan_columns(triangles, 3, np.zeros(0, dtype=int)).shape == (0, 0)
 
 
-def test_graded_master_candidates(monkeypatch):
-    """Two large facets beside many small ones (a graded master) leave the number of
-    candidate pairs of the points near the small ones as it is without them: the large
-    facets have KD-trees of their own instead of widening every query."""
+def _graded_master() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """5,000 segments 0.004 long on a gentle wave, the same with two segments 0.6 long
+    beyond their end, and 2,000 points over the small ones."""
     x = np.linspace(0.0, 20.0, 5001)
     v = np.stack([x, 0.01 * np.sin(x)], axis=1)
     fine = np.stack([v[:-1], v[1:]], axis=1)
     end = v[-1]
     large = np.array([[end, end + [0.6, 0.0]], [end + [0.6, 0.0], end + [1.2, 0.0]]])
-    graded = np.concatenate([fine, large])
     rng = np.random.default_rng(3)
     u = rng.uniform(0.0, 19.0, 2000)
     offset = rng.choice([-1.0, 1.0], 2000) * 0.004 * 10.0 ** rng.uniform(-2.0, 1.0, 2000)
     points = np.stack([u, 0.01 * np.sin(u) + offset], axis=1)
+    return fine, np.concatenate([fine, large]), points
+
+
+def test_graded_master_candidates(monkeypatch):
+    """NumPy search: two large facets beside many small ones (a graded master) leave the
+    number of candidate pairs of the points near the small ones as it is without them: the
+    large facets have KD-trees of their own instead of widening every query."""
+    monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
+    fine, graded, points = _graded_master()
     pairs = []
     lower_bound = projection._Master.lower_bound
 
@@ -203,3 +210,21 @@ def test_graded_master_candidates(monkeypatch):
         assert counts[2] <= counts[0] + 2 * len(points)
         assert counts[3] <= counts[1] + 2 * len(points)
         assert counts[0] < 20 * len(points)
+
+
+def test_graded_master_projections_compiled(monkeypatch):
+    """Compiled search: the two large facets of the graded master add almost no exact
+    projections to the points over the small ones (the branch and bound prunes them by
+    distance, whatever their size), at a finite and an infinite radius."""
+    monkeypatch.delenv("CONTACT_UFL_SEARCH", raising=False)
+    fine, graded, points = _graded_master()
+    for radius in (0.04, np.inf):
+        work = []
+        for nodes in (fine, graded):
+            trees = TreeCache()
+            proj = closest_points(points, nodes, radius, trees)
+            assert np.all(proj.facet < len(fine))
+            (entry,) = trees.entries.values()
+            work.append(entry[1].projections)
+        assert work[1] <= work[0] + 0.01 * len(points)
+        assert work[0] < 10 * len(points)
