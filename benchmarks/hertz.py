@@ -202,6 +202,7 @@ def run_3d(
     flat: str,
     degree: int = 1,
     eps: str = "scene",
+    multiplier_degree: int | str = 1,
 ) -> dict:
     """One 3D run; the record of :func:`hertz_3d_run` with the timings of the solver."""
     record, problem = hertz_3d_run(
@@ -209,6 +210,7 @@ def run_3d(
         steps=steps,
         degree=degree,
         default_eps=eps == "default",
+        multiplier_degree=multiplier_degree,
         depth=depth,
         h_edge=h_edge,
         flat=flat,
@@ -240,7 +242,16 @@ def main_3d(args) -> None:
     if args.h:
         meshes = [(h, None) for h in args.h]
     for h, h_edge in meshes:
-        r = run_3d(h, h_edge, args.depth, args.steps, args.flat, args.degree, args.eps)
+        r = run_3d(
+            h,
+            h_edge,
+            args.depth,
+            args.steps,
+            args.flat,
+            args.degree,
+            args.eps,
+            args.multiplier_degree,
+        )
         records.append(r)
         if comm.rank == 0:
             print(
@@ -280,7 +291,7 @@ def main() -> None:
         type=lambda v: v if v == "iso" else int(v),
         choices=(1, 2, "iso"),
         default=1,
-        help="2D: 1, 2 or iso (P1-iso-P2)",
+        help="1, 2 or iso (P1-iso-P2; 3D: with --degree 2)",
     )
     parser.add_argument(
         "--refine-radius", type=float, default=0.3, help="2D: zone of size h, in units of R"
