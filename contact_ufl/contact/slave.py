@@ -394,8 +394,8 @@ class SlaveSurface:
         collective_check(
             self.V.mesh.comm,
             bool(np.all(found >= 0)),
-            "degree-2 multipliers: a multiplier node has no slave facet on its rank (the "
-            "held multipliers need one): use multiplier_degree=1",
+            f"multiplier_degree={self.multiplier_degree!r}: a multiplier node has no slave "
+            "facet on its rank (the held multipliers need one): use multiplier_degree=1",
         )
         return found
 
