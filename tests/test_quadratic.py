@@ -12,12 +12,14 @@ import basix
 import dolfinx
 import numpy as np
 import pytest
+import ufl
 from mpi4py import MPI
 from test_self_contact import _slot_scene
 
 from contact_ufl.contact.interface import ContactInterface
 from contact_ufl.contact.projection import closest_points, shape_functions
 from contact_ufl.contact.quadrature import composite_quadrature, iso_subdivisions
+from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import ContactInputError
 from contact_ufl.materials import LinearElastic
 from contact_ufl.membranes import MembraneNeoHookean
@@ -530,3 +532,35 @@ def test_hertz_iso_removes_the_edge_overshoot_but_zigzags():
     deviation = lam[inside] - np.sqrt(1.0 - x[inside] ** 2)
     assert np.any(np.diff(lam[inside], 2) > 0.1)  # a zig-zag, not a concave profile
     assert deviation.max() > 0.15
+
+
+@pytest.mark.parametrize("dim, cell", [(2, "triangle"), (3, "tetrahedron"), (3, "hexahedron")])
+def test_iso_multiplier_at_points_is_that_of_the_forms(dim, cell):
+    """The P1-iso-P2 multiplier at the slave points as NumPy evaluates it (the laws' point
+    data) equals the one FFCx evaluates in the contact forms, on the curved slave facets of
+    segments, 6-node triangles and 9-node quadrilaterals: the submesh cells and the
+    parent facets number the refined cells alike, whatever their orientation."""
+    scene = curved_pair(dim, cell=cell)
+    pair = scene.contacts[0]
+    domain = scene.parts[0]
+    mesh = domain.mesh
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 2, (dim,)))
+    slave = SlaveSurface(V, domain.surface_tags, pair.slave, 3, 1, "gauss", "iso")
+    assert slave.subdivisions == 2
+    lam = dolfinx.fem.Function(slave.multiplier_space)
+    rng = np.random.default_rng(RNG_SEED)
+    lam.x.array[:] = rng.uniform(1.0, 2.0, lam.x.array.size)
+    lam.x.scatter_forward()
+    Q = slave.point_space(())
+    q = ufl.TestFunction(Q)
+    entity_maps = [slave.entity_map]
+    weighted = dolfinx.fem.assemble_vector(
+        dolfinx.fem.form(lam * q * slave.ds, entity_maps=entity_maps)
+    )
+    weights = dolfinx.fem.assemble_vector(dolfinx.fem.form(q * slave.ds, entity_maps=entity_maps))
+    owned = Q.dofmap.list[: slave.num_cells].ravel()
+    in_forms = weighted.array[owned] / weights.array[owned]
+    assert np.allclose(in_forms, slave.p1_at_points(lam), rtol=1e-12, atol=0.0)
+    # the values differ between the halves of a facet (a check that could fail)
+    per_cell = in_forms.reshape(slave.num_cells, slave.num_points)
+    assert slave.num_cells == 0 or np.ptp(per_cell, axis=1).min() > 1e-3
