@@ -167,11 +167,11 @@ class SlaveSurface:
         #: composite rule of the slave points itself, also in forms without point data
         #: (which would otherwise integrate the multipliers' kinks with one Gauss rule)
         metadata = {"quadrature_degree": self.quadrature_degree}
-        if self.iso:
+        if self.iso:  # as tuples: UFL's form signature (the JIT cache key) has every value
             metadata |= {
                 "quadrature_rule": "custom",
-                "quadrature_points": self.points_ref,
-                "quadrature_weights": self.weights_ref,
+                "quadrature_points": tuple(map(tuple, self.points_ref.tolist())),
+                "quadrature_weights": tuple(self.weights_ref.tolist()),
             }
         self.ds = ufl.Measure(
             "dx" if self.membrane else "ds",
