@@ -13,7 +13,7 @@ degree-2, mesh unless ``--order 1``).
 
     python benchmarks/hertz.py --json benchmarks/results/hertz.json [--quick] [--material linear]
     python benchmarks/hertz.py --json ... --degree 2 [--order 1] [--h 0.02 0.01] [--steps 1]
-        [--subdivisions 4] [--multiplier-degree 2] [--refine-radius 0.1] [--eps default]
+        [--subdivisions 4] [--multiplier-degree 2|iso] [--refine-radius 0.1] [--eps default]
     python benchmarks/hertz.py --dim 3 --degree 2 --steps 1 --eps default --h 0.1 0.07 --json ...
     mpirun -n 2 python benchmarks/hertz.py --json ...
     python benchmarks/hertz.py --plot docs/hertz_speed_error.png [--cpu] RESULTS.json [...]
@@ -71,7 +71,7 @@ def run(
     degree: int = 1,
     order: int | None = None,
     subdivisions: int = 1,
-    multiplier_degree: int = 1,
+    multiplier_degree: int | str = 1,
     refine_radius: float = 0.3,
     eps: str = "scene",
 ) -> dict:
@@ -202,6 +202,7 @@ def run_3d(
     flat: str,
     degree: int = 1,
     eps: str = "scene",
+    multiplier_degree: int | str = 1,
 ) -> dict:
     """One 3D run; the record of :func:`hertz_3d_run` with the timings of the solver."""
     record, problem = hertz_3d_run(
@@ -209,6 +210,7 @@ def run_3d(
         steps=steps,
         degree=degree,
         default_eps=eps == "default",
+        multiplier_degree=multiplier_degree,
         depth=depth,
         h_edge=h_edge,
         flat=flat,
@@ -240,7 +242,16 @@ def main_3d(args) -> None:
     if args.h:
         meshes = [(h, None) for h in args.h]
     for h, h_edge in meshes:
-        r = run_3d(h, h_edge, args.depth, args.steps, args.flat, args.degree, args.eps)
+        r = run_3d(
+            h,
+            h_edge,
+            args.depth,
+            args.steps,
+            args.flat,
+            args.degree,
+            args.eps,
+            args.multiplier_degree,
+        )
         records.append(r)
         if comm.rank == 0:
             print(
@@ -275,7 +286,13 @@ def main() -> None:
         "--h", type=float, nargs="+", default=None, help="h_contact list (3D: no h_edge)"
     )
     parser.add_argument("--subdivisions", type=int, default=1, help="2D: contact quadrature")
-    parser.add_argument("--multiplier-degree", type=int, choices=(1, 2), default=1, help="2D")
+    parser.add_argument(
+        "--multiplier-degree",
+        type=lambda v: v if v == "iso" else int(v),
+        choices=(1, 2, "iso"),
+        default=1,
+        help="1, 2 or iso (P1-iso-P2; 3D: with --degree 2)",
+    )
     parser.add_argument(
         "--refine-radius", type=float, default=0.3, help="2D: zone of size h, in units of R"
     )

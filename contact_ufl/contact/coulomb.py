@@ -82,7 +82,7 @@ class CoulombLaw:
         self.gdim = k.gdim
         mesh = k.u.function_space.mesh
         self.L_T = dolfinx.fem.functionspace(
-            self.slave.submesh, ("Lagrange", self.slave.multiplier_degree, (self.gdim,))
+            self.slave.submesh, self.slave.multiplier_element((self.gdim,))
         )
         self.lambda_T = dolfinx.fem.Function(self.L_T, name="lambda_T")
         self.mu = dolfinx.fem.Constant(mesh, float(mu))

@@ -47,6 +47,27 @@ from contact_ufl.layout import StackedLayout
 from contact_ufl.mpi import global_diameter
 
 
+def check_multiplier_degree(comm: MPI.Comm, pair: ContactPair, degree: int) -> None:
+    """Raise (on every rank) if the pair's multipliers do not fit a degree-``degree``
+    displacement: Lagrange multipliers of at most that degree, P1-iso-P2 with degree 2
+    only (its nodes are those of the P2 trace)."""
+    if pair.iso_multipliers:
+        collective_check(
+            comm,
+            degree == 2,
+            f"multiplier_degree={pair.multiplier_degree!r} (P1-iso-P2) of the pair with slave "
+            f"surface (tag {pair.slave}) needs a degree-2 displacement (got degree {degree}): "
+            "use multiplier_degree=1 with a degree-1 displacement",
+        )
+        return
+    collective_check(
+        comm,
+        pair.multiplier_degree <= degree,
+        f"multiplier_degree={pair.multiplier_degree} of the pair with slave surface (tag "
+        f"{pair.slave}) needs a displacement of that degree (got degree {degree})",
+    )
+
+
 class ContactInterface:
     """The contact terms of one pair, and what its converged state says.
 
@@ -117,12 +138,7 @@ class ContactInterface:
                 "needs one displacement degree on both sides",
             )
         qdeg = pair.quadrature_degree or 2 * degree + 1
-        collective_check(
-            comm,
-            pair.multiplier_degree <= degree,
-            f"multiplier_degree={pair.multiplier_degree} of the pair with slave surface (tag "
-            f"{pair.slave}) needs a displacement of that degree (got degree {degree})",
-        )
+        check_multiplier_degree(comm, pair, degree)
         self.slave = SlaveSurface(
             V,
             facet_tags,

@@ -8,7 +8,8 @@ It interpolates a continuous contact pressure with the same resolution as the sl
 of a P1 displacement, so the active set and the gap condition are imposed in the weak
 (mortar) sense at the contact quadrature points, and the multiplier *is* the nodal pressure
 (property (c) of ``formulation.md``). With a degree-2 displacement it stays P1 by default
-(``ContactPair.multiplier_degree``; the evidence is in ``docs/quadratic-contact.md``).
+(``ContactPair.multiplier_degree``: 2 gives P2, ``"iso"`` P1-iso-P2; the evidence is in
+``docs/quadratic-contact.md``).
 The slave side should be the finer mesh, as usual
 with standard mortar multipliers.
 """

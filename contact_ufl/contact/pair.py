@@ -8,6 +8,7 @@ from mpi4py import MPI
 
 from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.contact.quadrature import QUADRATURE_RULES
+from contact_ufl.contact.slave import ISO_MULTIPLIER, MULTIPLIER_DEGREES
 from contact_ufl.errors import check_positive, collective_check
 
 
@@ -81,10 +82,15 @@ class ContactPair:
         to tell apart integer tags in a scene of several meshes; by default a surface is
         found by its group name. The scene sets both to indices when it is made.
     multiplier_degree
-        Degree of the continuous Lagrange multipliers on the slave surface: 1 (default, also
-        with a degree-2 displacement: smooth and non-negative nodal pressures on 3-node
-        segments and 6-node triangles) or 2 (with a degree-2 displacement only; see
-        ``docs/quadratic-contact.md`` for the comparison).
+        The continuous multipliers on the slave surface: 1 (default: Lagrange P1, also with a
+        degree-2 displacement: smooth and non-negative nodal pressures on 3-node segments and
+        6-node triangles), 2 (Lagrange P2, with a degree-2 displacement only) or ``"iso"``
+        (:data:`~contact_ufl.contact.slave.ISO_MULTIPLIER`, with a degree-2 displacement
+        only): P1-iso-P2, piecewise linear on the once-refined slave facets, one node at each
+        node of the displacement's trace (the resolution of the P2 nodes, h / 2); the contact
+        rule is then composite over the refined facets (``quadrature_subdivisions`` rounded
+        up to an even number: 1 -> 2, 3 -> 4). See ``docs/quadratic-contact.md`` for the
+        comparison.
     """
 
     slave: int | str
@@ -99,7 +105,7 @@ class ContactPair:
     master_normal: str | None = None
     slave_domain: int | str | None = None
     master_domain: int | str | None = None
-    multiplier_degree: int = 1
+    multiplier_degree: int | str = 1
 
     @property
     def frictional(self) -> bool:
@@ -114,6 +120,11 @@ class ContactPair:
             self.master_domain,
             self.master,
         )
+
+    @property
+    def iso_multipliers(self) -> bool:
+        """Whether the multipliers are P1-iso-P2 (``multiplier_degree="iso"``)."""
+        return self.multiplier_degree == ISO_MULTIPLIER
 
     @property
     def on_obstacle(self) -> bool:
@@ -180,8 +191,9 @@ class ContactPair:
         )
         collective_check(
             comm,
-            self.multiplier_degree in (1, 2),
-            f"multiplier_degree must be 1 or 2, got {self.multiplier_degree!r}",
+            self.multiplier_degree in MULTIPLIER_DEGREES,
+            f"multiplier_degree must be 1 or 2 (Lagrange) or {ISO_MULTIPLIER!r} (P1-iso-P2), "
+            f"got {self.multiplier_degree!r}",
         )
         collective_check(
             comm,

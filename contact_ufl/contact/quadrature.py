@@ -51,3 +51,12 @@ def composite_quadrature(
         raise ValueError(f"no composite rule on {cell}")
     nsub = sub.shape[0]
     return sub.reshape(-1, points.shape[1]), np.tile(weights, nsub) / nsub
+
+
+def iso_subdivisions(subdivisions: int) -> int:
+    """The subdivisions of a composite contact rule with P1-iso-P2 multipliers:
+    ``subdivisions`` rounded up to an even number (1 -> 2, 3 -> 4), so that every sub-cell
+    of the rule lies in one of the once-refined cells on which those multipliers are
+    linear (a rule across their kinks would integrate them only to O(1/n^2))."""
+    m = int(subdivisions)
+    return m + m % 2

@@ -37,8 +37,13 @@ from contact_ufl.contact.facets import (
     scalar_element,
     tagged_facets,
 )
-from contact_ufl.contact.quadrature import composite_quadrature
+from contact_ufl.contact.quadrature import composite_quadrature, iso_subdivisions
 from contact_ufl.errors import collective_check
+
+#: The value of ``ContactPair.multiplier_degree`` that asks for P1-iso-P2 multipliers.
+ISO_MULTIPLIER = "iso"
+#: The values of ``ContactPair.multiplier_degree``.
+MULTIPLIER_DEGREES = (1, 2, ISO_MULTIPLIER)
 
 
 @dataclass
@@ -60,7 +65,10 @@ class SlaveSurface:
     rule
         ``"gauss"`` or ``"lobatto"`` (:data:`QUADRATURE_RULES`).
     multiplier_degree
-        Degree of the continuous Lagrange multiplier space on the submesh (1 or 2).
+        The continuous multiplier space on the submesh: Lagrange of degree 1 or 2, or
+        ``"iso"``: P1-iso-P2, piecewise linear on the once-refined cells, with the dofs of P2
+        (:data:`ISO_MULTIPLIER`). With ``"iso"`` the contact rule is composite over the
+        refined cells: ``subdivisions`` is rounded up to an even number.
 
     Attributes
     ----------
@@ -83,7 +91,7 @@ class SlaveSurface:
     quadrature_degree: int
     subdivisions: int = 1
     rule: str = "gauss"
-    multiplier_degree: int = 1
+    multiplier_degree: int | str = 1
     submesh: dolfinx.mesh.Mesh = field(init=False)
     entity_map: dolfinx.mesh.EntityMap = field(init=False)
 
@@ -113,6 +121,8 @@ class SlaveSurface:
             local_vertices = facet_vertices[local[pos]]
 
         sub_cell = basix_cell(self.submesh, sdim)
+        if self.iso:  # composite over the refined cells, where the multipliers are linear
+            self.subdivisions = iso_subdivisions(self.subdivisions)
         self.points_ref, self.weights_ref = composite_quadrature(
             sub_cell, self.quadrature_degree, self.subdivisions, self.rule
         )
@@ -153,21 +163,45 @@ class SlaveSurface:
         self._grad_phi_u = np.einsum("cqkd,kcqn->cqnd", inverse, dphi)
         self._cell_dofs = self.V.dofmap.list[self.parent_cells]
         #: the contact measure: the parent ``ds`` over the slave facets (``dx`` over the
-        #: cells of a membrane), with the rule's degree
+        #: cells of a membrane), with the rule's degree; with P1-iso-P2 multipliers the
+        #: composite rule of the slave points itself, also in forms without point data
+        #: (which would otherwise integrate the multipliers' kinks with one Gauss rule)
+        metadata = {"quadrature_degree": self.quadrature_degree}
+        if self.iso:  # as tuples: UFL's form signature (the JIT cache key) has every value
+            metadata |= {
+                "quadrature_rule": "custom",
+                "quadrature_points": tuple(map(tuple, self.points_ref.tolist())),
+                "quadrature_weights": tuple(self.weights_ref.tolist()),
+            }
         self.ds = ufl.Measure(
             "dx" if self.membrane else "ds",
             domain=mesh,
             subdomain_data=self.facet_tags,
             subdomain_id=self.tag,
-            metadata={"quadrature_degree": self.quadrature_degree},
+            metadata=metadata,
         )
-        #: the space of the multiplier nodes: continuous Lagrange on the slave submesh, of
-        #: degree 1 (default) or 2
-        self.multiplier_space = dolfinx.fem.functionspace(
-            self.submesh, ("Lagrange", self.multiplier_degree)
-        )
+        #: the space of the multiplier nodes on the slave submesh: continuous Lagrange of
+        #: degree 1 (default) or 2, or P1-iso-P2 (:meth:`multiplier_element`)
+        self.multiplier_space = dolfinx.fem.functionspace(self.submesh, self.multiplier_element())
         p1 = self.multiplier_space.ufl_element().basix_element
         self._phi_p1 = p1.tabulate(0, self.points_ref)[0, :, :, 0]  # (nq, nv)
+        # which points lie in the support of each node function of a cell (P1-iso-P2: only
+        # the refined cells around the node; Lagrange: the whole cell)
+        self._support = self._phi_p1 > 1e-12 if self.iso else np.ones_like(self._phi_p1, bool)
+
+    @property
+    def iso(self) -> bool:
+        """Whether the multipliers are P1-iso-P2 (``multiplier_degree="iso"``)."""
+        return self.multiplier_degree == ISO_MULTIPLIER
+
+    def multiplier_element(self, shape: tuple[int, ...] = ()) -> basix.ufl._ElementBase:
+        """The element of the multipliers (values of ``shape``) on the slave submesh:
+        Lagrange of ``multiplier_degree``, or P1-iso-P2 (basix's ``iso`` family of degree 1:
+        the dofs of P2, linear on each of the cell's once-refined sub-cells)."""
+        cell = self.submesh.basix_cell()
+        if self.iso:
+            return basix.ufl.element(basix.ElementFamily.iso, cell, 1, shape=shape)
+        return basix.ufl.element("Lagrange", cell, self.multiplier_degree, shape=shape)
 
     def _parent_reference_points(self, sub_cell, local_vertices, tdim) -> np.ndarray:
         """Map the submesh quadrature points into the parent reference cells.
@@ -320,7 +354,7 @@ class SlaveSurface:
     def node_blocks(self) -> np.ndarray:
         """For each owned multiplier node, the local dof block (node) of the parent
         displacement at the same vertex, ``(n,)``."""
-        if self.multiplier_degree > 1:
+        if self.multiplier_degree != 1:
             return self._node_blocks_by_position()
         mesh, sdim = self.V.mesh, self.submesh.topology.dim
         tdim = mesh.topology.dim
@@ -343,8 +377,8 @@ class SlaveSurface:
         return block_of_vertex[parent_vertex]
 
     def _node_blocks_by_position(self) -> np.ndarray:
-        """:meth:`node_blocks` of a degree-2 multiplier (degree-2 displacement): the
-        displacement dof block of the slave cells at the position of each owned multiplier
+        """:meth:`node_blocks` of a degree-2 or P1-iso-P2 multiplier (degree-2 displacement):
+        the displacement dof block of the slave cells at the position of each owned multiplier
         node (vertices and edge midpoints coincide); raises (collective) if a node has no
         slave cell on this rank."""
         owned = self.multiplier_space.dofmap.index_map.size_local
@@ -360,8 +394,8 @@ class SlaveSurface:
         collective_check(
             self.V.mesh.comm,
             bool(np.all(found >= 0)),
-            "degree-2 multipliers: a multiplier node has no slave facet on its rank (the "
-            "held multipliers need one): use multiplier_degree=1",
+            f"multiplier_degree={self.multiplier_degree!r}: a multiplier node has no slave "
+            "facet on its rank (the held multipliers need one): use multiplier_degree=1",
         )
         return found
 
@@ -370,9 +404,7 @@ class SlaveSurface:
         multiplier node, averaged, ``(n, gdim, gdim)`` (the sign of ``N`` does not matter:
         a membrane's vertex-order normals may point either way)."""
         gdim = self.normals.shape[1]
-        space = dolfinx.fem.functionspace(
-            self.submesh, ("Lagrange", self.multiplier_degree, (gdim * gdim + 1,))
-        )
+        space = dolfinx.fem.functionspace(self.submesh, self.multiplier_element((gdim * gdim + 1,)))
         f = dolfinx.fem.Function(space)
         values = f.x.array.reshape(-1, gdim * gdim + 1)
         outer = np.einsum("ci,cj->cij", self.normals, self.normals).reshape(-1, gdim * gdim)
@@ -386,10 +418,12 @@ class SlaveSurface:
 
     def count_at_nodes(self, mask: np.ndarray) -> np.ndarray:
         """For each owned multiplier node, how many of the (owned) points ``mask`` selects
-        lie in the cells around it, over all ranks."""
+        lie in the support of its function (Lagrange: the cells around it; P1-iso-P2: the
+        refined cells around it), over all ranks."""
         counts = dolfinx.fem.Function(self.P1)
-        per_cell = mask.reshape(self.num_cells, self.num_points).sum(axis=1)
+        selected = mask.reshape(self.num_cells, self.num_points).astype(float)
+        per_node = selected @ self._support  # (nc, nodes of a cell)
         dofs = self.P1.dofmap.list[: self.num_cells]
-        np.add.at(counts.x.array, dofs, per_cell[:, None].astype(float))
+        np.add.at(counts.x.array, dofs, per_node)
         counts.x.scatter_reverse(dolfinx.la.InsertMode.add)
         return counts.x.array[: self.P1.dofmap.index_map.size_local]

@@ -338,19 +338,27 @@ def _in_contact(problem, pair: int = 0) -> np.ndarray:
 
 
 def hertz_3d_run(
-    h_contact: float, steps: int = 2, degree: int = 1, default_eps: bool = False, **options
+    h_contact: float,
+    steps: int = 2,
+    degree: int = 1,
+    default_eps: bool = False,
+    multiplier_degree: int | str = 1,
+    **options,
 ) -> tuple[dict, ContactProblem]:
     """Solve :func:`~contact_ufl.verification.scenes.hertz_3d` (``options`` passed to it;
     its geometry ``order`` by default the displacement's ``degree``) in ``steps`` load
     steps (``default_eps``: with the library's default ``eps_N`` instead of the scene's
-    ``E / h``); return the record of :func:`hertz_3d_errors` with ``degree``,
-    ``geometry_order``, ``dofs``, ``h_contact``, ``slave_points``, ``newton_iterations``,
-    ``newton_per_step``, ``wall_s`` (the solve), ``cpu_s`` (its CPU time), ``search_s`` (its
-    closest-point search) and ``ranks``, and the problem."""
+    ``E / h``; ``multiplier_degree``: that of the pair); return the record of
+    :func:`hertz_3d_errors` with ``degree``, ``multiplier_degree``, ``geometry_order``,
+    ``dofs``, ``h_contact``, ``slave_points``, ``newton_iterations``, ``newton_per_step``,
+    ``wall_s`` (the solve), ``cpu_s`` (its CPU time), ``search_s`` (its closest-point
+    search) and ``ranks``, and the problem."""
     options.setdefault("order", degree)
     hertz = scenes.hertz_3d(h_contact=h_contact, **options)
+    pair = dataclasses.replace(hertz.scene.contacts[0], multiplier_degree=multiplier_degree)
     if default_eps:
-        hertz.scene.contacts[0] = dataclasses.replace(hertz.scene.contacts[0], eps_N=None)
+        pair = dataclasses.replace(pair, eps_N=None)
+    hertz.scene.contacts[0] = pair
     problem = ContactProblem(hertz.scene, degree=degree, verbose=False)
     start, cpu = time.perf_counter(), time.process_time()
     problem.solve(num_steps=steps)
@@ -358,6 +366,7 @@ def hertz_3d_run(
     newton = sum(s.newton_iterations for s in problem.history.steps)
     record = {
         "degree": degree,
+        "multiplier_degree": multiplier_degree,
         "geometry_order": options["order"],
         "dofs": problem.layout.global_size,
         "h_contact": h_contact,

@@ -119,6 +119,7 @@ def curved_case(
     cell: str = "tetrahedron",
     degree: int = 1,
     order: int = 1,
+    multiplier_degree: int | str = 1,
 ):
     """The Taylor test case on curved surfaces: problem at its state, direction, steps.
 
@@ -132,10 +133,16 @@ def curved_case(
     membrane made of its contact surface (:func:`~contact_ufl.verification.scenes.with_membrane`),
     its normal up (``direction = 1``) or down (``-1``); ``cell`` (3D) that of
     :func:`~contact_ufl.verification.scenes.curved_pair`. ``degree``: that of the
-    displacement; ``order``: that of the geometry (2: curved cells).
+    displacement; ``order``: that of the geometry (2: curved cells); ``multiplier_degree``:
+    that of the pair (``"iso"``: P1-iso-P2).
     """
     scene = curved_pair(dim, cell=cell, order=order)
-    scene.contacts[0] = dataclasses.replace(scene.contacts[0], mu=mu, master_normal=master_normal)
+    scene.contacts[0] = dataclasses.replace(
+        scene.contacts[0],
+        mu=mu,
+        master_normal=master_normal,
+        multiplier_degree=multiplier_degree,
+    )
     if own_meshes:
         scene = on_meshes_of_their_own(scene)
     if membrane:
