@@ -14,7 +14,12 @@ import pytest
 
 from contact_ufl.verification import scenes
 from contact_ufl.verification.literature import IRONING_3D
-from contact_ufl.verification.runs import coulomb_ratio_3d, history_at, ironing_3d_run
+from contact_ufl.verification.runs import (
+    coulomb_ratio_3d,
+    history_at,
+    ironing_3d_run,
+    ironing_plane_strain_run,
+)
 
 QUICK = dict(h_die=0.6, h_slab=0.75, press_steps=10, slide_steps=20)
 
@@ -131,3 +136,33 @@ def test_frictional_pressing_keeps_the_solver_pattern():
     problem.solve(num_steps=8, t_end=0.8, max_cutbacks=0)
     assert len(problem.history.steps) == 8
     assert not problem.history.cutbacks
+
+
+# -- the 2D shallow ironing extruded: plane strain solved by the 3D machinery ----------------
+
+
+def test_extruded_ironing_equals_the_plane_one():
+    """The 2D shallow ironing (mu = 0.3) on its quick quadrilateral mesh, pressed in five
+    steps, in 2D and extruded through 0.1 by one layer of hexahedra with u_z = 0 on both
+    faces (:func:`scenes.ironing_plane_strain`), with the facet master normal: the extruded
+    problem is the plane-strain one, so its forces per unit thickness equal the 2D ones to
+    the solver's tolerance (measured: 1e-14 of |fy|, the same Newton iterates), with friction
+    acting (its part of the force along the block is 10% of |fy| at t = 1), no force
+    across the plane, and every step converged in the same number of Newton iterations.
+    Regression: the contact held every component of lambda_T at the slave nodes where u_z
+    is prescribed (all of them here), leaving only the penalty part eps_T s_T of the
+    friction: the frictional force 21% low and fx off by 2% of |fy| at t = 1."""
+    options = dict(mu=0.3, press_steps=5, slide_steps=0, t_end=1.0, master_normal="facet")
+    plane = ironing_plane_strain_run(thickness=None, **options)[0]["history"]
+    extruded = ironing_plane_strain_run(thickness=0.1, **options)[0]["history"]
+    assert len(plane) == len(extruded) == 5
+    assert all(r["converged"] for r in plane + extruded)
+    scale = max(abs(r["fy"]) for r in plane)
+    for a, b in zip(plane, extruded, strict=True):
+        assert abs(a["fx"] - b["fx"]) < 1e-9 * scale
+        assert abs(a["fy"] - b["fy"]) < 1e-9 * scale
+        assert abs(b["Fz"]) < 1e-9 * scale * 0.1
+        assert a["newton_iterations"] == b["newton_iterations"]
+    friction = extruded[-1]["contact_friction"][0] / 0.1
+    assert abs(friction) > 0.05 * abs(extruded[-1]["fy"])
+    assert friction == pytest.approx(plane[-1]["contact_friction"][0], rel=1e-8)
