@@ -276,7 +276,10 @@ class ContactInterface:
         what the support holds already: the two equations are dependent and the tangent is
         singular (likewise ``lambda_T`` where the tangential displacement is prescribed, at a
         sticking point). Those multipliers are held at zero; the contact there is carried by
-        the neighbouring nodes and the supports.
+        the neighbouring nodes and the supports. Where the prescribed axes span the whole
+        tangent plane every component of ``lambda_T`` is held; where they span only part of
+        it (3D), only the prescribed tangential components (holding all would remove the
+        friction along the free directions).
 
         Parameters
         ----------
@@ -291,13 +294,21 @@ class ContactInterface:
         """
         held = prescribed[self.slave.node_blocks()].astype(float)  # (n, gdim)
         projector = self.slave.nodal_normal_projectors()
-        normal_part = np.einsum("nk,nkk->n", held, projector)
-        tangential_part = held.sum(axis=1) - normal_part
+        normal_k = np.einsum("nkk->nk", projector)  # the normal's share of each axis
+        normal_part = np.einsum("nk,nk->n", held, normal_k)
+        tangential_k = held * (1.0 - normal_k)  # prescribed axes along the tangent plane
+        tangential_part = tangential_k.sum(axis=1)
         rows_N = np.flatnonzero(normal_part > 0.5)
         if not self.friction:
             return rows_N, np.zeros(0, dtype=np.int64)
-        nodes_T = np.flatnonzero(tangential_part > 0.5)
-        rows_T = (nodes_T[:, None] * self.gdim + np.arange(self.gdim)).ravel()
+        # the whole tangent plane prescribed: every component of lambda_T held (in 2D any
+        # prescribed tangential axis); only some tangential axes (3D: u_z = 0 on a plane-strain
+        # face, a symmetry plane across the slip): only those components, the slave still
+        # slides, with friction, along the others
+        whole = tangential_part > self.gdim - 1.5
+        components = np.where(whole[:, None], True, tangential_k > 0.5)
+        nodes_T, axes = np.nonzero(components)
+        rows_T = nodes_T * self.gdim + axes
         return rows_N, rows_T
 
     # -- pseudo-time and the step protocol ------------------------------------------------

@@ -18,6 +18,8 @@ Generators
   overlapping in plan.
 * :func:`sphere_on_block_3d`: a half ball on a block, quarter model (3D Hertz).
 * :func:`ironing_3d`: a cylindrical die over a slab (3D ironing, Puso & Laursen 2004).
+* :func:`ironing_extruded`: the 2D shallow ironing on quadrilaterals, or extruded through a
+  thickness by one layer of hexahedra (plane strain in 3D).
 
 Tag values are the same for every scene: cell groups get the values 1, 2 and facet groups
 11, 12, ... in the order they are listed in each generator's documentation; always look them
@@ -48,6 +50,7 @@ __all__ = [
     "hemisphere_3d",
     "ironing_2d",
     "ironing_3d",
+    "ironing_extruded",
     "BeamPair",
     "beams_3d",
     "sphere_on_block_3d",
@@ -1444,3 +1447,131 @@ def sphere_on_block_3d(
     return generate_mesh(
         comm, "sphere_on_block_3d", build, 3, _mesh_options(order), msh_file, ghost_mode
     )
+
+
+# --------------------------------------------------------------------------------------------
+# The 2D shallow ironing on quadrilaterals, and extruded through a thickness (hexahedra)
+# --------------------------------------------------------------------------------------------
+
+
+def ironing_extruded(
+    thickness: float | None = 0.1,
+    h_punch: float = 0.05,
+    h_block: float = 0.2,
+    radius: float = 0.75,
+    chord: float = 1.2,
+    punch_height: float = 0.9,
+    block: tuple[float, float] = (12.0, 4.0),
+    x_punch: float = 0.8,
+    gap: float = 0.2,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    msh_file: str | Path | None = None,
+    ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
+) -> MeshData:
+    """The shallow-ironing scene of :func:`ironing_2d` meshed with quadrilaterals and, with a
+    ``thickness``, extruded along z through it by one layer of hexahedra.
+
+    The plane geometry, the size fields and the defaults are those of :func:`ironing_2d`
+    (punch over the block ``[0, w] x [-height, 0]``); the plane mesh is made of
+    quadrilaterals (gmsh's Frontal-Delaunay for quadrilaterals, then Blossom full-quad
+    recombination), so that its extrusion is all hexahedra and the same plane mesh serves
+    both: ``thickness=None`` gives the plane mesh itself (gdim 2), a positive ``thickness``
+    the mesh ``plane mesh x [0, thickness]`` (gdim 3; its faces z = 0 carry exactly the plane
+    mesh's nodes). With u_z = 0 on both faces z = 0 and z = thickness the extruded problem is
+    the plane-strain one: its solution does not vary along z, and its forces per unit
+    thickness are the plane ones.
+
+    Returns
+    -------
+    MeshData
+        As :func:`ironing_2d` (cells ``"punch"`` (1), ``"block"`` (2); facets
+        ``"punch_contact"`` (11), ``"punch_top"`` (12), ``"block_contact"`` (13),
+        ``"block_bottom"`` (14), ``"block_sides"`` (15)), the lines of the plane mesh being
+        the extruded faces of the 3D one; with a thickness also ``"plane_faces"`` (16): the
+        faces z = 0 and z = thickness of both bodies.
+    """
+    _check_positive(
+        radius=radius, chord=chord, punch_height=punch_height, h_punch=h_punch, h_block=h_block
+    )
+    if thickness is not None:
+        _check_positive(thickness=thickness)
+    if chord > 2.0 * radius:
+        raise ValueError(f"the punch's chord {chord} is wider than its arc's diameter {2 * radius}")
+    _check_common(gap, 1)
+    width, height = block
+    sag = radius - np.sqrt(radius**2 - chord**2 / 4.0)
+    dim = 2 if thickness is None else 3
+
+    def outline() -> tuple[int, int, list[int], list[int]]:
+        """The plane punch and block: surfaces and their boundary curves (loop order)."""
+        geo = gmsh.model.geo
+        half, corner = chord / 2.0, gap + sag
+        c = geo.addPoint(x_punch, gap + radius, 0.0)
+        p = [
+            geo.addPoint(x, y, 0.0)
+            for x, y in [
+                (x_punch - half, corner),
+                (x_punch, gap),
+                (x_punch + half, corner),
+                (x_punch + half, corner + punch_height),
+                (x_punch - half, corner + punch_height),
+            ]
+        ]
+        punch_curves = [geo.addCircleArc(p[0], c, p[1]), geo.addCircleArc(p[1], c, p[2])]
+        punch_curves += [geo.addLine(p[k], p[(k + 1) % 5]) for k in (2, 3, 4)]
+        q = [
+            geo.addPoint(x, y, 0.0)
+            for x, y in [(0.0, -height), (width, -height), (width, 0.0), (0.0, 0.0)]
+        ]
+        block_curves = [geo.addLine(q[i], q[(i + 1) % 4]) for i in range(4)]
+        punch = geo.addPlaneSurface([geo.addCurveLoop(punch_curves)])
+        body = geo.addPlaneSurface([geo.addCurveLoop(block_curves)])
+        return punch, body, punch_curves, block_curves
+
+    def build() -> None:
+        punch, body, pc, bc = outline()  # pc: arcs, right side, top, left side; bc: b, r, t, l
+        groups: dict[str, list[int]] = {}
+        if thickness is None:
+            gmsh.model.geo.synchronize()
+            cells = {"punch": [punch], "block": [body]}
+            side = {c: c for c in pc + bc}
+        else:
+            out = gmsh.model.geo.extrude(
+                [(2, punch), (2, body)], 0.0, 0.0, thickness, numElements=[1], recombine=True
+            )
+            gmsh.model.geo.synchronize()
+            # per source surface: its copy at z = thickness, the volume, then one face per
+            # boundary curve in the loop's order
+            k_body = 2 + len(pc)
+            cells = {"punch": [out[1][1]], "block": [out[k_body + 1][1]]}
+            faces = [t for _, t in out[2:k_body]] + [t for _, t in out[k_body + 2 :]]
+            side = dict(zip(pc + bc, faces, strict=True))
+            groups["plane_faces"] = [punch, body, out[0][1], out[k_body][1]]
+        _add_groups(
+            [
+                ("punch", dim, cells["punch"]),
+                ("block", dim, cells["block"]),
+                ("punch_contact", dim - 1, [side[c] for c in pc[:3] + pc[4:]]),
+                ("punch_top", dim - 1, [side[pc[3]]]),
+                ("block_contact", dim - 1, [side[bc[2]]]),
+                ("block_bottom", dim - 1, [side[bc[0]]]),
+                ("block_sides", dim - 1, [side[bc[1]], side[bc[3]]]),
+            ]
+            + [(name, dim - 1, tags) for name, tags in groups.items()],
+            tdim=dim,
+        )
+        distance = gmsh.model.mesh.field.add("Distance")
+        gmsh.model.mesh.field.setNumbers(distance, "CurvesList", [bc[2]])
+        lower = _threshold(distance, h_block, 4.0 * h_block, 0.5, height)
+        _set_background(
+            [_restricted(_constant(h_punch), 2, [punch]), _restricted(lower, 2, [body])]
+        )
+        gmsh.model.mesh.generate(dim)
+
+    options = _mesh_options(1) | {
+        "Mesh.Algorithm": 8.0,  # Frontal-Delaunay for quadrilaterals
+        "Mesh.RecombineAll": 1.0,
+        "Mesh.RecombinationAlgorithm": 3.0,  # Blossom full-quad: no triangle left
+    }
+    name = "ironing_2d_quadrilaterals" if thickness is None else "ironing_extruded"
+    return generate_mesh(comm, name, build, dim, options, msh_file, ghost_mode)

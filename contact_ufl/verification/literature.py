@@ -38,7 +38,10 @@ IRONING_FORCES = {
 #: or digitised curve of them was found, so there is no published number to compare with
 #: and ``forces`` is empty (no spread can be given). The checks that need no publication
 #: are in benchmarks/ironing_3d.py: Coulomb's ratio of the frictional to the normal force
-#: (mu = 0.3) and the mirror symmetry of the frictionless force history (mu = 0).
+#: (mu = 0.3) and the mirror symmetry of the frictionless force history (mu = 0). The
+#: published large-sliding force histories the 3D machinery is compared with are those of
+#: the 2D shallow ironing (:data:`IRONING_FORCES`), solved in plane strain on an extruded 3D
+#: mesh (benchmarks/ironing_plane_strain.py).
 IRONING_3D = {
     "source": "Puso & Laursen 2004, CMAME 193:4891-4913 (UCRL-JRNL-200667), example 2",
     "data_from": "LLNL Smith examples/die-on-slab (README and source)",
@@ -66,6 +69,29 @@ IRONING_3D = {
             "a different die (a full cylinder); a comparison picture, no numbers"
         ),
         "MOOSE contact tests": "the ironing tests are 2D; the 3D mortar test is a block",
+        # a second search (stored pages, documentation, code, issues), none with numbers:
+        "KratosMultiphysics/Examples validation/shallow_ironing_3D (Mataix Ferrandiz)": (
+            "the 2D shallow ironing extruded in 3D with u_z = 0 on the side faces (what "
+            "benchmarks/ironing_plane_strain.py does), frictionless 'literature' set; "
+            "compared with Poulios & Renard's curve in a picture only, no numbers"
+        ),
+        "Code_Aster validation tests (stored copies of astest/)": (
+            "searched for 'repassage' and 'ironing': only SSNP153, the 2D shallow ironing "
+            "(already in IRONING_FORCES); no 3D large-sliding test with published reference "
+            "forces found"
+        ),
+        "Abaqus Benchmarks/Verification manuals, NAFEMS 3D contact benchmarks": (
+            "not among the stored pages or documentation; the NAFEMS CGS-4 test found "
+            "(FrontISTR, analytical sliding limit F/G = 0.412371) is small sliding"
+        ),
+        "4C and MOOSE 3D contact tests": (
+            "tutorials and regression tests against their own earlier results (4C "
+            "tutorial_contact_3d, MOOSE frictionless-mortar-3d), no published force history"
+        ),
+        "Doca et al. 2014 (IJSS), Areias et al. 2004 (IJNME 61:1107)": (
+            "3D finite-strain frictional contact examples; only abstracts or first pages "
+            "reachable, no force values in them"
+        ),
     },
     "forces": {},
 }

@@ -33,6 +33,7 @@ __all__ = [
     "hertz_3d_run",
     "history_at",
     "ironing_3d_run",
+    "ironing_plane_strain_run",
     "ironing_run",
     "shear_error",
     "slave_point_weights",
@@ -380,3 +381,35 @@ def hertz_3d_run(
         "ranks": problem.comm.size,
     }
     return record, problem
+
+
+# -- the 2D ironing extruded (plane strain in 3D) -------------------------------------------------
+
+
+def ironing_plane_strain_run(
+    mu: float,
+    thickness: float | None = 0.1,
+    h_punch: float = 0.05,
+    h_block: float = 0.2,
+    press_steps: int = 20,
+    slide_steps: int = 100,
+    t_end: float = 2.0,
+    master_normal: str = "smoothed",
+    verbose: bool = False,
+) -> tuple[dict, ContactProblem]:
+    """The shallow ironing of :func:`~contact_ufl.verification.scenes.ironing_plane_strain`
+    on the quadrilateral plane mesh, in 2D (``thickness=None``) or extruded through
+    ``thickness`` (3D, u_z = 0 on both faces), pressed in ``press_steps`` then slid to
+    ``t_end`` in ``slide_steps`` (to t = 2: the slide's end); one record per converged step,
+    as :func:`ironing_run`, with the forces also per unit thickness: ``fx``, ``fy`` (equal to
+    ``Fx``, ``Fy`` in 2D; the 3D ones divided by ``thickness``)."""
+    scene = scenes.ironing_plane_strain(
+        mu=mu, thickness=thickness, h_punch=h_punch, h_block=h_block, master_normal=master_normal
+    )
+    stages = [(press_steps, 1.0)] + ([(slide_steps, t_end)] if slide_steps > 0 else [])
+    run, problem = _driven_run(scene, "punch_top", stages, verbose)
+    per_unit = 1.0 if thickness is None else 1.0 / thickness
+    for r in run["history"]:
+        r["fx"], r["fy"] = r["Fx"] * per_unit, r["Fy"] * per_unit
+    options = {"thickness": thickness, "h_punch": h_punch, "h_block": h_block}
+    return {"mu": mu, **options, "master_normal": master_normal, **run}, problem

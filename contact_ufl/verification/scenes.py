@@ -1545,3 +1545,74 @@ def _strip(n: int, a: float, dim: int, width: int, comm: MPI.Comm):
     )
     planes = {"x0": (0, 0.0), "xmax": (0, a), "y0": (1, 0.0), "ymax": (1, b)}
     return membrane_meshes.with_tags(mesh, planes, name="membrane"), planes
+
+
+def ironing_plane_strain(
+    mu: float = 0.3,
+    thickness: float | None = 0.1,
+    h_punch: float = 0.05,
+    h_block: float = 0.2,
+    depth: float = 1.0,
+    slide: float = 10.0,
+    master_normal: str = "smoothed",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Scene:
+    """The 2D shallow ironing of :func:`ironing` (the same geometry, materials, loading,
+    ``eps_N`` and ``mu``) on a quadrilateral plane mesh, solved in 2D (``thickness=None``)
+    or on that mesh extruded through ``thickness`` by one layer of hexahedra
+    (:func:`~contact_ufl.verification.geometries.ironing_extruded`) with u_z = 0 on both
+    faces z = 0 and z = thickness (``"plane_faces"``): plane strain solved by the 3D
+    machinery (closest points on bilinear quadrilaterals, the node-fan smoothed normal,
+    Coulomb friction with a 3D ``lambda_T``). Its solution does not vary along z, and its
+    forces per unit thickness are those of the 2D scene on the same plane mesh, but for
+    what the two machineries do differently: the 2D smoothed normal averages the unit
+    normals of the two segments at a node with equal weights, the 3D one weights the
+    facets by their area (here the segments' lengths); with ``master_normal="facet"`` there
+    is no such difference.
+
+    The punch's top is pressed down by ``depth`` from t = 0 to 1, then moved by ``slide``
+    along the block from t = 1 to 2 (z held); the slave is the punch's arc and sides, the
+    master the block's top.
+    """
+    sm = geometries.ironing_extruded(
+        thickness=thickness, h_punch=h_punch, h_block=h_block, comm=comm
+    )
+    tags = sm.tags
+    E_block, E_punch, nu = 6.896e8, 6.896e9, 0.32
+    if thickness is None:
+        supports = [
+            Dirichlet(tags["block_bottom"], (0.0, 0.0)),
+            Dirichlet(
+                tags["punch_top"], lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0))
+            ),
+        ]
+    else:
+        supports = [
+            Dirichlet(tags["block_bottom"], (0.0, 0.0, 0.0)),
+            Dirichlet(
+                tags["punch_top"],
+                lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0), 0.0),
+            ),
+            Dirichlet(tags["plane_faces"], 0.0, component=2),
+        ]
+    return Scene(
+        sm.mesh,
+        sm.cell_tags,
+        sm.facet_tags,
+        bodies=[
+            Body(tags["punch"], NeoHookean(E_punch, nu), "punch"),
+            Body(tags["block"], NeoHookean(E_block, nu), "block"),
+        ],
+        contacts=[
+            ContactPair(
+                tags["punch_contact"],
+                tags["block_contact"],
+                eps_N=E_block / h_block,
+                mu=mu,
+                search_radius=1.0,
+                master_normal=master_normal,
+            )
+        ],
+        dirichlet=supports,
+        tags=tags,
+    )
