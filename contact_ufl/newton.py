@@ -321,7 +321,10 @@ class NewtonSolver:
             p.pattern_gathers() if self.pattern_superset and hasattr(p, "pattern_gathers") else g
             for p, g in zip(parts, gathers, strict=True)
         ]
-        self._T_wide = self._chain_operator(wide)
+        # without the superset (3D) the pattern's operator is T itself: its product
+        # T^T K T is then the tangent's, not a second PtAP
+        same = all(w is g for w, g in zip(wide, gathers, strict=True))
+        self._T_wide = self._T if same else self._chain_operator(wide)
         keys = self._gather_keys(wide)
         self._wide_current = keys
         self._wide_now = len(keys)
@@ -420,14 +423,16 @@ class NewtonSolver:
         ``T^T K T``'s: ``T`` is within the superset operator."""
         if not (self._grow or new):
             return self._J
-        pattern = self._K.PtAP(self._T_wide)
+        tangent = self._T_wide is self._T and self._JT is not None
+        pattern = self._JT if tangent else self._K.PtAP(self._T_wide)
         if new:
-            J = pattern
+            J = pattern.duplicate(copy=True) if tangent else pattern
         else:
             J = self._J
             J.zeroEntries()
             J.axpy(1.0, pattern, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            pattern.destroy()
+            if not tangent:
+                pattern.destroy()
             self.snes.getKSP().getPC().reset()  # MUMPS fails on a changed pattern otherwise
         J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
         self._grow = False
