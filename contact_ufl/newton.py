@@ -249,7 +249,34 @@ class NewtonSolver:
         snes.setMonitor(_weakly(self._monitor))
         snes.setFromOptions()
         snes.getKSP().setFromOptions()
+        if snes.getKSP().getPC().getType() == PETSc.PC.Type.FIELDSPLIT:
+            self._split_fields(snes.getKSP().getPC())
         return snes
+
+    def _reset_pc(self) -> None:
+        """Reset the preconditioner (a new symbolic factorisation), keeping the field
+        splits of a ``fieldsplit`` (which a reset drops)."""
+        pc = self.snes.getKSP().getPC()
+        pc.reset()
+        if pc.getType() == PETSc.PC.Type.FIELDSPLIT:
+            self._split_fields(pc)
+
+    def _split_fields(self, pc: PETSc.PC) -> None:
+        """The splits of a ``pc_type fieldsplit``: ``u``, the displacements of the meshes
+        (block size the dimension, for GAMG), and ``lambda``, the other unknowns (the
+        multipliers; a control's load factor). Their solvers take the options
+        ``<prefix>fieldsplit_u_...`` and ``<prefix>fieldsplit_lambda_...``."""
+        layout, meshes = self.problem.layout, len(self.problem.bulks)
+        blocks = [layout.owned(b, np.arange(n)) for b, n in enumerate(layout.local_sizes)]
+        u = np.concatenate(blocks[:meshes]).astype(PETSc.IntType)
+        rest = np.concatenate([np.zeros(0, np.int64), *blocks[meshes:]]).astype(PETSc.IntType)
+        if self.comm.allreduce(len(rest), MPI.SUM) == 0:
+            return  # no multipliers: one field
+        displacements = PETSc.IS().createGeneral(u, comm=self.comm)
+        displacements.setBlockSize(self.problem.gdim)
+        pc.setFieldSplitIS(
+            ("u", displacements), ("lambda", PETSc.IS().createGeneral(rest, comm=self.comm))
+        )
 
     def _default_atol(self) -> float:
         """A force scale: 1e-11 of ``E_max L^(d-1)`` with L the scene's diameter."""
@@ -443,7 +470,7 @@ class NewtonSolver:
             if not tangent:
                 pattern.destroy()
         if not new:
-            self.snes.getKSP().getPC().reset()  # MUMPS fails on a changed pattern otherwise
+            self._reset_pc()  # MUMPS fails on a changed pattern otherwise
         J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
         self._grow = False
         self.timings.analyses += 1
@@ -465,7 +492,7 @@ class NewtonSolver:
         self._zero_dirichlet_rows(J)
         self._J = J
         self.snes.setJacobian(_weakly(self._jacobian), J)
-        self.snes.getKSP().getPC().reset()
+        self._reset_pc()
 
     def _zero_dirichlet_rows(self, J: PETSc.Mat) -> None:
         problem = self.problem
@@ -714,7 +741,7 @@ class NewtonSolver:
             self.timings.newton += time.perf_counter() - start
         self.timings.iterations += self.snes.getIterationNumber()
         if reason <= 0:
-            self.snes.getKSP().getPC().reset()  # no stale factorisation in the next try
+            self._reset_pc()  # no stale factorisation in the next try
         return reason, self.snes.getIterationNumber()
 
     @property

@@ -153,3 +153,35 @@ def test_rebuilt_solver_pattern_gives_the_same_solution():
     (kept, x_kept), (rebuilt, x_rebuilt) = results
     assert rebuilt > kept  # the negative slack rebuilt the pattern at every step
     np.testing.assert_allclose(x_rebuilt, x_kept, rtol=0, atol=1e-10 * np.abs(x_kept).max())
+
+
+def test_field_split_solver_gives_the_same_solution():
+    """``pc_type fieldsplit`` gets the splits ``u`` (displacements) and ``lambda``
+    (multipliers) from the solver, also after the resets of a new pattern: GMRES with a
+    Schur split, GAMG on the displacements, gives the direct solver's solution."""
+    split = {
+        "ksp_type": "fgmres",
+        "ksp_rtol": 1e-12,
+        "ksp_max_it": 400,
+        "pc_type": "fieldsplit",
+        "pc_fieldsplit_type": "schur",
+        "pc_fieldsplit_schur_fact_type": "full",
+        "pc_fieldsplit_schur_precondition": "selfp",
+        "fieldsplit_u_ksp_type": "preonly",
+        "fieldsplit_u_pc_type": "gamg",
+        "fieldsplit_lambda_ksp_type": "preonly",
+        "fieldsplit_lambda_pc_type": "lu",
+    }
+    results = []
+    for options in ({}, split):
+        problem = hertz_problem(**options)
+        problem.solver.pattern_slack = -1.0  # a new pattern, and a reset, at the second step
+        problem.solver.timings.reset()
+        problem.solve(num_steps=2)
+        results.append((problem.solver, problem.solver.x.array.copy()))
+    (direct, x_direct), (iterative, x_iterative) = results
+    pc = iterative.snes.getKSP().getPC()
+    assert pc.getType() == "fieldsplit"
+    assert iterative.timings.analyses >= 1  # the splits were kept through a reset
+    assert iterative.snes.getKSP().getIterationNumber() > 1
+    np.testing.assert_allclose(x_iterative, x_direct, rtol=0, atol=1e-8 * np.abs(x_direct).max())
