@@ -39,7 +39,9 @@ contact record adds ``glued_ratio`` (its ``total_s`` over the glued ``bulk_s``) 
 times (the fastest run of each is kept), and writes all records with ``speedup`` (wall time
 of the solve on one rank over that on k ranks) and ``per_rank`` (each rank's parts, its
 slave points and its share of the rows and nonzeros of ``K`` and ``T``: where the work is).
-``--option`` passes PETSc options to the solver (e.g. ``mat_mumps_icntl_7=3``).
+``--option`` passes PETSc options to the solver (e.g. ``mat_mumps_icntl_7=3``); ``--dump
+FILE`` writes the contact tangent at the end of the solve for ``benchmarks/linear_solvers.py``
+(orderings, MUMPS options, iterative solvers on it).
 
 The machine may be loaded: ``--repeat N`` solves each bulk / contact pair N times,
 interleaved, and keeps the fastest run of each (least disturbed); the process CPU time is
@@ -216,9 +218,26 @@ def _per_rank(problem: ContactProblem, cpu: float, timings) -> list[dict]:
     return problem.comm.allgather(mine)
 
 
-def run(make, size, contact: bool, options: dict | None = None, glue: int = 0) -> dict:
+def save_tangent(problem: ContactProblem, path: str) -> None:
+    """Write the contact tangent at the current state and the index set of its displacement
+    unknowns (PETSc binary; read by ``benchmarks/linear_solvers.py``)."""
+    J = problem.solver.evaluate_jacobian(problem.solver.x)
+    layout = problem.layout
+    rows = [layout.owned(b, np.arange(layout.local_sizes[b])) for b in range(len(problem.bulks))]
+    index = PETSc.IS().createGeneral(np.concatenate(rows).astype(PETSc.IntType), comm=problem.comm)
+    start = np.array([J.getOwnershipRange()[0]], dtype=PETSc.IntType)
+    viewer = PETSc.Viewer().createBinary(path, "w", comm=problem.comm)
+    J.view(viewer)
+    index.view(viewer)
+    PETSc.IS().createGeneral(start, comm=problem.comm).view(viewer)  # the ranks' rows
+    viewer.destroy()
+
+
+def run(
+    make, size, contact: bool, options: dict | None = None, glue: int = 0, dump: str = ""
+) -> dict:
     """Solve one scene and return its record (``glue``: with the glued baseline, its
-    factorisations repeated ``glue`` times)."""
+    factorisations repeated ``glue`` times; ``dump``: write the contact tangent there)."""
     scene, steps, t_end = make(size, contact)
     options = options or {}
     problem = ContactProblem(scene, verbose=False, petsc_options=options)
@@ -254,6 +273,8 @@ def run(make, size, contact: bool, options: dict | None = None, glue: int = 0) -
         "options": options,
     }
     record["per_rank"] = _per_rank(problem, cpu, timings)
+    if dump and contact:
+        save_tangent(problem, dump)
     if glue and contact:
         record["tangent"], record["glued"] = glued(problem, options, glue)
     elif glue:  # the bulk tangent timed alike, to be replaced by the glued block's
@@ -334,6 +355,7 @@ def _arguments() -> argparse.Namespace:
     parser.add_argument("--glued", action="store_true", help="add the glued baseline")
     parser.add_argument("--ranks", nargs="+", type=int, help="run under mpirun -n k for each k")
     parser.add_argument("--option", nargs="*", default=[], help="PETSc options KEY=VALUE")
+    parser.add_argument("--dump", default="", help="write the contact tangent (last size)")
     return parser.parse_args()
 
 
@@ -400,7 +422,10 @@ def main() -> None:
         for size in sizes:
             size = int(size) if make is beams else size
             runs = [
-                (run(make, size, False, options, glue), run(make, size, True, options, glue))
+                (
+                    run(make, size, False, options, glue),
+                    run(make, size, True, options, glue, args.dump),
+                )
                 for _ in range(args.repeat)
             ]
             bulk = fastest([b for b, _ in runs])
