@@ -38,8 +38,11 @@ def load(path: str, comm: MPI.Comm) -> tuple[PETSc.Mat, PETSc.IS, PETSc.IS]:
     saved.load(viewer)
     everything = np.concatenate(comm.allgather(saved.getIndices()))
     starts = PETSc.IS().create(comm)
-    starts.load(viewer)
-    starts = np.concatenate(comm.allgather(starts.getIndices()))
+    try:
+        starts.load(viewer)
+        starts = np.concatenate(comm.allgather(starts.getIndices()))
+    except PETSc.Error:  # a file without the ranks' rows
+        starts = np.zeros(0)
     if len(starts) == comm.size:  # the saving ranks' rows: whole nodes on each rank
         n = J.getSize()[0]
         local = int(np.append(starts, n)[comm.rank + 1] - starts[comm.rank])
