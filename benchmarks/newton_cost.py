@@ -20,7 +20,28 @@ plain bulk Newton does not do, are left out). The ratio is contact / bulk second
 iteration (issue 12's target: at most 1.3 at 100,000 unknowns in 2D and at the largest 3D size).
 
     python benchmarks/newton_cost.py --json benchmarks/results/newton_cost.json [--quick]
-        [--repeat N] [--scenes hertz beams hertz3d]
+        [--repeat N] [--scenes hertz beams hertz3d] [--sizes ...] [--glued]
+        [--ranks 1 2] [--option KEY=VALUE ...]
+
+``--glued`` adds the fair baseline of a contact scene (issue 12's bulk problem with the
+bodies *coupled*, not free): the bodies glued where the contact pairs them. Its tangent is
+the displacement block of the contact tangent at the end of the solve (the slave points
+tied to their master facets: the pattern of a penalty tie at every paired point, the same
+couplings between the bodies, no multipliers); the record ``case = "glued"`` has the bulk
+record's residual and Jacobian assembly and the factorisation and solve of that block,
+timed as the contact tangent's own factorisation and solve (``tangent_*`` in the contact
+record: one analysis, then ``--repeat``-fold numeric factorisations, MUMPS's flops
+RINFOG(3) and factor entries INFOG(29)), so that contact and glued are timed alike. The
+contact record adds ``glued_ratio`` (its ``total_s`` over the glued ``bulk_s``) and
+``factor_ratio`` (its tangent's factorisation flops over the glued block's).
+
+``--ranks 1 2`` runs every case under ``mpirun -n k`` for each k, interleaved ``--repeat``
+times (the fastest run of each is kept), and writes all records with ``speedup`` (wall time
+of the solve on one rank over that on k ranks) and ``per_rank`` (each rank's parts, its
+slave points and its share of the rows and nonzeros of ``K`` and ``T``: where the work is).
+``--option`` passes PETSc options to the solver (e.g. ``mat_mumps_icntl_7=3``); ``--dump
+FILE`` writes the contact tangent at the end of the solve for ``benchmarks/linear_solvers.py``
+(orderings, MUMPS options, iterative solvers on it).
 
 The machine may be loaded: ``--repeat N`` solves each bulk / contact pair N times,
 interleaved, and keeps the fastest run of each (least disturbed); the process CPU time is
@@ -43,8 +64,12 @@ import argparse
 import dataclasses
 import json
 import os
+import subprocess
+import sys
+import tempfile
 import time
 
+import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -96,10 +121,126 @@ def _event_seconds() -> dict[str, float]:
     return {k: PETSc.Log.Event(e).getPerfInfo()["time"] for k, e in FACTOR_EVENTS.items()}
 
 
-def run(make, size, contact: bool) -> dict:
-    """Solve one scene and return its record."""
+def _factorise(A: PETSc.Mat, options: dict, repeat: int) -> dict:
+    """Analyse ``A`` once with MUMPS LU (the solver's options), factorise it ``repeat`` times
+    and solve with it: the fastest wall and CPU seconds of a factorisation (this rank), of
+    a solve, and MUMPS's flops and factor entries."""
+    comm = A.getComm().tompi4py()
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("lu")
+    pc.setFactorSolverType("mumps")
+    opts = PETSc.Options()
+    prefix = "newton_cost_factor_"
+    ksp.setOptionsPrefix(prefix)
+    mumps = {k: v for k, v in options.items() if k.startswith("mat_mumps_")}
+    for k, v in mumps.items():
+        opts[prefix + k] = v
+    ksp.setFromOptions()
+    b = A.createVecLeft()
+    b.set(1.0)
+    x = b.duplicate()
+    start = time.perf_counter()
+    ksp.setUp()
+    first = time.perf_counter() - start
+    walls, cpus = [], []
+    for _ in range(repeat):
+        comm.Barrier()
+        cpu, start = time.process_time(), time.perf_counter()
+        A.assemble()  # a new state of the same matrix: a numeric factorisation only
+        ksp.setOperators(A)
+        pc.setUp()
+        walls.append(time.perf_counter() - start)
+        cpus.append(time.process_time() - cpu)
+    comm.Barrier()
+    cpu, start = time.process_time(), time.perf_counter()
+    ksp.solve(b, x)
+    solve, solve_cpu = time.perf_counter() - start, time.process_time() - cpu
+    F = pc.getFactorMatrix()
+    out = {
+        "first_setup_s": first,
+        "factorisation_s": min(walls),
+        "factorisation_cpu_s": min(cpus),
+        "solve_s": solve,
+        "solve_cpu_s": solve_cpu,
+        "flops": F.getMumpsRinfog(3),
+        "factor_entries": F.getMumpsInfog(29),
+        "rank_flops": comm.allgather(F.getMumpsRinfo(3)),
+    }
+    for k in mumps:
+        del opts[prefix + k]
+    ksp.destroy()
+    return out
+
+
+def displacement_block(problem: ContactProblem) -> PETSc.Mat:
+    """The displacement block (the meshes' displacements, no multipliers) of the contact
+    tangent at the current state: the bodies tied where the contact pairs them."""
+    J = problem.solver.evaluate_jacobian(problem.solver.x)
+    layout = problem.layout
+    rows = [layout.owned(b, np.arange(layout.local_sizes[b])) for b in range(len(problem.bulks))]
+    index = PETSc.IS().createGeneral(np.concatenate(rows).astype(PETSc.IntType), comm=problem.comm)
+    return J.createSubMatrix(index, index)
+
+
+def glued(problem: ContactProblem, options: dict, repeat: int) -> tuple[dict, dict]:
+    """The factorisations of the contact tangent and of its displacement block (the glued
+    bodies), timed alike (see the module's ``--glued``)."""
+    J = problem.solver.evaluate_jacobian(problem.solver.x)
+    tangent = _factorise(J, options, repeat)
+    G = displacement_block(problem)
+    block = _factorise(G, options, repeat)
+    block["dofs"] = G.getSize()[0]
+    G.destroy()
+    return tangent, block
+
+
+def _per_rank(problem: ContactProblem, cpu: float, timings) -> list[dict]:
+    """Each rank's parts (seconds per Newton iteration), CPU seconds of the solve, slave
+    points, and share of the rows and nonzeros of ``K`` and ``T``: where the work is."""
+    solver = problem.solver
+    local = PETSc.Mat.InfoType.LOCAL
+    n = max(timings.iterations, 1)
+    mine = {
+        "rank": problem.comm.rank,
+        "cpu_s": cpu,
+        **{f"{k}_s": v for k, v in timings.per_iteration().items()},
+        "search_own_s": sum(c.search_time for c in problem.contacts) / n,
+        "slave_points": int(sum(len(c.projection.facet) for c in problem.contacts)),
+        "unknowns": problem.layout.local_size,
+        "K_rows": solver._K.getLocalSize()[0],
+        "K_nonzeros": int(solver._K.getInfo(local)["nz_used"]),
+        "T_nonzeros": int(solver._T.getInfo(local)["nz_used"]),
+        "J_nonzeros": int(solver._J.getInfo(local)["nz_used"]),
+    }
+    return problem.comm.allgather(mine)
+
+
+def save_tangent(problem: ContactProblem, path: str) -> None:
+    """Write the contact tangent at the current state and the index set of its displacement
+    unknowns (PETSc binary; read by ``benchmarks/linear_solvers.py``)."""
+    J = problem.solver.evaluate_jacobian(problem.solver.x)
+    layout = problem.layout
+    rows = [layout.owned(b, np.arange(layout.local_sizes[b])) for b in range(len(problem.bulks))]
+    index = PETSc.IS().createGeneral(np.concatenate(rows).astype(PETSc.IntType), comm=problem.comm)
+    start = np.array([J.getOwnershipRange()[0]], dtype=PETSc.IntType)
+    viewer = PETSc.Viewer().createBinary(path, "w", comm=problem.comm)
+    J.view(viewer)
+    index.view(viewer)
+    PETSc.IS().createGeneral(start, comm=problem.comm).view(viewer)  # the ranks' rows
+    viewer.destroy()
+
+
+def run(
+    make, size, contact: bool, options: dict | None = None, glue: int = 0, dump: str = ""
+) -> dict:
+    """Solve one scene and return its record (``glue``: with the glued baseline, its
+    factorisations repeated ``glue`` times; ``dump``: write the contact tangent there)."""
     scene, steps, t_end = make(size, contact)
-    problem = ContactProblem(scene, verbose=False)
+    options = options or {}
+    problem = ContactProblem(scene, verbose=False, petsc_options=options)
     timings = problem.solver.timings
     timings.reset()
     load = os.getloadavg()[0]
@@ -129,7 +270,16 @@ def run(make, size, contact: bool) -> dict:
         "cpu_per_it_s": cpu / n,
         "bulk_s": per["residual_assembly"] + per["jacobian_assembly"] + per["linear_solve"],
         "ranks": problem.comm.size,
+        "options": options,
     }
+    record["per_rank"] = _per_rank(problem, cpu, timings)
+    if dump and contact:
+        save_tangent(problem, dump)
+    if glue and contact:
+        record["tangent"], record["glued"] = glued(problem, options, glue)
+    elif glue:  # the bulk tangent timed alike, to be replaced by the glued block's
+        J = problem.solver.evaluate_jacobian(problem.solver.x)
+        record["tangent"] = _factorise(J, options, glue)
     return record
 
 
@@ -157,14 +307,99 @@ def row(r: dict) -> str:
     )
 
 
-def main() -> None:
+def glued_record(with_contact: dict, bulk: dict) -> dict:
+    """The glued baseline's record: the bulk record's times with its tangent's
+    factorisation and solve replaced by the glued block's (all timed alike by
+    :func:`_factorise`; wall and CPU seconds); sets the contact record's ``glued_ratio``,
+    ``glued_cpu_ratio`` and ``factor_ratio`` (flops)."""
+    block, tangent = with_contact["glued"], with_contact["tangent"]
+    free = bulk["tangent"]
+    linear = block["factorisation_s"] + block["solve_s"]
+    linear_cpu = block["factorisation_cpu_s"] + block["solve_cpu_s"]
+    free_linear = free["factorisation_s"] + free["solve_s"]
+    free_cpu = free["factorisation_cpu_s"] + free["solve_cpu_s"]
+    record = {
+        **{k: bulk[k] for k in ("scene", "size", "load", "ranks", "options")},
+        "case": "glued",
+        "dofs": block["dofs"],
+        "newton_iterations": bulk["newton_iterations"],
+        "new_patterns": 0,
+        "analyses": 0,
+        "total_s": bulk["total_s"] - free_linear + linear,
+        **{f"{p}_s": 0.0 for p in PARTS},
+        "residual_assembly_s": bulk["residual_assembly_s"],
+        "jacobian_assembly_s": bulk["jacobian_assembly_s"],
+        "linear_solve_s": bulk["linear_solve_s"] - free_linear + linear,
+        "analysis_s": 0.0,
+        "factorisation_s": block["factorisation_s"],
+        "cpu_per_it_s": bulk["cpu_per_it_s"] - free_cpu + linear_cpu,
+        "bulk_s": bulk["bulk_s"] - free_linear + linear,
+        "flops": block["flops"],
+        "factor_entries": block["factor_entries"],
+    }
+    tangent_linear = tangent["factorisation_s"] + tangent["solve_s"]
+    with_contact["glued_ratio"] = with_contact["total_s"] / record["bulk_s"]
+    with_contact["glued_cpu_ratio"] = with_contact["cpu_per_it_s"] / record["cpu_per_it_s"]
+    with_contact["factor_ratio"] = tangent["flops"] / block["flops"]
+    with_contact["factor_time_ratio"] = tangent_linear / linear
+    return record
+
+
+def _arguments() -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--json", required=True, help="output file")
     parser.add_argument("--quick", action="store_true", help="two 2D sizes, one 3D each")
     parser.add_argument("--repeat", type=int, default=1, help="interleaved runs per case")
     parser.add_argument("--scenes", nargs="+", default=list(MAKERS), choices=list(MAKERS))
     parser.add_argument("--sizes", nargs="+", type=float, help="sizes (default: the scene's)")
-    args = parser.parse_args()
+    parser.add_argument("--glued", action="store_true", help="add the glued baseline")
+    parser.add_argument("--ranks", nargs="+", type=int, help="run under mpirun -n k for each k")
+    parser.add_argument("--option", nargs="*", default=[], help="PETSc options KEY=VALUE")
+    parser.add_argument("--dump", default="", help="write the contact tangent (last size)")
+    return parser.parse_args()
+
+
+def _by_ranks(args: argparse.Namespace) -> None:
+    """Run the cases under ``mpirun -n k`` for each k of ``--ranks``, interleaved, and
+    write their records with the speed-up of each over one rank."""
+    mpirun = os.path.join(os.path.dirname(sys.executable), "mpirun")
+    rest, skip = [], False  # the arguments of each run: not --ranks, --repeat, --json
+    for a in sys.argv[1:]:
+        if a.startswith("--"):
+            skip = a in ("--ranks", "--repeat", "--json")
+        if not skip:
+            rest.append(a)
+    runs: dict[int, list[list[dict]]] = {k: [] for k in args.ranks}
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(args.repeat):
+            for k in args.ranks:
+                out = os.path.join(tmp, f"n{k}.json")
+                command = [mpirun, "-n", str(k), sys.executable, __file__, *rest, "--json", out]
+                subprocess.run(command, check=True)
+                with open(out) as f:
+                    runs[k].append(json.load(f))
+    records = []
+    for k in args.ranks:
+        for j in range(len(runs[k][0])):
+            records.append(fastest([r[j] for r in runs[k]]))
+    one = {(r["scene"], r["size"], r["case"]): r for r in records if r["ranks"] == 1}
+    for r in records:
+        base = one.get((r["scene"], r["size"], r["case"]))
+        if base is not None and "wall_s" in r:
+            r["speedup"] = base["wall_s"] / r["wall_s"]
+            r["cpu_speedup"] = base["cpu_per_it_s"] / r["cpu_per_it_s"]
+    for r in records:
+        print(f"{r['ranks']:2d} " + row(r) + f" {r.get('speedup', float('nan')):6.2f}")
+    with open(args.json, "w") as f:
+        json.dump(records, f, indent=1)
+
+
+def main() -> None:
+    args = _arguments()
+    if args.ranks:
+        _by_ranks(args)
+        return
+    options = dict(o.split("=", 1) for o in args.option)
     PETSc.Log.begin()
     sizes = {
         "hertz": HERTZ_QUICK if args.quick else HERTZ_FULL,
@@ -182,18 +417,36 @@ def main() -> None:
     if rank0:
         print(header, flush=True)
     records = []
+    glue = 3 if args.glued else 0
     for make, sizes in cases:
         for size in sizes:
             size = int(size) if make is beams else size
-            runs = [(run(make, size, False), run(make, size, True)) for _ in range(args.repeat)]
+            runs = [
+                (
+                    run(make, size, False, options, glue),
+                    run(make, size, True, options, glue, args.dump),
+                )
+                for _ in range(args.repeat)
+            ]
             bulk = fastest([b for b, _ in runs])
             with_contact = fastest([c for _, c in runs])
             with_contact["ratio"] = with_contact["total_s"] / bulk["bulk_s"]
             with_contact["cpu_ratio"] = with_contact["cpu_per_it_s"] / bulk["cpu_per_it_s"]
-            for r in (with_contact, bulk):
+            rows = [with_contact, bulk]
+            if args.glued:
+                rows.append(glued_record(with_contact, bulk))
+            for r in rows:
                 records.append(r)
                 if rank0:
                     print(row(r), flush=True)
+            if rank0 and args.glued:
+                print(
+                    f"  glued: ratio {with_contact['glued_ratio']:.2f} (cpu "
+                    f"{with_contact['glued_cpu_ratio']:.2f}), factorisation flops contact / "
+                    f"glued {with_contact['factor_ratio']:.2f}, time "
+                    f"{with_contact['factor_time_ratio']:.2f}",
+                    flush=True,
+                )
     if rank0:
         with open(args.json, "w") as f:
             json.dump(records, f, indent=1)

@@ -175,9 +175,12 @@ class NewtonSolver:
         master nodes of its facet and of the facets beside it (the contacts'
         ``pattern_gathers``), explicit zeros where there is no coupling. A pairing that
         moves points onto neighbouring facets then keeps the pattern, and the factorisation
-        keeps its symbolic analysis. A pairing outside it grows the pattern (a union); at
-        the start of a step, a union that holds more than ``1 + pattern_slack`` times the
-        couplings of the current superset is rebuilt on the current one.
+        keeps its symbolic analysis. A pairing outside it grows the pattern (a union); a
+        union that would hold more than ``1 + pattern_slack`` times the couplings of the
+        current superset is rebuilt on the current one instead (at that growth, or at the
+        start of a step). In 3D, where every new pairing grows the pattern, the union of
+        the 40 pairings of the 3D Hertz solve at 50,000 P1 unknowns had 6 times the
+        nonzeros of the rebuilt pattern and 2.6 times its factorisation's flops.
     pattern_superset
         Whether the pattern holds the facets beside each point's facet (default: in 2D).
         Without it (the 3D default) the pattern is the union of the pairings met: an analysis
@@ -215,6 +218,7 @@ class NewtonSolver:
         self._wide_current = None  # sorted keys of the last superset operator
         self._gathers = None  # the parts of the problem that gather, and their gathers
         self._grow = True  # the pattern must grow before the next factorisation
+        self._retired = None  # a solver matrix replaced inside a SNES Jacobian call
         self.pattern_slack = 0.5
         self.pattern_superset = problem.gdim == 2
         self._state = None
@@ -255,7 +259,34 @@ class NewtonSolver:
         snes.setMonitor(_weakly(self._monitor))
         snes.setFromOptions()
         snes.getKSP().setFromOptions()
+        if snes.getKSP().getPC().getType() == PETSc.PC.Type.FIELDSPLIT:
+            self._split_fields(snes.getKSP().getPC())
         return snes
+
+    def _reset_pc(self) -> None:
+        """Reset the preconditioner (a new symbolic factorisation), keeping the field
+        splits of a ``fieldsplit`` (which a reset drops)."""
+        pc = self.snes.getKSP().getPC()
+        pc.reset()
+        if pc.getType() == PETSc.PC.Type.FIELDSPLIT:
+            self._split_fields(pc)
+
+    def _split_fields(self, pc: PETSc.PC) -> None:
+        """The splits of a ``pc_type fieldsplit``: ``u``, the displacements of the meshes
+        (block size the dimension, for GAMG), and ``lambda``, the other unknowns (the
+        multipliers; a control's load factor). Their solvers take the options
+        ``<prefix>fieldsplit_u_...`` and ``<prefix>fieldsplit_lambda_...``."""
+        layout, meshes = self.problem.layout, len(self.problem.bulks)
+        blocks = [layout.owned(b, np.arange(n)) for b, n in enumerate(layout.local_sizes)]
+        u = np.concatenate(blocks[:meshes]).astype(PETSc.IntType)
+        rest = np.concatenate([np.zeros(0, np.int64), *blocks[meshes:]]).astype(PETSc.IntType)
+        if self.comm.allreduce(len(rest), MPI.SUM) == 0:
+            return  # no multipliers: one field
+        displacements = PETSc.IS().createGeneral(u, comm=self.comm)
+        displacements.setBlockSize(self.problem.gdim)
+        pc.setFieldSplitIS(
+            ("u", displacements), ("lambda", PETSc.IS().createGeneral(rest, comm=self.comm))
+        )
 
     def _default_atol(self) -> float:
         """A force scale: 1e-11 of ``E_max L^(d-1)`` with L the scene's diameter."""
@@ -331,7 +362,10 @@ class NewtonSolver:
             p.pattern_gathers() if self.pattern_superset and hasattr(p, "pattern_gathers") else g
             for p, g in zip(parts, gathers, strict=True)
         ]
-        self._T_wide = self._chain_operator(wide)
+        # without the superset (3D) the pattern's operator is T itself: its product
+        # T^T K T is then the tangent's, not a second PtAP
+        same = all(w is g for w, g in zip(wide, gathers, strict=True))
+        self._T_wide = self._T if same else self._chain_operator(wide)
         keys = self._gather_keys(wide)
         self._wide_current = keys
         self._wide_now = len(keys)
@@ -430,15 +464,23 @@ class NewtonSolver:
         ``T^T K T``'s: ``T`` is within the superset operator."""
         if not (self._grow or new):
             return self._J
-        pattern = self._K.PtAP(self._T_wide)
-        if new:
-            J = pattern
+        tangent = self._T_wide is self._T and self._JT is not None
+        pattern = self._JT if tangent else self._K.PtAP(self._T_wide)
+        union, now = self.comm.allreduce(np.array([len(self._wide_keys), self._wide_now]))
+        if new or union > (1.0 + self.pattern_slack) * now:  # on the current superset only
+            J = pattern.duplicate(copy=True) if tangent else pattern
+            self._wide_keys = self._wide_current
+            if not new:  # the SNES's matrix from now on (the old one kept for its caller)
+                self._retired, self._J = self._J, J
+                self.snes.setJacobian(_weakly(self._jacobian), J)
         else:
             J = self._J
             J.zeroEntries()
             J.axpy(1.0, pattern, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            pattern.destroy()
-            self.snes.getKSP().getPC().reset()  # MUMPS fails on a changed pattern otherwise
+            if not tangent:
+                pattern.destroy()
+        if not new:
+            self._reset_pc()  # MUMPS fails on a changed pattern otherwise
         J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
         self._grow = False
         self.timings.analyses += 1
@@ -460,7 +502,7 @@ class NewtonSolver:
         self._zero_dirichlet_rows(J)
         self._J = J
         self.snes.setJacobian(_weakly(self._jacobian), J)
-        self.snes.getKSP().getPC().reset()
+        self._reset_pc()
 
     def _zero_dirichlet_rows(self, J: PETSc.Mat) -> None:
         problem = self.problem
@@ -786,7 +828,7 @@ class NewtonSolver:
             self.timings.newton += time.perf_counter() - start
         self.timings.iterations += self.snes.getIterationNumber()
         if reason <= 0:
-            self.snes.getKSP().getPC().reset()  # no stale factorisation in the next try
+            self._reset_pc()  # no stale factorisation in the next try
         return reason, self.snes.getIterationNumber()
 
     @property

@@ -185,3 +185,52 @@ def test_an_unknown_predictor_is_refused():
     problem.solver.predictor = "linear"
     with pytest.raises(ValueError, match="predictor must be 'retry', 'first' or None"):
         problem.solve(num_steps=1)
+
+
+def test_field_split_solver_gives_the_same_solution():
+    """``pc_type fieldsplit`` gets the splits ``u`` (displacements) and ``lambda``
+    (multipliers) from the solver, also after the resets of a new pattern: GMRES with a
+    Schur split, GAMG on the displacements, gives the direct solver's solution."""
+    split = {
+        "ksp_type": "fgmres",
+        "ksp_rtol": 1e-12,
+        "ksp_max_it": 400,
+        "pc_type": "fieldsplit",
+        "pc_fieldsplit_type": "schur",
+        "pc_fieldsplit_schur_fact_type": "full",
+        "pc_fieldsplit_schur_precondition": "selfp",
+        "fieldsplit_u_ksp_type": "preonly",
+        "fieldsplit_u_pc_type": "gamg",
+        "fieldsplit_lambda_ksp_type": "preonly",
+        "fieldsplit_lambda_pc_type": "lu",
+    }
+    results = []
+    for options in ({}, split):
+        problem = hertz_problem(**options)
+        problem.solver.pattern_slack = -1.0  # a new pattern, and a reset, at the second step
+        problem.solver.timings.reset()
+        problem.solve(num_steps=2)
+        results.append((problem.solver, problem.solver.x.array.copy()))
+    (direct, x_direct), (iterative, x_iterative) = results
+    pc = iterative.snes.getKSP().getPC()
+    assert pc.getType() == "fieldsplit"
+    assert iterative.timings.analyses >= 1  # the splits were kept through a reset
+    assert iterative.snes.getKSP().getIterationNumber() > 1
+    np.testing.assert_allclose(x_iterative, x_direct, rtol=0, atol=1e-8 * np.abs(x_direct).max())
+
+
+def test_solver_matrix_rebuilt_inside_a_newton_solve():
+    """3D (no superset: every new pairing grows the pattern): with no slack, a growth
+    inside a Newton solve rebuilds the solver matrix on the current pattern there (the
+    SNES's matrix replaced during its Jacobian call); the solution is the default's."""
+    results = []
+    for slack in (0.5, -1.0):
+        problem = ContactProblem(scenes.hertz_3d(h_contact=0.025).scene, verbose=False)
+        problem.solver.pattern_slack = slack
+        problem.solve(num_steps=2)
+        results.append((problem.solver, problem.solver.x.array.copy()))
+    (kept, x_kept), (rebuilt, x_rebuilt) = results
+    assert kept._retired is None  # the union stayed within the slack
+    assert rebuilt._retired is not None  # replaced inside a Newton solve
+    assert rebuilt.timings.iterations == kept.timings.iterations
+    np.testing.assert_allclose(x_rebuilt, x_kept, rtol=0, atol=1e-10 * np.abs(x_kept).max())
