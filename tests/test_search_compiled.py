@@ -42,6 +42,19 @@ def test_compiled_equals_numpy(make, nf, radius, monkeypatch):
         )
 
 
+def test_points_in_any_memory_layout():
+    """Points given as a Fortran-ordered or strided array (e.g. a transpose) get the closest
+    points of the same points in C order (the compiled kernel reads a C-contiguous copy)."""
+    rng = np.random.default_rng(3)
+    nodes = triangle_soup(rng, 50)
+    points = near_and_far(rng, nodes, 40)
+    expected = closest_points(points, nodes, np.inf)
+    for layout in (np.asfortranarray(points), np.repeat(points, 2, axis=0)[::2]):
+        got = closest_points(layout, nodes, np.inf)
+        np.testing.assert_array_equal(got.facet, expected.facet)
+        np.testing.assert_array_equal(got.y, expected.y)
+
+
 def test_work_does_not_grow_with_the_radius():
     """On a flat grid of 20,000 triangles, points 0.01 to 3 facet sizes above it: the exact
     projections per point of an infinite radius are those of a radius of a few facets, and

@@ -1505,7 +1505,7 @@ def _search_compiled(
     tree = trees.hierarchy(nodes)
     rule = None if self_contact is None else _self_contact_arrays(self_contact, nodes)
     order = _cell_order(points) if nodes.shape[0] > _SORT else None
-    x = points if order is None else np.ascontiguousarray(points[order])
+    x = np.ascontiguousarray(points if order is None else points[order])
     if rule is not None and order is not None:
         rule = (rule[0][order], rule[1][order], rule[2], rule[3])
     # the points with one facet within the tie reach get their closest point in C
