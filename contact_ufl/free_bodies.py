@@ -183,15 +183,6 @@ def pairs_on(problem: ContactProblem, piece: Piece) -> list[int]:
     return out
 
 
-def net_force(problem: ContactProblem, residual: np.ndarray, piece: Piece) -> np.ndarray:
-    """The sum over the piece's nodes of the residual of the unknowns ``residual`` (owned
-    part): the net out-of-balance force on the piece (collective)."""
-    bulk = problem.bulks[piece.mesh]
-    r = residual[problem.block_rows(piece.mesh)].reshape(-1, problem.gdim)
-    owned = piece.blocks[piece.blocks < bulk.V.dofmap.index_map.size_local]
-    return problem.comm.allreduce(r[owned].sum(axis=0), MPI.SUM)
-
-
 def net_free_load(problem: ContactProblem, residual: np.ndarray, piece: Piece) -> float:
     """The norm of the out-of-balance load of the residual ``residual`` (owned part) along
     the piece's free modes: forces, and moments about its centre over its size (a force;
