@@ -631,8 +631,8 @@ class NewtonSolver:
         if self._increment is None:
             return False
         t_from, t_to, x_to, dx = self._increment
-        if abs(t_to - t0) > 1e-12 * max(abs(t0), 1.0):
-            return False
+        if t_to == t_from or abs(t_to - t0) > 1e-12 * max(abs(t0), 1.0):
+            return False  # a solve at its start's time predicts nothing
         diff = self.x.copy()
         diff.axpy(-1.0, x_to)
         if diff.norm() > 0.0:

@@ -180,6 +180,23 @@ def test_a_failed_first_try_is_tried_again_from_the_predicted_state():
     assert forces["first"] == pytest.approx(forces[None], rel=1e-8)
 
 
+def test_a_solve_at_its_start_time_predicts_nothing():
+    """A converged solve at the time it starts from (``solve_step(problem.t)``: a step of
+    length zero) leaves no increment to scale: the next step starts from the converged
+    state (it raised ZeroDivisionError with the predicted state first)."""
+    problem = hertz_problem()
+    problem.solver.predictor = "first"
+    problem.solve(num_steps=1, t_end=0.25)
+    problem.begin_step()
+    assert problem.solver.solve_step(problem.t)[0]
+    problem.solve(num_steps=1, t_end=0.5)
+    reference = hertz_problem()
+    reference.solver.predictor = None
+    reference.solve(num_steps=2, t_end=0.5)
+    assert problem.t == pytest.approx(0.5)
+    assert problem.contact_force()[1] == pytest.approx(reference.contact_force()[1], rel=1e-8)
+
+
 def test_an_unknown_predictor_is_refused():
     problem = hertz_problem()
     problem.solver.predictor = "linear"
