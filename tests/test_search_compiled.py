@@ -9,11 +9,14 @@ import sys
 
 import numpy as np
 import pytest
+from mpi4py import MPI
 from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_quads
 from test_search_exact import near_and_far
 
 from contact_ufl.contact import compiled, projection
 from contact_ufl.contact.projection import TreeCache, closest_points
+from contact_ufl.problem import ContactProblem
+from contact_ufl.verification import scenes
 
 FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
 
@@ -104,6 +107,28 @@ def test_no_compiler_is_a_clear_error(monkeypatch):
     monkeypatch.setattr(compiled.shutil, "which", lambda name: None)
     with pytest.raises(compiled.CompilerNotFound, match="C compiler"):
         compiled._compiler()
+
+
+def test_a_build_error_is_raised_on_every_rank(monkeypatch):
+    """A kernel that cannot be built on rank 0 only: :func:`compiled.require` raises the
+    build error on every rank, and making a contact problem calls it (its search builds the
+    kernel on every rank, not only on the ranks with slave points, which search)."""
+    comm = MPI.COMM_WORLD
+    built = compiled.kernel
+
+    def kernel():
+        if comm.rank == 0:
+            raise compiled.CompilerNotFound("no C compiler on rank 0")
+        return built()
+
+    monkeypatch.setattr(compiled, "kernel", kernel)
+    with pytest.raises(compiled.CompilerNotFound, match="no C compiler on rank 0"):
+        compiled.require(comm)
+    monkeypatch.setattr(compiled, "kernel", built)
+    required = []
+    monkeypatch.setattr(compiled, "require", required.append)
+    ContactProblem(scenes.hertz_2d(h_contact=0.05, depth=0.01).scene, verbose=False)
+    assert len(required) == 1  # the one pair's search, on every rank
 
 
 def test_numpy_search_on_request(monkeypatch):

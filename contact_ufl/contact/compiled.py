@@ -30,8 +30,9 @@ import threading
 from pathlib import Path
 
 import cffi
+from mpi4py import MPI
 
-__all__ = ["CompilerNotFound", "cache_dir", "kernel"]
+__all__ = ["CompilerNotFound", "cache_dir", "kernel", "require"]
 
 CDEF = """
 typedef long long i64;
@@ -138,3 +139,21 @@ def kernel() -> tuple[cffi.FFI, object]:
             ffi.cdef(CDEF)
             _loaded = (ffi, ffi.dlopen(str(library)))
         return _loaded
+
+
+def require(comm: MPI.Comm) -> None:
+    """Build or load the kernel on every rank of ``comm`` (collective): where any rank
+    cannot (no C compiler, a failed build, an unwritable cache), raise its error on every
+    rank, not on the ranks that search only (the others would wait in their next collective
+    call). The error is :class:`CompilerNotFound`, or :class:`OSError` for the cache."""
+    failure = None
+    try:
+        kernel()
+    except CompilerNotFound as error:
+        failure = ("compiler", str(error))
+    except OSError as error:
+        failure = ("cache", str(error))
+    failures = [f for f in comm.allgather(failure) if f is not None]
+    if failures:
+        kind, message = failures[0]
+        raise (CompilerNotFound if kind == "compiler" else OSError)(message)

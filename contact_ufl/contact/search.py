@@ -21,9 +21,16 @@ import numpy as np
 import scipy.sparse
 from mpi4py import MPI
 
+from contact_ufl.contact import compiled
 from contact_ufl.contact.facets import on_edges
 from contact_ufl.contact.master import MeshMaster, smoothed_normals, smoothed_normals_3d
-from contact_ufl.contact.projection import Projection, SelfContact, TreeCache, closest_points
+from contact_ufl.contact.projection import (
+    Projection,
+    SelfContact,
+    TreeCache,
+    _compiled,
+    closest_points,
+)
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
 from contact_ufl.layout import StackedLayout
@@ -101,8 +108,12 @@ class ClosestPointSearch:
         self.gdim = slave.V.mesh.geometry.dim
         #: seconds spent in :meth:`pair` so far
         self.time = 0.0
-        #: KD-trees of the master facets, reused from one search to the next
+        #: search trees of the master facets, reused from one search to the next
         self.trees = TreeCache()
+        # the compiled kernel on every rank now: a rank with no slave points never builds
+        # it, so a build error would otherwise be raised on the searching ranks only
+        if self.comm.allreduce(_compiled(master.nn, self.gdim), MPI.LOR):
+            compiled.require(self.comm)
 
     def exchange(self, master_nodes: np.ndarray, points: np.ndarray, payload=None):
         """Master facets of all ranks near this rank's ``points`` (bounding-box filter).
