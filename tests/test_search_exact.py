@@ -116,8 +116,9 @@ def test_equidistant_grid_facets():
 
 
 def test_reused_tree_after_the_master_moves():
-    """The KD-tree of a master of the same shape is reused while its nodes move little: the
-    results after small and large movements are those of a fresh projection."""
+    """The search tree (here the compiled search's hierarchy) of a master of the same shape
+    is reused while its nodes move little: the results after small and large movements are
+    those of a fresh projection."""
     rng = np.random.default_rng(7)
     nodes = wavy_quads(rng, 36)
     points = near_and_far(rng, nodes, 30)

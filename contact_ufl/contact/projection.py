@@ -123,7 +123,7 @@ _EDGES["quadrilateral9"] = _EDGES["quadrilateral"]
 
 _K = {2: 8, 3: 16}  # neighbours of the first KD-tree query, by dimension
 _TREES = 4  # KD-trees kept for reuse (one per master surface of a distinct shape)
-_MOVE = 0.25  # a KD-tree is reused while no node has moved more than this times R_max
+_MOVE = 0.25  # a search tree is reused while no node has moved more than this times R_max
 _LEVEL_RADIUS = 2.0  # facets of radius up to this times the median share the first KD-tree
 _LEVEL_RATIO = 4.0  # ratio of the largest facet radii of successive KD-tree levels
 _BLOCK = 1 << 12  # points processed at once (keeps the arrays of the candidate pairs in cache)
@@ -943,18 +943,20 @@ def _dot3(a: list[FloatArray], b: list[FloatArray]) -> FloatArray:
 
 
 class TreeCache:
-    """KD-trees of facet centroids, reused while the master surface has barely moved.
+    """Search trees of a master surface, reused while it has barely moved: KD-trees of facet
+    centroids (the NumPy search, :meth:`tree`) and bounding-volume hierarchies (the compiled
+    search, :meth:`hierarchy`).
 
     Held by whoever searches the same master surface again and again (a
     :class:`~contact_ufl.contact.search.ClosestPointSearch`) and passed to
     :func:`closest_points`.
 
-    One entry per shape ``(nf, nn, gdim)`` of the node array (the ``_TREES`` most recent):
-    the nodes the tree was built from and the tree.
+    One entry per shape ``(nf, nn, gdim)`` of the node array and KD-tree level or hierarchy (the
+    ``_TREES`` most recent): the nodes the tree was built from and the tree.
     """
 
     def __init__(self) -> None:
-        self.entries: OrderedDict[tuple[int, ...], tuple[FloatArray, cKDTree]] = OrderedDict()
+        self.entries: OrderedDict[tuple, tuple[FloatArray, cKDTree | _Hierarchy]] = OrderedDict()
 
     def tree(
         self, nodes: FloatArray, centroid: FloatArray, R_max: float, level: int = 0
