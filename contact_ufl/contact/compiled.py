@@ -12,8 +12,8 @@ cached name (the last rename wins; every candidate is a complete library of the 
 so no process ever loads a half-written file.
 
 The compiler is ``$CC`` if set, else the one Python was built with, else ``cc``; the flags
-``-O2 -fPIC -shared -ffp-contract=off`` (no fused multiply-add: the kernels repeat the NumPy
-operations to the last bit).
+``-O2 -fPIC -shared -ffp-contract=off -fno-fast-math`` (no fused multiply-add: the kernels
+repeat the NumPy operations to the last bit).
 """
 
 from __future__ import annotations
@@ -42,8 +42,6 @@ double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64
 double largest_change(i64 len, const double *p, const double *q);
 int same_nodes(i64 n, int width, const double *nodes, const i64 *perm,
                const double *leaf_nodes);
-void project_pairs(int kind, int g, int nn, const double *nodes, i64 P, const double *x,
-                   const i64 *f, double *xi, double *dist, i64 *edge, unsigned char *vertex);
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
               const double *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,

@@ -394,21 +394,6 @@ INLINE void project(int kind, const double *X, const double *x, pair_t *out)
     }
 }
 
-/* Exact projections of the pairs (x[p], facet f[p]) (a test and fallback entry point). */
-void project_pairs(int kind, int g, int nn, const double *nodes, i64 P, const double *x,
-                   const i64 *f, double *xi, double *dist, i64 *edge, unsigned char *vertex)
-{
-    int fdim = g - 1;
-    for (i64 p = 0; p < P; p++) {
-        pair_t q;
-        project(kind, nodes + f[p] * nn * g, x + p * g, &q);
-        for (int j = 0; j < fdim; j++) xi[p * fdim + j] = q.xi[j];
-        dist[p] = q.dist;
-        edge[p] = q.edge;
-        vertex[p] = (unsigned char)q.vertex;
-    }
-}
-
 /* -- branch-and-bound query -------------------------------------------------------------- */
 
 INLINE double box_distance2(int g, const double *B, const double *x)
