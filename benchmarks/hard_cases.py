@@ -18,6 +18,12 @@ limit point). A case stopped by a ``ConvergenceError`` is recorded as ``stopped`
 :mod:`contact_ufl.verification.hard_cases`.
 
     python benchmarks/hard_cases.py --json benchmarks/results/hard_cases.json [--quick]
+        [--cases NAME [NAME ...]]
+
+``--cases`` runs only the named cases, in the order given (the others are recorded as
+``"not run"``). The JSON is written after every case, in the suite's order, so a run that is
+stopped (a time-out) keeps the cases it finished; the cases it did not reach are recorded as
+``"not run"`` with why, never with numbers of an earlier run.
 """
 
 import argparse
@@ -60,14 +66,15 @@ def why(record: dict) -> str:
 
 
 def print_table(records: list[dict], header: bool = True) -> None:
+    """Print one line per record (with a header line if ``header``)."""
     if header:
         print(
             f"{'case':34} {'status':13} {'t':>6} {'steps':>5} {'cuts':>4} {'newton':>10} "
             f"{'all conv':>8} {'wall s':>7}  why"
         )
     for r in records:
-        if r["status"] == "not implemented":
-            print(f"{r['name']:34} not implemented: {r['description']}")
+        if r["status"] in ("not implemented", "not run"):
+            print(f"{r['name']:34} {r['status']}: {r['description']}")
             continue
         newton = f"{r['newton_max']}/{r['newton_mean']:.1f}"
         print(
@@ -77,27 +84,51 @@ def print_table(records: list[dict], header: bool = True) -> None:
         )
 
 
+NOT_SELECTED = "not run this time (not in --cases)"
+NOT_REACHED = "not run this time (the run ended before this case)"
+
+
+def write(path: str, quick: bool, ranks: int, records: list[dict]) -> None:
+    """Write the report to ``path``: ``quick``, ``ranks`` and ``records`` (the suite's order)."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w") as f:
+        json.dump({"quick": quick, "ranks": ranks, "cases": records}, f, indent=1)
+
+
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--json", required=True)
     parser.add_argument("--quick", action="store_true", help="coarse meshes, larger steps")
+    parser.add_argument("--cases", nargs="+", metavar="NAME", help="run only these, in order")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
-    records = []
-    for case in cases(quick=args.quick):
-        records.append(run_case(case))
-        if comm.rank == 0:
-            print_table(records[-1:], header=len(records) == 1)
-    records += [
-        {"name": name, "status": "not implemented", "description": text}
+    suite = {case.name: case for case in cases(quick=args.quick)}
+    selected = args.cases or list(suite)
+    unknown = [name for name in selected if name not in suite]
+    if unknown:
+        parser.error(f"unknown case(s) {unknown}; the cases are {list(suite)}")
+    records = {
+        name: {
+            "name": name,
+            "status": "not run",
+            "description": NOT_REACHED if name in selected else NOT_SELECTED,
+        }
+        for name in suite
+    }
+    records |= {
+        name: {"name": name, "status": "not implemented", "description": text}
         for name, text in NOT_IMPLEMENTED.items()
-    ]
+    }
+    for i, name in enumerate(selected):
+        records[name] = run_case(suite[name])
+        if comm.rank == 0:
+            print_table([records[name]], header=i == 0)
+            write(args.json, args.quick, comm.size, list(records.values()))
     if comm.rank == 0:
         print()
-        print_table(records)
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        with open(args.json, "w") as f:
-            json.dump({"quick": args.quick, "ranks": comm.size, "cases": records}, f, indent=1)
+        print_table(list(records.values()))
 
 
 if __name__ == "__main__":
