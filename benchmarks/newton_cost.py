@@ -21,7 +21,7 @@ iteration (issue 12's target: at most 1.3 at 100,000 unknowns in 2D and at the l
 
     python benchmarks/newton_cost.py --json benchmarks/results/newton_cost.json [--quick]
         [--repeat N] [--scenes hertz beams hertz3d] [--sizes ...] [--glued]
-        [--ranks 1 2] [--option KEY=VALUE ...]
+        [--ranks 1 2] [--option KEY=VALUE ...] [--partition bodies|graph]
 
 ``--glued`` adds the fair baseline of a contact scene (issue 12's bulk problem with the
 bodies *coupled*, not free): the bodies glued where the contact pairs them. Its tangent is
@@ -39,6 +39,9 @@ contact record adds ``glued_ratio`` (its ``total_s`` over the glued ``bulk_s``) 
 times (the fastest run of each is kept), and writes all records with ``speedup`` (wall time
 of the solve on one rank over that on k ranks) and ``per_rank`` (each rank's parts, its
 slave points and its share of the rows and nonzeros of ``K`` and ``T``: where the work is).
+``--partition graph`` distributes the meshes with DOLFINx's graph partition (whole bodies on
+ranks) instead of the default that splits every body over all ranks
+(:mod:`contact_ufl.partition`); the records say which (``partition``).
 ``--option`` passes PETSc options to the solver (e.g. ``mat_mumps_icntl_7=3``); ``--dump
 FILE`` writes the contact tangent at the end of the solve for ``benchmarks/linear_solvers.py``
 (orderings, MUMPS options, iterative solvers on it).
@@ -73,7 +76,9 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from contact_ufl.gmshio import PARTITION_VARIABLE
 from contact_ufl.loads import Dirichlet
+from contact_ufl.partition import PARTITIONS
 from contact_ufl.problem import ContactProblem
 from contact_ufl.verification import scenes
 
@@ -271,6 +276,7 @@ def run(
         "bulk_s": per["residual_assembly"] + per["jacobian_assembly"] + per["linear_solve"],
         "ranks": problem.comm.size,
         "options": options,
+        "partition": os.environ.get(PARTITION_VARIABLE, "bodies"),
     }
     record["per_rank"] = _per_rank(problem, cpu, timings)
     if dump and contact:
@@ -355,6 +361,7 @@ def _arguments() -> argparse.Namespace:
     parser.add_argument("--glued", action="store_true", help="add the glued baseline")
     parser.add_argument("--ranks", nargs="+", type=int, help="run under mpirun -n k for each k")
     parser.add_argument("--option", nargs="*", default=[], help="PETSc options KEY=VALUE")
+    parser.add_argument("--partition", choices=PARTITIONS, default="bodies", help="mesh partition")
     parser.add_argument("--dump", default="", help="write the contact tangent (last size)")
     return parser.parse_args()
 
@@ -396,6 +403,7 @@ def _by_ranks(args: argparse.Namespace) -> None:
 
 def main() -> None:
     args = _arguments()
+    os.environ[PARTITION_VARIABLE] = args.partition  # read by every mesh made (and mpirun's)
     if args.ranks:
         _by_ranks(args)
         return

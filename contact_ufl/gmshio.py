@@ -34,11 +34,15 @@ import numpy.typing as npt
 from mpi4py import MPI
 
 from contact_ufl.errors import ContactInputError
+from contact_ufl.partition import PARTITIONS, cell_partitioner
 
 __all__ = ["MeshData", "gmsh_session", "read_gmsh", "generate_mesh"]
 
 #: Physical group name -> (dimension, tag).
 Groups = dict[str, tuple[int, int]]
+
+#: Environment variable naming the default partition (``bodies`` or ``graph``).
+PARTITION_VARIABLE = "CONTACT_UFL_PARTITION"
 
 
 @dataclass(frozen=True, eq=False)
@@ -150,6 +154,7 @@ def read_gmsh(
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
     require_names: bool = False,
     tdim: int | None = None,
+    partition: str | None = None,
 ) -> MeshData:
     """Read a mesh and its physical groups from a ``.msh`` file or a live gmsh model.
 
@@ -172,6 +177,12 @@ def read_gmsh(
     tdim
         The topological dimension the caller needs (a scene of solid bodies: ``gdim``);
         refuse a mesh of another dimension.
+    partition
+        How the cells are spread over the ranks: ``"bodies"`` splits every body (connected
+        piece of the mesh) over all the ranks, so that each rank holds a share of every
+        contact surface (:mod:`contact_ufl.partition`); ``"graph"`` is DOLFINx's partition
+        of the whole mesh, which puts whole bodies on ranks. Default: the environment
+        variable ``CONTACT_UFL_PARTITION``, else ``"bodies"``.
 
     Returns
     -------
@@ -183,21 +194,34 @@ def read_gmsh(
     ContactInputError
         On every rank: the file is missing or unreadable, the model has no mesh or no
         physical group of its cells, the dimension does not match ``gdim``/``tdim``, a name
-        is used by two groups, or (with ``require_names``) a group has no name.
+        is used by two groups, (with ``require_names``) a group has no name, or
+        ``partition`` is unknown.
     """
+    partition = _partition(partition)
     is_file = comm.bcast(
         isinstance(source, str | os.PathLike) if comm.rank == rank else None, root=rank
     )
     mine = comm.rank == rank
 
     def distribute(model: Any, origin: str) -> MeshData:
-        return _distribute(model, comm, rank, gdim, ghost_mode, require_names, tdim, origin)
+        return _distribute(
+            model, comm, rank, gdim, (ghost_mode, partition), require_names, tdim, origin
+        )
 
     if not is_file:
         return distribute(source if mine else None, "the gmsh model")
     with _session_on(comm, rank, "msh"):
         _raise_from(comm, rank, _merge(Path(source)) if mine else None)
         return distribute(gmsh.model if mine else None, f"mesh file '{source}'" if mine else "")
+
+
+def _partition(partition: str | None) -> str:
+    """The partition asked for, else the environment's, else ``"bodies"``; checked."""
+    chosen = partition or os.environ.get(PARTITION_VARIABLE) or "bodies"
+    if chosen not in PARTITIONS:
+        source = "partition" if partition else PARTITION_VARIABLE
+        raise ContactInputError(f"{source} = '{chosen}' is unknown: use one of {PARTITIONS}")
+    return chosen
 
 
 def _merge(path: Path) -> str | None:
@@ -216,7 +240,7 @@ def _distribute(
     comm: MPI.Comm,
     rank: int,
     gdim: int | None,
-    ghost_mode: dolfinx.mesh.GhostMode,
+    how: tuple[dolfinx.mesh.GhostMode, str],
     require_names: bool,
     tdim: int | None,
     origin: str,
@@ -231,7 +255,7 @@ def _distribute(
     error, model_dim, groups, name = comm.bcast(summary, root=rank)
     _raise_from(comm, rank, error)
     gdim = model_dim if gdim is None else gdim
-    partitioner = dolfinx.mesh.create_cell_partitioner(ghost_mode, 2)
+    partitioner = cell_partitioner(how[1], how[0])
     data = dolfinx.io.gmsh.model_to_mesh(
         model if comm.rank == rank else None, comm, rank, gdim=gdim, partitioner=partitioner
     )
@@ -318,12 +342,13 @@ def generate_mesh(
     msh_file: str | Path | None = None,
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
     rank: int = 0,
+    partition: str | None = None,
 ) -> MeshData:
     """Run ``build`` (geometry, size fields, named groups, meshing) in a fresh gmsh model on
     rank ``rank`` and distribute the mesh (:func:`read_gmsh`).
 
     Errors of ``build`` on that rank are raised on every rank. With ``msh_file`` the gmsh
-    mesh is also written there.
+    mesh is also written there. ``partition``: see :func:`read_gmsh`.
     """
     error = None
     with _session_on(comm, rank, name, options):
@@ -340,4 +365,6 @@ def generate_mesh(
         if error is not None:
             raise RuntimeError(f"building the gmsh model '{name}' failed: {error}")
         model = gmsh.model if comm.rank == rank else None
-        return read_gmsh(model, comm, gdim, rank, ghost_mode, require_names=True)
+        return read_gmsh(
+            model, comm, gdim, rank, ghost_mode, require_names=True, partition=partition
+        )

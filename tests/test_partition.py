@@ -1,0 +1,93 @@
+"""The partition of a multi-body mesh: every body split over all the ranks (issue 12, item 5)."""
+
+import dolfinx
+import numpy as np
+import pytest
+import scipy.sparse
+from mpi4py import MPI
+
+from contact_ufl.errors import ContactInputError
+from contact_ufl.gmshio import PARTITION_VARIABLE
+from contact_ufl.partition import body_partitioner
+from contact_ufl.problem import ContactProblem
+from contact_ufl.verification.scenes import patch
+
+PRESSURE = 0.01
+TIGHT = {"snes_rtol": 1e-13, "snes_atol": 1e-15}
+
+
+def dual_graph(mesh: dolfinx.mesh.Mesh) -> scipy.sparse.csr_array:
+    """Cells joined by a shared facet (this rank's cells, serial)."""
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    inner = np.flatnonzero(np.diff(f2c.offsets) == 2)
+    a, b = f2c.array[f2c.offsets[inner]], f2c.array[f2c.offsets[inner] + 1]
+    n = mesh.topology.index_map(tdim).size_local
+    ones = np.ones(2 * len(a))
+    return scipy.sparse.coo_array((ones, (np.r_[a, b], np.r_[b, a])), (n, n)).tocsr()
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize("nparts", [2, 3])
+def test_body_partitioner_splits_every_body(nparts):
+    """On the serial 3D patch mesh: each body, and the slave and master surfaces, are
+    shared by every part within 30%; a ghost goes to exactly the other parts of the cell's
+    facet neighbours."""
+    scene = patch(3, PRESSURE, quadrature_degree=2, subdivisions=1, cell="tetrahedron")
+    graph = dual_graph(scene.mesh)
+    adjacency = dolfinx.cpp.graph.AdjacencyList_int64(
+        graph.indices.astype(np.int64), graph.indptr.astype(np.int32)
+    )
+    dest = body_partitioner()(MPI.COMM_SELF, nparts, adjacency, True)
+    offsets, data = np.asarray(dest.offsets), np.asarray(dest.array)
+    owner = data[offsets[:-1]]
+    f2c = scene.mesh.topology.connectivity(2, 3)
+    pair = scene.contacts[0]
+    for tags, cells_of in (
+        (scene.cell_tags, lambda idx: idx),
+        (scene.facet_tags, lambda idx: f2c.array[f2c.offsets[idx]]),
+    ):
+        for tag in (*[b.tag for b in scene.bodies], pair.slave, pair.master):
+            idx = tags.indices[tags.values == tag]
+            if len(idx) == 0:
+                continue
+            count = np.bincount(owner[cells_of(idx)], minlength=nparts)
+            assert count.min() > 0.7 * len(idx) / nparts, (tag, count)
+    for cell in np.flatnonzero(np.diff(offsets) > 1)[:50]:
+        neighbours = graph.indices[graph.indptr[cell] : graph.indptr[cell + 1]]
+        expected = np.setdiff1d(owner[neighbours], [owner[cell]])
+        assert np.array_equal(data[offsets[cell] + 1 : offsets[cell + 1]], expected)
+
+
+def test_unknown_partition_is_refused(monkeypatch):
+    monkeypatch.setenv(PARTITION_VARIABLE, "metis")
+    with pytest.raises(ContactInputError, match="CONTACT_UFL_PARTITION = 'metis' is unknown"):
+        patch(2, PRESSURE)
+
+
+def solve(monkeypatch, partition: str) -> ContactProblem:
+    monkeypatch.setenv(PARTITION_VARIABLE, partition)
+    scene = patch(2, PRESSURE, quadrature_degree=3, subdivisions=4)
+    problem = ContactProblem(scene, verbose=False, petsc_options=TIGHT)
+    problem.solve(num_steps=1)
+    return problem
+
+
+def test_every_rank_owns_slave_points_and_answers_are_unchanged(monkeypatch):
+    """With the default partition every rank owns slave points of the patch scene (on two
+    ranks DOLFINx's graph partition gives the whole slave body to one rank); the contact
+    force, the multiplier's extremes and the displacement norm are those of the graph
+    partition to solver tolerance."""
+    bodies, graph = solve(monkeypatch, "bodies"), solve(monkeypatch, "graph")
+    comm = bodies.comm
+    points = comm.allgather(len(bodies.contacts[0].projection.facet))
+    assert min(points) > 0, points
+    assert np.allclose(bodies.contact_force(), graph.contact_force(), rtol=1e-10, atol=1e-15)
+
+    def summary(problem):
+        lam = problem.contacts[0].lambda_N.x.array
+        u = problem.bulks[0].u.x.petsc_vec.norm()
+        return comm.allreduce(lam.min(), MPI.MIN), comm.allreduce(lam.max(), MPI.MAX), u
+
+    assert np.allclose(summary(bodies), summary(graph), rtol=1e-9)
