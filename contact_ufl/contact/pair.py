@@ -106,7 +106,8 @@ class ContactPair:
         nears 1 (the 3D Hertz with ``eps_N = E / h`` and a step's depth near a master
         element), and the next iterate crushes the master's facets. README "Robustness of
         the Newton solve": the 3D Hertz P1 at 17k unknowns in one step, 10 Newton
-        iterations instead of 25 failed and 13 with the line search, the same force.
+        iterations instead of 25 failed and about 13 with the line search, the same force;
+        at 50k, 10 and 7 in two steps instead of 36 and 7.
     """
 
     slave: int | str
