@@ -244,9 +244,15 @@ class ContactProblem:
         for control in self.controls:
             k = self.bulks.index(control.bulk)
             residuals[k] = residuals[k] - control.bulk_residual(tests[k])
+        tangent_extra = {}
         for c in self.contacts:
             k = c.pair.slave_domain
             Fu_c, F_fields = c.residuals(tests[k])
+            extra = c.tangent_residuals(tests[k])
+            if extra is not None:
+                tangent_extra[k] = tangent_extra.get(k, 0) + extra[0]
+                for j, form in enumerate(extra[1]):
+                    tangent_extra[len(residuals) + j] = form
             residuals[k] = residuals[k] + Fu_c
             contact_residuals[k] = contact_residuals[k] + Fu_c
             residuals += F_fields
@@ -260,9 +266,14 @@ class ContactProblem:
             unknowns += control.unknowns
             control.block = len(unknowns) - 1
         self.fields, self.unknowns = fields, unknowns
+        # the residuals the tangent is taken from: with the terms only the tangent sees
+        # (ContactPair.geometric_traction)
+        tangent = [
+            r + tangent_extra[i] if i in tangent_extra else r for i, r in enumerate(residuals)
+        ]
         jacobian = [
             [_nonempty(ufl.derivative(Fi, f, ufl.TrialFunction(f.function_space))) for f in fields]
-            for Fi in residuals
+            for Fi in tangent
         ]
         entity_maps = [c.slave.entity_map for c in self.contacts]
         self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)

@@ -167,6 +167,11 @@ class ContactInterface:
             else None
         )
         self._surface_forms: dict[str, list[dolfinx.fem.Form]] = {}
+        #: the shift of the traction in the master geometric terms of the tangent (None:
+        #: the consistent tangent; see :meth:`tangent_residuals`)
+        self.geometric_shift = None
+        if pair.geometric_traction == "multiplier" and not pair.on_obstacle:
+            self.geometric_shift = dolfinx.fem.Function(self.slave.point_space(()))
 
     def _mesh_side(
         self,
@@ -244,6 +249,24 @@ class ContactInterface:
         own = [*self.kinematics.master_residuals(traction), self.normal.residual(self.t_N)]
         return F_u, own + (self.friction.residuals() if self.friction else [])
 
+    def tangent_residuals(self, v: ufl.Argument) -> tuple[ufl.Form, list[ufl.Form]] | None:
+        """Terms added to :meth:`residuals` for the tangent only: the virtual work of the
+        traction ``c nu``, ``c`` a point coefficient (:attr:`geometric_shift`), whose
+        derivative is ``c`` times the master geometric terms (normal variation, sliding of
+        the closest point). ``None`` without a shift."""
+        if self.geometric_shift is None:
+            return None
+        T = self.geometric_shift * self.kinematics.nu
+        F_u = -ufl.dot(T, v) * self.slave.ds
+        return F_u, self.kinematics.master_residuals(T)
+
+    def _set_geometric_shift(self) -> None:
+        if self.geometric_shift is None:
+            return
+        t_N = self.normal.traction_at_points(self.projection)
+        lam = np.maximum(self.normal.multiplier_at_points(), 0.0)
+        self.slave.set_at_points(self.geometric_shift, np.minimum(t_N, lam) - t_N)
+
     def update(self, layout: StackedLayout) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
         """Search, and refresh the point data of the kinematics.
 
@@ -258,6 +281,7 @@ class ContactInterface:
         order), the stacked index of the (master) displacement unknown it gathers, or -1.
         """
         gathers = self.kinematics.update(layout)
+        self._set_geometric_shift()
         return gathers + (self.friction.gathers() if self.friction else [])
 
     def pattern_gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:

@@ -11,6 +11,9 @@ from contact_ufl.contact.quadrature import QUADRATURE_RULES
 from contact_ufl.contact.slave import ISO_MULTIPLIER, MULTIPLIER_DEGREES
 from contact_ufl.errors import check_positive, collective_check
 
+#: Values of :attr:`ContactPair.geometric_traction`.
+GEOMETRIC_TRACTIONS = ("bracket", "multiplier")
+
 
 @dataclass(frozen=True)
 class ContactPair:
@@ -91,6 +94,20 @@ class ContactPair:
         rule is then composite over the refined facets (``quadrature_subdivisions`` rounded
         up to an even number: 1 -> 2, 3 -> 4). See ``docs/quadratic-contact.md`` for the
         comparison.
+    geometric_traction
+        The normal traction that weights the master's geometric terms of the Newton tangent
+        (the variation of the master normal and the sliding of the closest point; the
+        residual, and so the solution, is the same either way): ``"bracket"`` (default) the
+        consistent ``t_N = <lambda_N + eps_N g>``, ``"multiplier"`` ``min(t_N,
+        max(lambda_N, 0))`` (a meshed master only). The two differ where a point is deep in
+        the master with a small multiplier, as after the contact-free first iterate of a
+        step that starts open: that iterate's penetration ``g`` weights the terms by
+        ``eps_N g``, of the order of the bulk stiffness ``E / h`` once ``eps_N g h / E``
+        nears 1 (the 3D Hertz with ``eps_N = E / h`` and a step's depth near a master
+        element), and the next iterate crushes the master's facets. README "Robustness of
+        the Newton solve": the 3D Hertz P1 at 17k unknowns in one step, 10 Newton
+        iterations instead of 25 failed and about 13 with the line search, the same force;
+        at 50k, 10 and 7 in two steps instead of 36 and 7.
     """
 
     slave: int | str
@@ -106,6 +123,7 @@ class ContactPair:
     slave_domain: int | str | None = None
     master_domain: int | str | None = None
     multiplier_degree: int | str = 1
+    geometric_traction: str = "bracket"
 
     @property
     def frictional(self) -> bool:
@@ -188,6 +206,12 @@ class ContactPair:
             self.master_normal in (None, "facet", "smoothed"),
             f"master_normal must be 'facet', 'smoothed' or None (the default: smoothed on a 2D "
             f"solid master of degree 1, else facet), got {self.master_normal!r}",
+        )
+        collective_check(
+            comm,
+            self.geometric_traction in GEOMETRIC_TRACTIONS,
+            f"geometric_traction must be one of {GEOMETRIC_TRACTIONS}, "
+            f"got {self.geometric_traction!r}",
         )
         collective_check(
             comm,
