@@ -13,6 +13,12 @@ DEMOS = Path(__file__).parents[1] / "demos"
 #: the MPI launcher beside the interpreter (the wheel's MPICH), else the one on PATH
 MPIRUN = shutil.which("mpirun", path=str(Path(sys.executable).parent)) or shutil.which("mpirun")
 RANKS = pytest.mark.parametrize("ranks", [1, 2], ids=["1 rank", "2 ranks"])
+#: the longer demos on 2 ranks run with the slow tests (their scenes' rank independence is
+#: tested in test_plasticity; the membrane scenes run on 2 ranks in the 2-rank suite; the
+#: beams and Hertz demos keep their 2-rank runs)
+RANKS_SLOW_2 = pytest.mark.parametrize(
+    "ranks", [1, pytest.param(2, marks=pytest.mark.slow)], ids=["1 rank", "2 ranks"]
+)
 
 
 def run_demo(
@@ -70,7 +76,7 @@ def test_beams_demo_runs(tmp_path, ranks):
 
 
 @pytest.mark.serial
-@RANKS
+@RANKS_SLOW_2
 def test_plastic_indentation_demo_runs(tmp_path, ranks):
     stdout, out = run_demo("plastic_indentation.py", ["--steps", "4"], tmp_path, ranks=ranks)
     assert "plastic: peak pressure" in stdout and "imprint" in stdout
@@ -80,7 +86,7 @@ def test_plastic_indentation_demo_runs(tmp_path, ranks):
 
 
 @pytest.mark.serial
-@RANKS
+@RANKS_SLOW_2
 def test_membrane_demo_runs(tmp_path, ranks):
     stdout, out = run_demo("membrane.py", ["--mu", "0.3"], tmp_path, ranks=ranks)
     assert "12 steps, 0 cut-backs" in stdout
