@@ -864,6 +864,38 @@ def tag_single_body(
     return cell_tags, facet_tags
 
 
+def _ironing_sizes(
+    radius: float,
+    chord: float,
+    punch_height: float,
+    block: tuple[float, float],
+    gap: float,
+    h_punch: float,
+    h_block: float,
+) -> tuple[float, float, float]:
+    """Check the shallow ironing's dimensions; the block's width and height and the sag of
+    the punch's arc."""
+    _check_positive(
+        radius=radius, chord=chord, punch_height=punch_height, h_punch=h_punch, h_block=h_block
+    )
+    if chord > 2.0 * radius:
+        raise ValueError(f"the punch's chord {chord} is wider than its arc's diameter {2 * radius}")
+    _check_common(gap, 1)
+    width, height = block
+    return width, height, radius - np.sqrt(radius**2 - chord**2 / 4.0)
+
+
+def _ironing_size_field(
+    punch: int, body: int, block_top: int, h_punch: float, h_block: float, height: float
+) -> None:
+    """The shallow ironing's sizes: ``h_punch`` in the punch, ``h_block`` on the block's top
+    growing to 4 ``h_block`` below it."""
+    distance = gmsh.model.mesh.field.add("Distance")
+    gmsh.model.mesh.field.setNumbers(distance, "CurvesList", [block_top])
+    lower = _threshold(distance, h_block, 4.0 * h_block, 0.5, height)
+    _set_background([_restricted(_constant(h_punch), 2, [punch]), _restricted(lower, 2, [body])])
+
+
 def ironing_2d(
     radius: float = 0.75,
     chord: float = 1.2,
@@ -893,14 +925,7 @@ def ironing_2d(
         vertical sides, 11), ``"punch_top"`` (12), ``"block_contact"`` (top, 13),
         ``"block_bottom"`` (14), ``"block_sides"`` (15).
     """
-    _check_positive(
-        radius=radius, chord=chord, punch_height=punch_height, h_punch=h_punch, h_block=h_block
-    )
-    if chord > 2.0 * radius:
-        raise ValueError(f"the punch's chord {chord} is wider than its arc's diameter {2 * radius}")
-    _check_common(gap, 1)
-    width, height = block
-    sag = radius - np.sqrt(radius**2 - chord**2 / 4.0)
+    width, height, sag = _ironing_sizes(radius, chord, punch_height, block, gap, h_punch, h_block)
 
     def build() -> None:
         geo = gmsh.model.geo
@@ -938,12 +963,7 @@ def ironing_2d(
             ],
             tdim=2,
         )
-        distance = gmsh.model.mesh.field.add("Distance")
-        gmsh.model.mesh.field.setNumbers(distance, "CurvesList", [block_top])
-        lower = _threshold(distance, h_block, 4.0 * h_block, 0.5, height)
-        _set_background(
-            [_restricted(_constant(h_punch), 2, [punch]), _restricted(lower, 2, [body])]
-        )
+        _ironing_size_field(punch, body, block_top, h_punch, h_block, height)
         _generate(2)
 
     return generate_mesh(comm, "ironing_2d", build, 2, _mesh_options(1), msh_file, ghost_mode)
@@ -1490,16 +1510,9 @@ def ironing_extruded(
         the extruded faces of the 3D one; with a thickness also ``"plane_faces"`` (16): the
         faces z = 0 and z = thickness of both bodies.
     """
-    _check_positive(
-        radius=radius, chord=chord, punch_height=punch_height, h_punch=h_punch, h_block=h_block
-    )
     if thickness is not None:
         _check_positive(thickness=thickness)
-    if chord > 2.0 * radius:
-        raise ValueError(f"the punch's chord {chord} is wider than its arc's diameter {2 * radius}")
-    _check_common(gap, 1)
-    width, height = block
-    sag = radius - np.sqrt(radius**2 - chord**2 / 4.0)
+    width, height, sag = _ironing_sizes(radius, chord, punch_height, block, gap, h_punch, h_block)
     dim = 2 if thickness is None else 3
 
     def outline() -> tuple[int, int, list[int], list[int]]:
@@ -1560,12 +1573,7 @@ def ironing_extruded(
             + [(name, dim - 1, tags) for name, tags in groups.items()],
             tdim=dim,
         )
-        distance = gmsh.model.mesh.field.add("Distance")
-        gmsh.model.mesh.field.setNumbers(distance, "CurvesList", [bc[2]])
-        lower = _threshold(distance, h_block, 4.0 * h_block, 0.5, height)
-        _set_background(
-            [_restricted(_constant(h_punch), 2, [punch]), _restricted(lower, 2, [body])]
-        )
+        _ironing_size_field(punch, body, bc[2], h_punch, h_block, height)
         gmsh.model.mesh.generate(dim)
 
     options = _mesh_options(1) | {

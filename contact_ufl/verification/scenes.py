@@ -8,6 +8,7 @@ data needed to compare with the analytic solution.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import dolfinx
@@ -556,6 +557,29 @@ def ironing(
     default (the punch slides over many master vertices).
     """
     sm = geometries.ironing_2d(h_punch=h_punch, h_block=h_block, comm=comm)
+    dirichlet = [
+        Dirichlet("block_bottom", (0.0, 0.0)),
+        Dirichlet("punch_top", _punch_path(depth, slide, 2)),
+    ]
+    return _ironing_scene(sm, mu, h_block, master_normal, dirichlet)
+
+
+def _punch_path(depth: float, slide: float, dim: int) -> Callable[[float], tuple]:
+    """The ironing punch top's motion: down by ``depth`` from t = 0 to 1, then along the
+    block by ``slide`` from t = 1 to 2 (in 3D z held)."""
+
+    def path(t: float) -> tuple:
+        return (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0)) + (0.0,) * (dim - 2)
+
+    return path
+
+
+def _ironing_scene(
+    sm: MeshData, mu: float, h_block: float, master_normal: str, dirichlet: list
+) -> Scene:
+    """The shallow ironing's bodies (a Neo-Hookean block, E = 6.896e8, nu = 0.32, and a ten
+    times stiffer punch) and its pair (the punch's arc and sides on the block's top, eps_N =
+    E_block / h_block) on the mesh data ``sm`` of either ironing geometry."""
     E_block, E_punch, nu = 6.896e8, 6.896e9, 0.32
     pair = ContactPair(
         "punch_contact",
@@ -569,10 +593,7 @@ def ironing(
         sm,
         bodies=_solids(punch=NeoHookean(E_punch, nu), block=NeoHookean(E_block, nu)),
         contacts=[pair],
-        dirichlet=[
-            Dirichlet("block_bottom", (0.0, 0.0)),
-            Dirichlet("punch_top", lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0))),
-        ],
+        dirichlet=dirichlet,
     )
 
 
@@ -1577,42 +1598,11 @@ def ironing_plane_strain(
     sm = geometries.ironing_extruded(
         thickness=thickness, h_punch=h_punch, h_block=h_block, comm=comm
     )
-    tags = sm.tags
-    E_block, E_punch, nu = 6.896e8, 6.896e9, 0.32
-    if thickness is None:
-        supports = [
-            Dirichlet(tags["block_bottom"], (0.0, 0.0)),
-            Dirichlet(
-                tags["punch_top"], lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0))
-            ),
-        ]
-    else:
-        supports = [
-            Dirichlet(tags["block_bottom"], (0.0, 0.0, 0.0)),
-            Dirichlet(
-                tags["punch_top"],
-                lambda t: (slide * max(t - 1.0, 0.0), -depth * min(t, 1.0), 0.0),
-            ),
-            Dirichlet(tags["plane_faces"], 0.0, component=2),
-        ]
-    return Scene(
-        sm.mesh,
-        sm.cell_tags,
-        sm.facet_tags,
-        bodies=[
-            Body(tags["punch"], NeoHookean(E_punch, nu), "punch"),
-            Body(tags["block"], NeoHookean(E_block, nu), "block"),
-        ],
-        contacts=[
-            ContactPair(
-                tags["punch_contact"],
-                tags["block_contact"],
-                eps_N=E_block / h_block,
-                mu=mu,
-                search_radius=1.0,
-                master_normal=master_normal,
-            )
-        ],
-        dirichlet=supports,
-        tags=tags,
-    )
+    dim = 2 if thickness is None else 3
+    dirichlet = [
+        Dirichlet("block_bottom", (0.0,) * dim),
+        Dirichlet("punch_top", _punch_path(depth, slide, dim)),
+    ]
+    if thickness is not None:
+        dirichlet.append(Dirichlet("plane_faces", 0.0, component=2))
+    return _ironing_scene(sm, mu, h_block, master_normal, dirichlet)
