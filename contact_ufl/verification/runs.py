@@ -42,15 +42,25 @@ __all__ = [
 
 
 def cattaneo_mindlin_run(
-    h: float, mu: float = 0.3, depth: float = 0.005, shift: float = 0.0015, steps: int = 4
+    h: float,
+    mu: float = 0.3,
+    depth: float = 0.005,
+    shift: float = 0.0015,
+    steps: int = 4,
+    refine_radius: float = 0.3,
 ):
     """Hertz loading, then ``steps`` tangential steps; one record per tangential level.
+
+    ``h`` is the element size within ``refine_radius`` of the first point of contact (the
+    contact half-width is about 0.05 here; see :func:`scenes.hertz_2d`).
 
     Returns the records (Q / (mu P), stick-zone half-width measured and exact, its relative
     error, the RMS shear-traction error in |x| < 0.8 a relative to mu p0, Newton
     iterations) and the problem.
     """
-    hertz = scenes.hertz_2d(h_contact=h, depth=depth, mu=mu, shift=shift)
+    hertz = scenes.hertz_2d(
+        h_contact=h, depth=depth, mu=mu, shift=shift, refine_radius=refine_radius
+    )
     problem = ContactProblem(hertz.scene, verbose=False)
     problem.solve(num_steps=4, t_end=1.0)
     levels = []
