@@ -135,6 +135,26 @@ def test_objectivity_under_a_large_rotation():
     ]
 
 
+def test_pressed_from_touching_sticks_on_any_number_of_ranks():
+    """The block of ``scenes.pushed_block`` pressed from touching (g = 0, lambda = 0, no
+    slip: every point on the kink of the bracket and at the centre of a disc of radius 0):
+    every point sticks from the first iterate on, 3 Newton iterations, on this
+    communicator as on one rank. When round-off chose stick or slip there, the first step
+    took 8 iterations on one rank and 32 on two (25 of them cycling)."""
+
+    def pressed(comm):
+        problem = ContactProblem(scenes.pushed_block(push=0.3, comm=comm), verbose=False)
+        problem.solve(num_steps=1, t_end=0.5)
+        c = problem.contacts[0]
+        counts = np.array([c.active().sum(), c.stick().sum()])
+        return problem.history.steps[0].newton_iterations, problem.comm.allreduce(counts)
+
+    its, (active, stick) = pressed(MPI.COMM_WORLD)
+    assert its == 3 and active > 50 and stick == active
+    if MPI.COMM_WORLD.size > 1:
+        assert pressed(MPI.COMM_SELF)[0] == its
+
+
 def test_points_beyond_the_master_surface_are_released():
     """The pushed block slides past the end of the lower block: its overhanging part is not
     in contact (the last master facet is not an infinite line)."""

@@ -48,15 +48,25 @@ from contact_ufl.contact.slave import SlaveSurface
 MasterKinematics = MeshKinematics | ObstacleKinematics
 
 
-def disc_projection(q, radius):
+def disc_projection(q, radius, in_contact=None, round_off=0.0):
     """Projection of the vector ``q`` onto the disc of radius ``radius >= 0``.
 
     A disc of radius 0 (no contact pressure) projects everything to 0, with a zero
     derivative, also at ``q = 0``: an open point has ``lambda_T = 0`` whatever q is.
+
+    ``in_contact`` (a UFL condition: the normal bracket counts as positive) decides, where
+    given, which points may stick, instead of ``radius > 0``; a trial traction within
+    ``round_off`` of the disc sticks. A point that starts touching (``g = 0``, ``lambda = 0``,
+    no slip) has ``q = 0`` and a disc of radius 0, each up to round-off: without the two,
+    round-off alone would choose between stick (tangential stiffness ``eps_T``) and slip
+    (none) for its first iterate, and the Newton path would depend on the number of ranks
+    (the block of ``scenes.pushed_block``: 8 and 32 iterations on 1 and 2 ranks; 3 and 3
+    now). The value changes by at most ``round_off``.
     """
     qq = ufl.dot(q, q)
     safe_norm = ufl.sqrt(qq + ufl.conditional(ufl.eq(qq, 0.0), 1.0, 0.0))
-    stick = ufl.And(ufl.le(qq, radius**2), ufl.gt(radius, 0.0))
+    may_stick = ufl.gt(radius, 0.0) if in_contact is None else in_contact
+    stick = ufl.And(ufl.le(qq, (ufl.max_value(radius, 0.0) + round_off) ** 2), may_stick)
     return ufl.conditional(stick, q, radius / safe_norm * q)
 
 
@@ -70,13 +80,27 @@ class CoulombLaw:
         ``y_n`` with its history, made by its ``slip_reference()``).
     t_N
         The normal contact traction (UFL, from the normal law).
+    in_contact
+        Where the normal law counts the point as in contact (a UFL condition; see
+        :func:`disc_projection`). ``None``: where ``t_N > 0``.
+    touching
+        The normal law's length of round-off: a slip within it of zero counts as stick
+        (a trial traction within ``eps_T touching`` of the disc; :func:`disc_projection`).
     mu
         Friction coefficient (> 0).
     eps_T
         Tangential augmentation parameter (> 0).
     """
 
-    def __init__(self, kinematics: MasterKinematics, t_N, mu: float, eps_T: float):
+    def __init__(
+        self,
+        kinematics: MasterKinematics,
+        t_N,
+        mu: float,
+        eps_T: float,
+        in_contact=None,
+        touching: float = 0.0,
+    ):
         self.kinematics = k = kinematics
         self.slave: SlaveSurface = k.slave
         self.gdim = k.gdim
@@ -103,7 +127,8 @@ class CoulombLaw:
         self.y_n = self.reference.y_n
         self.slip = self.mask_n * tangential(k.x - self.y_n)
         self.q = tangential(self.lambda_T) + self.eps_T * self.slip
-        self.t_T = disc_projection(self.q, self.mu * t_N)
+        self.touching = touching
+        self.t_T = disc_projection(self.q, self.mu * t_N, in_contact, self.eps_T * touching)
 
     @property
     def mask_n(self) -> dolfinx.fem.Function:
@@ -148,15 +173,16 @@ class CoulombLaw:
         gathered from the displacement)."""
         self.reference.update_history(T, x, block_slice)
 
-    def commit(self, x, normal_traction: np.ndarray) -> None:
+    def commit(self, x, normal_traction: np.ndarray, in_contact: np.ndarray | None = None) -> None:
         """Remember the converged projection: the reference of the next step's slip.
 
         The slip reference itself moves only in :meth:`begin_step`, so that until the next
         step starts everything inspected (slip, stick, tractions, contact force) is that of
-        the converged step. ``normal_traction``: ``t_N`` at the owned points.
+        the converged step. ``normal_traction``: ``t_N`` at the owned points; ``in_contact``:
+        the mask of those in contact (see :meth:`stick`).
         """
         self.last_slip = self.slip_at_points()
-        self.last_stick = self.stick(normal_traction)
+        self.last_stick = self.stick(normal_traction, in_contact)
         self.last_weak_slip = self.weak_slip(self.last_stick)
         self.reference.commit(x)
 
@@ -203,11 +229,16 @@ class CoulombLaw:
         q = self.tangential_multiplier_at_points() + float(self.eps_T.value) * self.slip_at_points()
         return q, float(self.mu.value) * normal_traction
 
-    def stick(self, normal_traction: np.ndarray) -> np.ndarray:
+    def stick(
+        self, normal_traction: np.ndarray, in_contact: np.ndarray | None = None
+    ) -> np.ndarray:
         """Mask of the owned slave points in stick (``|q| <= mu t_N``), of those in contact;
-        ``normal_traction``: ``t_N`` at the owned points."""
+        ``normal_traction``: ``t_N`` at the owned points; ``in_contact``: the mask of the
+        points in contact (default: ``t_N > 0``; see :func:`disc_projection`)."""
         q, radius = self._trial_and_radius(normal_traction)
-        return (np.einsum("pd,pd->p", q, q) <= radius**2) & (radius > 0)
+        may_stick = radius > 0 if in_contact is None else in_contact
+        bound = np.maximum(radius, 0.0) + float(self.eps_T.value) * self.touching
+        return (np.einsum("pd,pd->p", q, q) <= bound**2) & may_stick
 
     def traction_at_points(self, normal_traction: np.ndarray) -> np.ndarray:
         """The frictional traction on the slave body at the owned slave points, ``-P(q)``

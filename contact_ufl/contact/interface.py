@@ -162,7 +162,14 @@ class ContactInterface:
         self.t_N = self.normal.traction(self.kinematics.gap, self.kinematics.mask)
         #: the Coulomb law, or ``None`` for a frictionless pair
         self.friction = (
-            CoulombLaw(self.kinematics, self.t_N, pair.mu, pair.eps_T or eps_N)
+            CoulombLaw(
+                self.kinematics,
+                self.t_N,
+                pair.mu,
+                pair.eps_T or eps_N,
+                self.normal.in_contact_condition(self.kinematics.gap, self.kinematics.mask),
+                self.touching,
+            )
             if pair.frictional
             else None
         )
@@ -353,7 +360,7 @@ class ContactInterface:
     def commit(self, x) -> None:
         """Accept the current state as the converged state of a load step."""
         if self.friction:
-            self.friction.commit(x, self.normal.traction_at_points(self.projection))
+            self.friction.commit(x, self.normal_traction_at_points(), self.active())
 
     # -- results ------------------------------------------------------------------------
     @property
@@ -418,7 +425,7 @@ class ContactInterface:
 
     def stick(self) -> np.ndarray:
         """Mask of the owned points in stick (with friction; see :meth:`.CoulombLaw.stick`)."""
-        return self.friction.stick(self.normal_traction_at_points())
+        return self.friction.stick(self.normal_traction_at_points(), self.active())
 
 
 #: What contact supports: (displacement degree, geometry degree) of a body's mesh.

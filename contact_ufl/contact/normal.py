@@ -68,6 +68,12 @@ class NormalLaw:
         """The normal contact traction ``t_N = <lambda_N + eps_N g>`` (0 where ``mask`` is 0)."""
         return mask * macaulay(self.lambda_N + self.eps_N * gap, self.eps_N * self.closing)
 
+    def in_contact_condition(self, gap: ufl.core.expr.Expr, mask: ufl.core.expr.Expr):
+        """Where the bracket of :meth:`traction` counts as positive (a UFL condition; the
+        forms' twin of :meth:`in_contact`)."""
+        argument = self.lambda_N + self.eps_N * gap
+        return ufl.And(ufl.gt(mask, 0.5), ufl.gt(argument, -self.eps_N * self.closing))
+
     def residual(self, t_N: ufl.core.expr.Expr) -> ufl.Form:
         """The multiplier equation, times ``eps_N``: its rows are forces like those of the
         displacement (one tolerance for all, and conditioning)."""
