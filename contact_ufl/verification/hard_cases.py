@@ -1,10 +1,10 @@
 """The hard-case suite (issue 13, item 7): runs that test the numerical stability of the
 solver, each reported by its steps, cut-backs, Newton iterations and, where a step failed,
 why (the SNES reasons and diagnoses of the failed tries: inverted elements, active-set
-cycling, a limit point; at the failed state the inverted elements, the contact points in
-contact and those whose status differs from the last accepted step). A case meant to stop
-(load control beyond a limit point) names the diagnosis it should stop with: its stop is
-recorded as ``"expected stop"``, not as a failure.
+cycling, a limit point; at the failed state the inverted elements and the contact points
+in contact; along the try the contact-status changes between Newton iterates). A case
+meant to stop (load control beyond a limit point) names the diagnosis it should stop with:
+its stop is recorded as ``"expected stop"``, not as a failure.
 
 :func:`cases` lists the cases (quick or full), :func:`run_case` runs one and returns its
 record (a ``dict`` ready for JSON); ``benchmarks/hard_cases.py`` runs them all.
@@ -14,9 +14,11 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.control import VolumeControl
@@ -257,40 +259,61 @@ def cases(quick: bool = False) -> list[Case]:
 
 class _FailureObserver:
     """Records the failed tries of a problem's Newton solver: pseudo-times, SNES reason,
-    iterations, inverted cells, points in contact and points whose contact status differs
-    from the last accepted step, at the failed state: the last iterate of the solver's last
-    try (with the backtracking line search where the full-step Newton failed), which the
-    solver leaves in the fields until the stepper restores the step's start.
+    iterations, inverted cells and points in contact at the failed state (the last iterate
+    of the solver's last try, which the solver leaves in the fields until the stepper
+    restores the step's start), and the contact-status changes along the way: points whose
+    status (open, in contact; with friction stick or slip) differs between consecutive
+    Newton iterates, summed over the iterates of every Newton solve of the try (full-step,
+    predicted, line-search and closing solves; not from the end of one to the start of
+    the next).
 
-    Wraps the solver's ``solve_step``; :meth:`accepted` is the stepping callback that keeps
-    the contact status of the accepted steps.
+    Wraps the solver's ``solve_step`` and adds a monitor to its SNES (held weakly, as the
+    solver's own callbacks are).
     """
 
     def __init__(self, problem: ContactProblem):
         self.problem = problem
         self.failures: list[dict] = []
-        self._accepted_active: list | None = None
+        self._changes = 0  # this rank's status changes between iterates of the current try
+        self._previous: list[np.ndarray] | None = None  # the status at the last iterate
         self._solve_step = problem.solver.solve_step
         problem.solver.solve_step = self._observed
+        monitor = weakref.WeakMethod(self._monitor)
 
-    def accepted(self, problem: ContactProblem, record: object) -> None:
-        self._accepted_active = [c.active().copy() for c in problem.contacts]
+        def call(*args) -> None:
+            if (method := monitor()) is not None:
+                method(*args)
 
-    def _status_changes(self) -> int | None:
-        """Points (all ranks) whose contact status differs from the last accepted step
-        (``None`` before the first accepted step)."""
-        if self._accepted_active is None:
-            return None
-        contacts = self.problem.contacts
-        changed = sum(
-            int((c.active() != a).sum())
-            for c, a in zip(contacts, self._accepted_active, strict=True)
-        )
-        return self.problem.comm.allreduce(changed)
+        problem.solver.snes.setMonitor(call)
+
+    def _status(self) -> list[np.ndarray]:
+        """Each pair's status at its owned slave points: 0 open, 1 in contact (in slip,
+        with friction), 2 in stick."""
+        status = []
+        for c in self.problem.contacts:
+            if c.projection is None:
+                status.append(np.zeros(0, dtype=np.int8))
+                continue
+            active = c.active().astype(np.int8)
+            status.append(active * (1 + c.stick()) if c.friction else active)
+        return status
+
+    def _monitor(self, snes, its: int, norm: float) -> None:
+        """At each Newton iterate: count the points whose status changed since the last
+        iterate of the same solve (``its == 0`` starts a solve)."""
+        status = self._status()
+        if its > 0 and self._previous is not None:
+            self._changes += sum(
+                int(np.count_nonzero(a != b))
+                for a, b in zip(status, self._previous, strict=True)
+                if a.shape == b.shape
+            )
+        self._previous = status
 
     def _observed(self, t: float) -> tuple[bool, int, str]:
         problem = self.problem
         t_start = problem.t
+        self._changes, self._previous = 0, None
         ok, its, reason = self._solve_step(t)
         if not ok:
             self.failures.append(
@@ -301,7 +324,7 @@ class _FailureObserver:
                     "newton_iterations": its,
                     "inverted_cells": inverted_cells(problem),
                     "active_points": problem.active_points(),
-                    "status_changes": self._status_changes(),
+                    "status_changes": problem.comm.allreduce(self._changes),
                     "why": problem.solver.diagnose(),
                 }
             )
@@ -324,7 +347,8 @@ def run_case(case: Case) -> dict:
         SNES reason), ``step_reasons`` (the distinct reasons of the accepted steps),
         ``failures`` (one record per failed try: ``from_time``, ``time``, ``reason``, ``why``,
         ``newton_iterations``, ``inverted_cells``, ``active_points``, ``status_changes``:
-        the points whose contact status differs from the last accepted step), ``error`` (the
+        the contact-status changes of points between consecutive Newton iterates of the
+        try, see :class:`_FailureObserver`), ``error`` (the
         message of the :class:`ConvergenceError`, or ``None``), ``unknowns``, ``wall_s``.
     """
     start = time.perf_counter()
@@ -337,7 +361,6 @@ def run_case(case: Case) -> dict:
                 num_steps=num_steps,
                 t_end=t_end,
                 max_cutbacks=case.max_cutbacks,
-                callback=observer.accepted,
             )
     except ConvergenceError as e:
         error = str(e)
