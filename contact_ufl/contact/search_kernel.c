@@ -11,19 +11,41 @@
  *
  * Tree layout: nodes in preorder; node i is a leaf when a[i] < 0 (its facets are
  * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query reads
- * the packed rows of bvh_refit: (lo_0 .. lo_g-1, hi_0 .. hi_g-1, a, b), one cache line in 3D.
+ * the rows of bvh_refit (node_t, one 64-byte cache line): the boxes of both children of an
+ * internal node in single precision, rounded outwards (a box holding the exact one: the
+ * pruning is as safe, the closest points are the same), and the children as codes (a node
+ * index, or -1 - (8 start + count) for a leaf), so that a step of the walk reads one line.
+ * Row m holds the root's box and code as its first child.
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 typedef long long i64;
 
+typedef struct {
+    float box[2][6]; /* per child: lo_0 .. lo_g-1, hi_0 .. hi_g-1 */
+    i64 child[2];    /* node index, or -1 - (8 start + count) for a leaf */
+} node_t;
+
+/* the rows of a tree buffer of at least (m + 1) sizeof(node_t) + 64 bytes, 64-byte aligned */
+static node_t *rows(const void *buffer)
+{
+    return (node_t *)(((uintptr_t)buffer + 63) & ~(uintptr_t)63);
+}
+
 #define LEAF 4
 #define NEWTON_ITERATIONS 25
 #define NEWTON_TOL 1e-13
 #define STACK 512
+#define AHEAD 16 /* facets ahead whose nodes the refit prefetches */
 #define INLINE static inline __attribute__((always_inline))
+#if defined(__GNUC__) || defined(__clang__)
+#define PREFETCH(address) __builtin_prefetch(address)
+#else
+#define PREFETCH(address) ((void)0)
+#endif
 
 /* -- build ------------------------------------------------------------------------------ */
 
@@ -89,15 +111,49 @@ i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b)
     return count;
 }
 
-INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                    const i64 *a, const i64 *b, double *tree, double *leaf_nodes)
+INLINE float down(double v)
 {
-    int W = 2 * g + 2;
-    double r2max = 0.0;
-    for (i64 j = 0; j < n; j++) {
-        const double *X = nodes + perm[j] * nn * g;
-        double *Y = leaf_nodes + j * nn * g, c[3];
-        for (int q = 0; q < nn * g; q++) Y[q] = X[q];
+    /* the largest float not above v */
+    float f = (float)v;
+    return (double)f > v ? nextafterf(f, -INFINITY) : f;
+}
+
+INLINE float up(double v)
+{
+    float f = (float)v;
+    return (double)f < v ? nextafterf(f, INFINITY) : f;
+}
+
+typedef struct {
+    int g, nn;
+    i64 n;
+    const double *nodes; /* (n, nn, g) as given */
+    const i64 *perm, *a, *b;
+    double *leaf_nodes; /* (n, nn, g) in the order of perm */
+    node_t *T;
+    double r2max, finite;
+} fit_t;
+
+/* The facets of a leaf copied in the order of perm, their box (lo, hi), and the largest
+ * facet radius and finiteness so far updated. */
+INLINE void fit_leaf(fit_t *F, i64 i, double *box)
+{
+    const int g = F->g, nn = F->nn, w = nn * g;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double r2max = F->r2max, zero = 0.0;
+    i64 start = -F->a[i] - 1;
+    for (i64 j = start; j < start + F->b[i]; j++) {
+        const double *X = F->nodes + F->perm[j] * w;
+        double *Y = F->leaf_nodes + j * w, c[3];
+        for (int q = 0; q < w; q++) {
+            Y[q] = X[q];
+            zero += 0.0 * X[q]; /* stays 0 unless a coordinate is NaN or infinite */
+        }
+        if (j + AHEAD < F->n) { /* the nodes of a facet a few leaves on: the gather's latency hidden */
+            const double *next = F->nodes + F->perm[j + AHEAD] * w;
+            PREFETCH(next);
+            PREFETCH(next + w - 1);
+        }
         for (int k = 0; k < g; k++) {
             double s = X[k];
             for (int q = 1; q < nn; q++) s += X[q * g + k];
@@ -106,49 +162,72 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
         for (int q = 0; q < nn; q++) {
             double d2 = 0.0;
             for (int k = 0; k < g; k++) {
-                double d = X[q * g + k] - c[k];
+                double v = X[q * g + k], d = v - c[k];
                 d2 += d * d;
+                lo[k] = v < lo[k] ? v : lo[k];
+                hi[k] = v > hi[k] ? v : hi[k];
             }
-            if (d2 > r2max) r2max = d2;
+            r2max = d2 > r2max ? d2 : r2max;
         }
     }
-    for (i64 i = m - 1; i >= 0; i--) {
-        double *B = tree + i * W;
-        for (int k = 0; k < g; k++) {
-            B[k] = INFINITY;
-            B[g + k] = -INFINITY;
-        }
-        B[2 * g] = (double)a[i];
-        B[2 * g + 1] = (double)b[i];
-        if (a[i] < 0) {
-            i64 start = -a[i] - 1;
-            for (i64 j = start; j < start + b[i]; j++) {
-                const double *X = leaf_nodes + j * nn * g;
-                for (int q = 0; q < nn; q++)
-                    for (int k = 0; k < g; k++) {
-                        double v = X[q * g + k];
-                        if (v < B[k]) B[k] = v;
-                        if (v > B[g + k]) B[g + k] = v;
-                    }
-            }
-        } else {
-            const double *L = tree + a[i] * W, *R = tree + b[i] * W;
-            for (int k = 0; k < g; k++) {
-                B[k] = L[k] < R[k] ? L[k] : R[k];
-                B[g + k] = L[g + k] > R[g + k] ? L[g + k] : R[g + k];
-            }
-        }
+    F->r2max = r2max;
+    F->finite += zero;
+    for (int k = 0; k < g; k++) {
+        box[k] = lo[k];
+        box[g + k] = hi[k];
     }
-    return sqrt(r2max);
 }
 
-/* The tree over the current nodes (n, nn, g) of the facets: tree (m, 2 g + 2) holds per tree
- * node its box (lo_0 .. lo_g-1, hi_0 .. hi_g-1; every facet point lies in the convex hull of
- * its nodes) and a, b as doubles; leaf_nodes (n, nn, g) the nodes in the order of perm (the
- * facets of a leaf contiguous). Returns the largest facet radius (node distance from the
- * mean of the nodes), or -1 for an unknown facet kind. */
+/* The box (lo, hi) of node i; the rows of its subtree written, its leaves fitted. */
+static void fit(fit_t *F, i64 i, double *box)
+{
+    if (F->a[i] < 0) {
+        fit_leaf(F, i, box);
+        return;
+    }
+    const int g = F->g;
+    const i64 child[2] = {F->a[i], F->b[i]};
+    double B[2][6];
+    fit(F, child[0], B[0]);
+    fit(F, child[1], B[1]);
+    node_t *N = F->T + i;
+    for (int c = 0; c < 2; c++) {
+        for (int k = 0; k < g; k++) {
+            N->box[c][k] = down(B[c][k]);
+            N->box[c][g + k] = up(B[c][g + k]);
+        }
+        i64 ac = F->a[child[c]];
+        N->child[c] = ac < 0 ? -1 - (8 * (-ac - 1) + F->b[child[c]]) : child[c];
+    }
+    for (int k = 0; k < g; k++) {
+        box[k] = B[0][k] < B[1][k] ? B[0][k] : B[1][k];
+        box[g + k] = B[0][g + k] > B[1][g + k] ? B[0][g + k] : B[1][g + k];
+    }
+}
+
+INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
+                    const i64 *a, const i64 *b, void *tree, double *leaf_nodes)
+{
+    fit_t F = {g, nn, n, nodes, perm, a, b, leaf_nodes, rows(tree), 0.0, 0.0};
+    if (m > 0) {
+        double B[6];
+        fit(&F, 0, B);
+        for (int k = 0; k < g; k++) {
+            F.T[m].box[0][k] = down(B[k]);
+            F.T[m].box[0][g + k] = up(B[g + k]);
+        }
+        F.T[m].child[0] = a[0] < 0 ? -1 - (8 * (-a[0] - 1) + b[0]) : 0;
+    }
+    return F.finite == 0.0 ? sqrt(F.r2max) : -2.0;
+}
+
+/* The tree over the current nodes (n, nn, g) of the facets: tree (a buffer of (m + 1)
+ * sizeof(node_t) + 64 bytes) gets the rows of the walk (every facet point lies in the box of
+ * its nodes' convex hull); leaf_nodes (n, nn, g) the nodes in the order of perm (the facets
+ * of a leaf contiguous). Returns the largest facet radius (node distance from the mean of
+ * the nodes), -1 for an unknown facet kind, -2 if a coordinate is not finite. */
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, double *tree, double *leaf_nodes)
+                 const i64 *a, const i64 *b, void *tree, double *leaf_nodes)
 {
     if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaf_nodes);
     if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaf_nodes);
@@ -156,15 +235,81 @@ double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64
     return -1.0;
 }
 
-/* Whether the nodes (n, nn, g) are those of the last bvh_refit (leaf_nodes, in the order of
- * perm), to the last bit (stops at the first difference). */
-int same_nodes(i64 n, int width, const double *nodes, const i64 *perm,
-               const double *leaf_nodes)
+/* Whether two arrays of len values are equal to the last bit (memcmp: one sequential sweep,
+ * stopped at the first difference). */
+int same_values(i64 len, const double *p, const double *q)
 {
-    for (i64 j = 0; j < n; j++)
-        if (memcmp(nodes + perm[j] * width, leaf_nodes + j * width, width * sizeof(double)))
-            return 0;
-    return 1;
+    return memcmp(p, q, (size_t)len * sizeof(double)) == 0;
+}
+
+/* -- the order of the points: a Z-order (Morton) curve ----------------------------------- */
+
+INLINE unsigned long long spread_bits(unsigned long long v, int g)
+{
+    /* the 10 low bits of v to every g-th bit (bit i to bit g i) */
+    unsigned long long out = 0;
+    for (int i = 0; i < 10; i++) out |= ((v >> i) & 1ULL) << (g * i);
+    return out;
+}
+
+/* An order (n) of the points x (n, g) along a Z-order curve through the cells of a 1024^g
+ * grid over their bounding box (the cell of a coordinate: min((x - lo) 1024 / span, 1023)
+ * with span the box's largest side): the points of a cell, then of its neighbours, come one
+ * after the other. A radix sort of the keys (stable: equal keys in the given order); the
+ * identity if the span is not positive and finite. Returns 0, or -1 when out of memory. */
+int morton_order(int g, i64 n, const double *x, i64 *order)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (i64 i = 0; i < n; i++)
+        for (int k = 0; k < g; k++) {
+            double v = x[i * g + k];
+            if (v < lo[k]) lo[k] = v;
+            if (v > hi[k]) hi[k] = v;
+        }
+    double span = 0.0;
+    for (int k = 0; k < g; k++)
+        if (hi[k] - lo[k] > span) span = hi[k] - lo[k];
+    for (i64 i = 0; i < n; i++) order[i] = i;
+    if (!(span > 0.0 && span < INFINITY)) return 0;
+    unsigned *key = malloc(2 * n * sizeof(unsigned));
+    i64 *other = malloc(n * sizeof(i64));
+    if (!key || !other) {
+        free(key);
+        free(other);
+        return -1;
+    }
+    for (i64 i = 0; i < n; i++) {
+        unsigned k3 = 0;
+        for (int k = 0; k < g; k++) {
+            double c = (x[i * g + k] - lo[k]) * (1024.0 / span);
+            unsigned long long cell = c < 1023.0 ? (unsigned long long)c : 1023ULL;
+            k3 |= (unsigned)(spread_bits(cell, g) << k);
+        }
+        key[i] = k3;
+    }
+    /* least significant digit first, 10 bits a pass, over the 10 g bits of the keys */
+    unsigned *kin = key, *kout = key + n;
+    i64 *oin = order, *oout = other;
+    for (int shift = 0; shift < 10 * g; shift += 10) {
+        i64 start[1025] = {0};
+        for (i64 i = 0; i < n; i++) start[((kin[i] >> shift) & 1023) + 1]++;
+        for (int d = 0; d < 1024; d++) start[d + 1] += start[d];
+        for (i64 i = 0; i < n; i++) {
+            i64 at = start[(kin[i] >> shift) & 1023]++;
+            kout[at] = kin[i];
+            oout[at] = oin[i];
+        }
+        unsigned *kt = kin;
+        kin = kout;
+        kout = kt;
+        i64 *ot = oin;
+        oin = oout;
+        oout = ot;
+    }
+    if (oin != order) memcpy(order, oin, n * sizeof(i64));
+    free(key);
+    free(other);
+    return 0;
 }
 
 /* The largest coordinate change between two node arrays of len values. */
@@ -409,6 +554,19 @@ INLINE double box_distance2(int g, const double *B, const double *x)
     return s;
 }
 
+INLINE double box_distance2f(int g, const float *B, const double *x)
+{
+    /* box_distance2 of a single-precision box (its bounds exact in double) */
+    double s = 0.0;
+    for (int k = 0; k < g; k++) {
+        double lo = (double)B[k] - x[k], hi = x[k] - (double)B[g + k];
+        double d = lo > hi ? lo : hi;
+        d = d > 0.0 ? d : 0.0;
+        s += d * d;
+    }
+    return s;
+}
+
 /* the distance below which a facet may tie with the closest one at distance v (wider than
  * the tie tolerance 1e-10 (v + 2 R_f) of projection._select) */
 INLINE double reach(double v, double rmax) { return v + 1e-9 * (v + 2.0 * rmax); }
@@ -533,14 +691,15 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
  * fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
  * Returns the number of exact projections made, or -1 when out of memory. */
 INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const double *tree, double rmax, i64 npts,
+              const void *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
               double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
               double *oxi, double *y, double *normal, double *gap, double *distance,
               double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
               const i64 *fnodes, const double *axis)
 {
-    int fdim = g - 1, W = 2 * g + 2;
+    int fdim = g - 1;
+    const node_t *T = rows(tree);
     i64 room = 64, projected = 0;
     hit_t *hits = malloc(room * sizeof(hit_t));
     if (!hits) return -1;
@@ -553,39 +712,39 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
         i64 nh = 0, top = 0;
         count[p] = 0;
         if (m == 0) continue;
-        double d0 = box_distance2(g, tree, xp);
+        double d0 = box_distance2f(g, T[m].box[0], xp);
         if (d0 <= bound2) {
-            stack[0] = 0;
+            stack[0] = T[m].child[0];
             lower[0] = d0;
             top = 1;
         }
         while (top > 0) {
             top--;
-            i64 i = stack[top];
+            i64 code = stack[top];
             if (lower[top] > bound2) continue;
-            const double *T = tree + i * W;
-            i64 ai = (i64)T[2 * g], bi = (i64)T[2 * g + 1];
-            if (ai >= 0) {
-                double dl = box_distance2(g, tree + ai * W, xp);
-                double dr = box_distance2(g, tree + bi * W, xp);
-                i64 near = dl <= dr ? ai : bi, far = dl <= dr ? bi : ai;
-                double dfar = dl <= dr ? dr : dl, dnear = dl <= dr ? dl : dr;
+            if (code >= 0) {
+                const node_t *N = T + code;
+                double dl = box_distance2f(g, N->box[0], xp);
+                double dr = box_distance2f(g, N->box[1], xp);
+                int near = dl <= dr ? 0 : 1;
+                double dnear = near ? dr : dl, dfar = near ? dl : dr;
                 if (top + 2 > STACK) {
                     free(hits);
                     return -1;
                 }
                 if (dfar <= bound2) {
-                    stack[top] = far;
+                    stack[top] = N->child[1 - near];
                     lower[top++] = dfar;
                 }
                 if (dnear <= bound2) {
-                    stack[top] = near;
+                    stack[top] = N->child[near];
                     lower[top++] = dnear;
                 }
                 continue;
             }
-            i64 start = -ai - 1;
-            for (i64 j = start; j < start + bi; j++) {
+            i64 start = (-code - 1) >> 3, end = start + ((-code - 1) & 7);
+            PREFETCH(perm + start);
+            for (i64 j = start; j < end; j++) {
                 const double *X = leaf_nodes + j * nn * g;
                 {  /* the facet's box before its exact projection */
                     double B[6];
@@ -676,7 +835,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
 }
 
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const double *tree, double rmax, i64 npts,
+              const void *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
               double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
               double *oxi, double *y, double *normal, double *gap, double *distance,
