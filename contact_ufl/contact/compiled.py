@@ -11,7 +11,9 @@ any collective call: each compiles into a file of its own and renames it atomica
 cached name (the last rename wins; every candidate is a complete library of the same source),
 so no process ever loads a half-written file. A process that builds a library removes the
 libraries of other source hashes (and leftover temporary files) last changed over a day ago
-(:func:`remove_stale`: none of them is being built or loaded by then).
+(:func:`remove_stale`; loading a library sets its time of change, so a library loaded within
+the day is kept, and a process that finds its library removed between its check and its
+load builds it again).
 
 The compiler is ``$CC`` if set, else the one Python was built with, else ``cc``; the flags
 ``-O2 -fPIC -shared -ffp-contract=off -fno-fast-math`` (no fused multiply-add: the kernels
@@ -163,8 +165,19 @@ def kernel() -> tuple[cffi.FFI, object]:
                 remove_stale(library)
             ffi = cffi.FFI()
             ffi.cdef(CDEF)
-            _loaded = (ffi, ffi.dlopen(str(library)))
+            _loaded = (ffi, _open(ffi, library, compiler))
         return _loaded
+
+
+def _open(ffi: cffi.FFI, library: Path, compiler: list[str]) -> object:
+    """The loaded ``library``, its time of change set to now (a library in use is never
+    stale: :func:`remove_stale`); built again if it was removed meanwhile."""
+    try:
+        os.utime(library)
+        return ffi.dlopen(str(library))
+    except OSError:
+        _build(library, compiler)
+        return ffi.dlopen(str(library))
 
 
 def require(comm: MPI.Comm) -> None:

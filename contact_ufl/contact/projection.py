@@ -391,6 +391,7 @@ def _by_direction(
     radius: float,
     rule: SelfContact,
     out: Projection,
+    trees: TreeCache,
 ) -> None:
     """Self-contact search by normal bins: the points of a bin are searched against the
     facets of the bins that may face them only.
@@ -402,6 +403,8 @@ def _by_direction(
     such bins are inadmissible for those points and skipped (the facets around a point on its
     own side, which otherwise fill every query up to the partner across the gap). The
     admissible pairs are all kept (facets in their given order): the same closest points.
+    The search trees of each point bin are kept in ``trees`` (its part of that bin) for the
+    next call.
     """
     g = points.shape[1]
     X = [[np.ascontiguousarray(nodes[:, a, k]) for k in range(g)] for a in range(nodes.shape[1])]
@@ -418,7 +421,7 @@ def _by_direction(
             continue
         part = Projection(*(getattr(out, k)[p] for k in _FIELDS))
         sub = SelfContact(rule.point_nodes[p], rule.facet_nodes[f], rule.point_normals[p])
-        _search(points[p], nodes[f], radius, TreeCache(), sub, part)
+        _search(points[p], nodes[f], radius, trees.part(("bin", int(A))), sub, part)
         part.facet[part.facet >= 0] = f[part.facet[part.facet >= 0]]
         for k in _FIELDS:
             getattr(out, k)[p] = getattr(part, k)
@@ -981,7 +984,15 @@ class TreeCache:
     """
 
     def __init__(self) -> None:
-        self.entries: OrderedDict[tuple, tuple[FloatArray, cKDTree | _Hierarchy]] = OrderedDict()
+        self.entries: OrderedDict[tuple, tuple[FloatArray | None, cKDTree | _Hierarchy]] = (
+            OrderedDict()
+        )
+        #: the caches of the parts of a search (a self-contact search's normal bins)
+        self.parts: dict[object, TreeCache] = {}
+
+    def part(self, key: object) -> TreeCache:
+        """The cache of the part ``key`` of a search (made on first use)."""
+        return self.parts.setdefault(key, TreeCache())
 
     def tree(
         self, nodes: FloatArray, centroid: FloatArray, R_max: float, level: int = 0
@@ -1507,7 +1518,7 @@ def closest_points(
     if self_contact is not None:
         _check_self_contact(self_contact, npts, nf, gdim)
         if nf > _DIRECTIONS_MIN:
-            _by_direction(points, nodes, radius, self_contact, out)
+            _by_direction(points, nodes, radius, self_contact, out, trees)
             return out
     _search(points, nodes, radius, trees, self_contact, out)
     return out

@@ -567,6 +567,20 @@ INLINE double box_distance2f(int g, const float *B, const double *x)
     return s;
 }
 
+/* Start loading what the walk reads of a child (code as in node_t): its row, or the nodes
+ * of the leaf's first facets. */
+INLINE void prefetch_child(const node_t *T, const double *leaf_nodes, int w, i64 code)
+{
+    if (code >= 0) {
+        PREFETCH(T + code);
+    } else {
+        const double *X = leaf_nodes + ((-code - 1) >> 3) * w;
+        PREFETCH(X);
+        PREFETCH(X + 8);
+        PREFETCH(X + 16);
+    }
+}
+
 /* the distance below which a facet may tie with the closest one at distance v (wider than
  * the tie tolerance 1e-10 (v + 2 R_f) of projection._select) */
 INLINE double reach(double v, double rmax) { return v + 1e-9 * (v + 2.0 * rmax); }
@@ -735,10 +749,12 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                 if (dfar <= bound2) {
                     stack[top] = N->child[1 - near];
                     lower[top++] = dfar;
+                    prefetch_child(T, leaf_nodes, nn * g, N->child[1 - near]);
                 }
                 if (dnear <= bound2) {
                     stack[top] = N->child[near];
                     lower[top++] = dnear;
+                    prefetch_child(T, leaf_nodes, nn * g, N->child[near]);
                 }
                 continue;
             }
