@@ -553,8 +553,8 @@ class _Hierarchy:
         self.b = np.empty(nf + 2, dtype=np.int64)
         p = self._pointers
         self.m = int(self.lib.bvh_build(self.gdim, nf, *p(centroid, self.perm, self.a, self.b)))
-        # the rows of the walk: 64 bytes a tree node, one more, 64 bytes to align them
-        self.tree = np.empty((self.m + 2) * 64, dtype=np.uint8)
+        # the rows of the walk: 128 bytes a tree node at most, one more, 128 to align them
+        self.tree = np.empty((self.m + 2) * 128, dtype=np.uint8)
         self.leaf_nodes = np.empty_like(nodes)
         self.fitted_nodes = np.empty_like(nodes)  # the nodes of the last refit, as given
         self.is_fitted = False

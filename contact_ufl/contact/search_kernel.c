@@ -10,12 +10,14 @@
  * are those of the NumPy kernels to the last bit.
  *
  * Tree layout: nodes in preorder; node i is a leaf when a[i] < 0 (its facets are
- * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query reads
- * the rows of bvh_refit (node_t, one 64-byte cache line): the boxes of both children of an
- * internal node in single precision, rounded outwards (a box holding the exact one: the
- * pruning is as safe, the closest points are the same), and the children as codes (a node
- * index, or -1 - (8 start + count) for a leaf), so that a step of the walk reads one line.
- * Row m holds the root's box and code as its first child.
+ * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query walks
+ * the rows of bvh_refit (node_t, two 64-byte cache lines), a tree of four children a node:
+ * the row of an internal node holds the boxes of its children's children (of a child that is
+ * a leaf, that leaf), in single precision rounded outwards (a box holding the exact one: the
+ * pruning is as safe, the closest points are the same), and their codes (a row index, or
+ * -1 - (8 start + count) for a leaf, EMPTY for an unused slot), so that two levels of the
+ * binary tree cost one row. The rows are in preorder; row m holds the root's box and code
+ * as its first child.
  */
 #include <math.h>
 #include <stdint.h>
@@ -24,15 +26,19 @@
 
 typedef long long i64;
 
+#define WIDE 4
+#define EMPTY ((i64)1 << 62) /* the code of an unused slot of a row */
+
 typedef struct {
-    float box[2][6]; /* per child: lo_0 .. lo_g-1, hi_0 .. hi_g-1 */
-    i64 child[2];    /* node index, or -1 - (8 start + count) for a leaf */
+    float box[WIDE][6]; /* per child: lo_0 .. lo_g-1, hi_0 .. hi_g-1 */
+    i64 child[WIDE];    /* row index, leaf code -1 - (8 start + count), or EMPTY */
 } node_t;
 
-/* the rows of a tree buffer of at least (m + 1) sizeof(node_t) + 64 bytes, 64-byte aligned */
+/* the rows of a tree buffer of at least (m + 1) sizeof(node_t) + 128 bytes, 128-byte
+ * aligned (a row in two cache lines that are loaded together) */
 static node_t *rows(const void *buffer)
 {
-    return (node_t *)(((uintptr_t)buffer + 63) & ~(uintptr_t)63);
+    return (node_t *)(((uintptr_t)buffer + 127) & ~(uintptr_t)127);
 }
 
 #define LEAF 4
@@ -131,6 +137,7 @@ typedef struct {
     const i64 *perm, *a, *b;
     double *leaf_nodes; /* (n, nn, g) in the order of perm */
     node_t *T;
+    i64 used; /* rows written */
     double r2max, finite;
 } fit_t;
 
@@ -178,51 +185,76 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box)
     }
 }
 
-/* The box (lo, hi) of node i; the rows of its subtree written, its leaves fitted. */
-static void fit(fit_t *F, i64 i, double *box)
+INLINE i64 leaf_code(const fit_t *F, i64 i) { return -1 - (8 * (-F->a[i] - 1) + F->b[i]); }
+
+INLINE void store_box(node_t *N, int slot, int g, const double *B)
 {
+    for (int k = 0; k < g; k++) {
+        N->box[slot][k] = down(B[k]);
+        N->box[slot][g + k] = up(B[g + k]);
+    }
+}
+
+/* The box (lo, hi) of binary node i and its code (leaf code, or the row written for it, its
+ * subtree's rows after it). */
+static i64 fit(fit_t *F, i64 i, double *box)
+{
+    const int g = F->g;
     if (F->a[i] < 0) {
         fit_leaf(F, i, box);
-        return;
+        return leaf_code(F, i);
     }
-    const int g = F->g;
-    const i64 child[2] = {F->a[i], F->b[i]};
-    double B[2][6];
-    fit(F, child[0], B[0]);
-    fit(F, child[1], B[1]);
-    node_t *N = F->T + i;
+    i64 row = F->used++, grand[WIDE];
+    int slots = 0;
     for (int c = 0; c < 2; c++) {
-        for (int k = 0; k < g; k++) {
-            N->box[c][k] = down(B[c][k]);
-            N->box[c][g + k] = up(B[c][g + k]);
+        i64 child = c ? F->b[i] : F->a[i];
+        if (F->a[child] < 0) {
+            grand[slots++] = child;
+        } else {
+            grand[slots++] = F->a[child];
+            grand[slots++] = F->b[child];
         }
-        i64 ac = F->a[child[c]];
-        N->child[c] = ac < 0 ? -1 - (8 * (-ac - 1) + F->b[child[c]]) : child[c];
     }
+    double B[WIDE][6];
+    i64 code[WIDE];
+    for (int c = 0; c < slots; c++) code[c] = fit(F, grand[c], B[c]);
+    node_t *N = F->T + row;
     for (int k = 0; k < g; k++) {
-        box[k] = B[0][k] < B[1][k] ? B[0][k] : B[1][k];
-        box[g + k] = B[0][g + k] > B[1][g + k] ? B[0][g + k] : B[1][g + k];
+        box[k] = INFINITY;
+        box[g + k] = -INFINITY;
     }
+    for (int c = 0; c < WIDE; c++) {
+        if (c >= slots) {
+            N->child[c] = EMPTY;
+            continue;
+        }
+        store_box(N, c, g, B[c]);
+        N->child[c] = code[c];
+        for (int k = 0; k < g; k++) {
+            box[k] = B[c][k] < box[k] ? B[c][k] : box[k];
+            box[g + k] = B[c][g + k] > box[g + k] ? B[c][g + k] : box[g + k];
+        }
+    }
+    return row;
 }
 
 INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
                     const i64 *a, const i64 *b, void *tree, double *leaf_nodes)
 {
-    fit_t F = {g, nn, n, nodes, perm, a, b, leaf_nodes, rows(tree), 0.0, 0.0};
+    fit_t F = {g, nn, n, nodes, perm, a, b, leaf_nodes, rows(tree), 0, 0.0, 0.0};
     if (m > 0) {
         double B[6];
-        fit(&F, 0, B);
-        for (int k = 0; k < g; k++) {
-            F.T[m].box[0][k] = down(B[k]);
-            F.T[m].box[0][g + k] = up(B[g + k]);
-        }
-        F.T[m].child[0] = a[0] < 0 ? -1 - (8 * (-a[0] - 1) + b[0]) : 0;
+        i64 code = fit(&F, 0, B);
+        node_t *R = F.T + m;
+        store_box(R, 0, g, B);
+        R->child[0] = code;
+        for (int c = 1; c < WIDE; c++) R->child[c] = EMPTY;
     }
     return F.finite == 0.0 ? sqrt(F.r2max) : -2.0;
 }
 
 /* The tree over the current nodes (n, nn, g) of the facets: tree (a buffer of (m + 1)
- * sizeof(node_t) + 64 bytes) gets the rows of the walk (every facet point lies in the box of
+ * sizeof(node_t) + 128 bytes) gets the rows of the walk (every facet point lies in the box of
  * its nodes' convex hull); leaf_nodes (n, nn, g) the nodes in the order of perm (the facets
  * of a leaf contiguous). Returns the largest facet radius (node distance from the mean of
  * the nodes), -1 for an unknown facet kind, -2 if a coordinate is not finite. */
@@ -573,6 +605,7 @@ INLINE void prefetch_child(const node_t *T, const double *leaf_nodes, int w, i64
 {
     if (code >= 0) {
         PREFETCH(T + code);
+        PREFETCH((const char *)(T + code) + 64);
     } else {
         const double *X = leaf_nodes + ((-code - 1) >> 3) * w;
         PREFETCH(X);
@@ -694,13 +727,14 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
     return s < 0.0;
 }
 
-/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose exact distance is within reach() of the
- * smallest one, if that smallest one is within reach(radius). count[p] is their number; up
- * to cap of them are written at p * cap of f, xi (fdim per pair), dist, edge, vertex
- * (projection._Pairs). Where one facet is within that reach (count 1) and y is not NULL,
- * the fields of its closest point are written at index[p] (p if index is NULL) of facet,
- * oxi, y, normal, gap, distance and sliding (a projection.Projection; count set to 0 and
- * the placeholders written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible facets, with
+/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose
+ * exact distance is within reach() of the smallest one, if that smallest one is within
+ * reach(radius). count[p] is their number; up to cap of them are written at p * cap of f,
+ * xi (fdim per pair), dist, edge, vertex (projection._Pairs). Where one facet is within that
+ * reach (count 1) and y is not NULL, the fields of its closest point are written at row
+ * index[p] (p if index is NULL) of facet, oxi, y, normal, gap, distance and sliding (a
+ * projection.Projection; count set to 0 and the placeholders written if it is beyond
+ * radius). Self-contact (pnodes not NULL): only the admissible facets, with
  * pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its normal,
  * fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
  * Returns the number of exact projections made, or -1 when out of memory. */
@@ -737,24 +771,31 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
             i64 code = stack[top];
             if (lower[top] > bound2) continue;
             if (code >= 0) {
+                /* the children within the bound, pushed farthest first */
                 const node_t *N = T + code;
-                double dl = box_distance2f(g, N->box[0], xp);
-                double dr = box_distance2f(g, N->box[1], xp);
-                int near = dl <= dr ? 0 : 1;
-                double dnear = near ? dr : dl, dfar = near ? dl : dr;
-                if (top + 2 > STACK) {
+                double d[WIDE];
+                i64 c[WIDE];
+                int k = 0;
+                for (int slot = 0; slot < WIDE; slot++) {
+                    double ds = box_distance2f(g, N->box[slot], xp);
+                    if (N->child[slot] == EMPTY || ds > bound2) continue;
+                    int at = k++; /* insertion by decreasing distance */
+                    while (at > 0 && d[at - 1] < ds) {
+                        d[at] = d[at - 1];
+                        c[at] = c[at - 1];
+                        at--;
+                    }
+                    d[at] = ds;
+                    c[at] = N->child[slot];
+                }
+                if (top + k > STACK) {
                     free(hits);
                     return -1;
                 }
-                if (dfar <= bound2) {
-                    stack[top] = N->child[1 - near];
-                    lower[top++] = dfar;
-                    prefetch_child(T, leaf_nodes, nn * g, N->child[1 - near]);
-                }
-                if (dnear <= bound2) {
-                    stack[top] = N->child[near];
-                    lower[top++] = dnear;
-                    prefetch_child(T, leaf_nodes, nn * g, N->child[near]);
+                for (int j = 0; j < k; j++) {
+                    stack[top] = c[j];
+                    lower[top++] = d[j];
+                    prefetch_child(T, leaf_nodes, nn * g, c[j]);
                 }
                 continue;
             }
@@ -836,13 +877,13 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                 for (int j = 0; j < fdim; j++) oxi[o * fdim + j] = q->xi[j];
             } else {
                 count[p] = 0;
-                for (int k2 = 0; k2 < g; k2++) {  /* the placeholders of an unpaired point */
-                    y[o * g + k2] = xp[k2];
-                    normal[o * g + k2] = 0.0;
+                for (int c = 0; c < g; c++) {  /* the placeholders of an unpaired point */
+                    y[o * g + c] = xp[c];
+                    normal[o * g + c] = 0.0;
                 }
                 gap[o] = -INFINITY;
                 distance[o] = INFINITY;
-                for (int j = 0; j < fdim * fdim; j++) sliding[o * fdim * fdim + j] = 0.0;
+                for (int c = 0; c < fdim * fdim; c++) sliding[o * fdim * fdim + c] = 0.0;
             }
         }
     }
