@@ -599,6 +599,42 @@ INLINE double box_distance2f(int g, const float *B, const double *x)
     return s;
 }
 
+/* Whether the surface facet X (kind 1 or 2) is certainly farther than bound from x: the
+ * facet lies in a slab along its normal n at the centre (a triangle in its plane; a bilinear
+ * quadrilateral between its corners' heights, n . X(s, t) being bilinear), so the distance
+ * from x to the slab is a lower bound of its distance. The slab must be beyond bound by a
+ * margin (1e-10 (bound + rmax), far above the round-off of either distance), so that no
+ * facet within bound of x by its exact projection is ever skipped. Used before the
+ * quadrilaterals' projections (several Newton steps); a triangle's costs no more than it. */
+INLINE int beyond_slab(int kind, const double *X, const double *x, double bound, double rmax)
+{
+    double a1[3], a2[3], n[3], h[4] = {0.0}, r[3];
+    for (int k = 0; k < 3; k++) {
+        a1[k] = X[3 + k] - X[k];
+        a2[k] = X[6 + k] - X[k];
+        r[k] = x[k] - X[k];
+    }
+    if (kind == 2) /* the tangents at the centre */
+        for (int k = 0; k < 3; k++) {
+            double c3 = 0.5 * (X[k] - X[3 + k] - X[6 + k] + X[9 + k]);
+            a1[k] += c3;
+            a2[k] += c3;
+        }
+    n[0] = a1[1] * a2[2] - a1[2] * a2[1];
+    n[1] = a1[2] * a2[0] - a1[0] * a2[2];
+    n[2] = a1[0] * a2[1] - a1[1] * a2[0];
+    double lo = 0.0, hi = 0.0, hx = dot3(n, r);
+    for (int q = 1; q < (kind == 2 ? 4 : 3); q++) {
+        double e[3] = {X[3 * q] - X[0], X[3 * q + 1] - X[1], X[3 * q + 2] - X[2]};
+        h[q] = dot3(n, e);
+        lo = h[q] < lo ? h[q] : lo;
+        hi = h[q] > hi ? h[q] : hi;
+    }
+    double excess = hx > hi ? hx - hi : (hx < lo ? lo - hx : 0.0);
+    double margin = bound + 1e-10 * (bound + rmax);
+    return excess * excess > margin * margin * dot3(n, n);
+}
+
 /* Start loading what the walk reads of a child (code as in node_t): its row, or the nodes
  * of the leaf's first facets. */
 INLINE void prefetch_child(const node_t *T, const double *leaf_nodes, int w, i64 code)
@@ -815,6 +851,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                     }
                     if (box_distance2(g, B, xp) > bound2) continue;
                 }
+                if (kind == 2 && beyond_slab(kind, X, xp, bound, rmax)) continue;
                 if (pnodes && !admissible(g, mp, pnodes + p * mp, pnormal + p * g, mf,
                                           fnodes + perm[j] * mf, axis + perm[j] * g))
                     continue;
