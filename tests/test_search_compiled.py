@@ -235,3 +235,35 @@ def test_self_contact_bins_keep_their_trees(monkeypatch):
     assert built == []
     np.testing.assert_array_equal(second.facet, first.facet)
     assert np.count_nonzero(first.facet >= 0) > n // 5
+
+
+def test_compiled_order_is_the_cell_order():
+    """The Z-order of the points computed in C (a radix sort) is the NumPy one
+    (:func:`projection._cell_order`, stable), in 2D and 3D, with repeated points; the
+    identity for points that all coincide."""
+    rng = np.random.default_rng(9)
+    nodes = triangle_soup(rng, 20)
+    tree = TreeCache().hierarchy(np.ascontiguousarray(nodes))
+    for g in (2, 3):
+        points = rng.normal(size=(3000, g)) * [1.0, 0.01, 5.0][:g]
+        points = np.concatenate([points, points[:500]])  # equal keys: the given order kept
+        np.testing.assert_array_equal(tree.order(points), projection._cell_order(points))
+        same = np.ones((7, g))
+        np.testing.assert_array_equal(tree.order(same), np.arange(7))
+
+
+@pytest.mark.parametrize("offset", [-1e5, 3e4])
+def test_far_from_the_origin(offset, monkeypatch):
+    """Masters and points far from the origin (the single-precision boxes of the walk much
+    wider than the facets): the compiled search finds the NumPy search's facets."""
+    rng = np.random.default_rng(13)
+    for make, nf in ((wavy_quads, 400), (triangle_soup, 300)):
+        base = make(rng, nf)
+        points = near_and_far(rng, base, 300) * 1e-3 + offset
+        nodes = base * 1e-3 + offset
+        fast = closest_points(points, nodes, np.inf)
+        monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
+        slow = closest_points(points, nodes, np.inf)
+        monkeypatch.delenv("CONTACT_UFL_SEARCH")
+        np.testing.assert_array_equal(fast.facet, slow.facet)
+        np.testing.assert_allclose(fast.y, slow.y, rtol=0, atol=1e-9)

@@ -16,7 +16,7 @@ the day is kept, and a process that finds its library removed between its check 
 load builds it again).
 
 The compiler is ``$CC`` if set, else the one Python was built with, else ``cc``; the flags
-``-O2 -fPIC -shared -ffp-contract=off -fno-fast-math`` (no fused multiply-add: the kernels
+``-O3 -fPIC -shared -ffp-contract=off -fno-fast-math`` (no fused multiply-add: the kernels
 repeat the NumPy operations to the last bit).
 """
 
@@ -56,7 +56,7 @@ i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm
               const i64 *fnodes, const double *axis);
 """
 
-FLAGS = ("-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
+FLAGS = ("-O3", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 SOURCE = Path(__file__).with_name("search_kernel.c")
 STALE_AGE = 86400.0  # seconds after which a kernel of another source hash is removed
 

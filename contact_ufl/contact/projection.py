@@ -537,8 +537,11 @@ class _Hierarchy:
 
     Built once over the facets' centroids (median splits on the longest axis, two to four
     facets a leaf: ``O(n log n)``), its boxes refitted over the current nodes at every search
-    (``O(n)``, with a copy of the nodes in the order of the leaves): exact however far the
-    nodes moved since the build (only slower once they moved far).
+    whose nodes differ from the last one's (``O(n)``, one pass with a copy of the nodes in the
+    order of the leaves; an unchanged master costs one comparison with the nodes of the last
+    refit): exact however far the nodes moved since the build (only slower once they moved
+    far). The walk reads rows of four children (two levels of the binary tree) with their
+    boxes in single precision, rounded outwards.
     """
 
     def __init__(self, nodes: FloatArray) -> None:
@@ -980,7 +983,9 @@ class TreeCache:
     :func:`closest_points`.
 
     One entry per shape ``(nf, nn, gdim)`` of the node array and KD-tree level or hierarchy (the
-    ``_TREES`` most recent): the nodes the tree was built from and the tree.
+    ``_TREES`` most recent): the nodes the tree was built from (``None`` for a hierarchy, which
+    keeps the nodes of its last refit) and the tree. A search in parts (the normal bins of a
+    self-contact search) keeps the trees of each part in a cache of its own (:meth:`part`).
     """
 
     def __init__(self) -> None:
@@ -1433,10 +1438,13 @@ def closest_points(
     ``CONTACT_UFL_SEARCH=numpy``): a bounding-volume hierarchy of axis-aligned boxes over the
     facets' nodes (median splits, 2 to 4 facets a leaf; built once per master shape and
     kept in ``trees`` while no node has moved more than ``0.25 R_max``, its boxes refitted
-    to the current nodes at every call) is walked per point in C, nearer child first,
-    skipping every box (and facet box) farther than ``r = min(d, radius)`` with ``d`` the
-    smallest exact distance met so far (widened by ``1e-9 (r + 2 R_max)``, beyond the
-    tie tolerance): the work follows the point's distance to the surface, not the radius.
+    to the current nodes at every call where they changed; walked four children a step,
+    their boxes in single precision rounded outwards) is walked per point in C, nearest
+    child first, skipping every box (and facet box; of a quadrilateral, also the slab
+    between its corners' heights along its centre normal) farther than ``r = min(d,
+    radius)`` with ``d`` the smallest exact distance met so far (widened by ``1e-9 (r + 2
+    R_max)``, beyond the tie tolerance): the work follows the point's distance to the
+    surface, not the radius.
     The exact projections are those of the NumPy kernels, in the same operations. A point
     with one facet within that reach gets its closest point, normal, proximity and ``M``
     from C; the points with several go through the NumPy tie-break below. Self-contact:

@@ -13,10 +13,10 @@
  * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query walks
  * the rows of bvh_refit (node_t, two 64-byte cache lines), a tree of four children a node:
  * the row of an internal node holds the boxes of its children's children (of a child that is
- * a leaf, that leaf), in single precision rounded outwards (a box holding the exact one: the
- * pruning is as safe, the closest points are the same), and their codes (a row index, or
- * -1 - (8 start + count) for a leaf, EMPTY for an unused slot), so that two levels of the
- * binary tree cost one row. The rows are in preorder; row m holds the root's box and code
+ * a leaf, that leaf; by coordinate, the four side by side for the compiler to vectorise), in
+ * single precision rounded outwards (a box holding the exact one: the pruning is as safe,
+ * the closest points are the same), and their codes (a row index, or -1 - (8 start + count)
+ * for a leaf, EMPTY for an unused slot), so that two levels of the binary tree cost one row. The rows are in preorder; row m holds the root's box and code
  * as its first child.
  */
 #include <math.h>
@@ -30,8 +30,8 @@ typedef long long i64;
 #define EMPTY ((i64)1 << 62) /* the code of an unused slot of a row */
 
 typedef struct {
-    float box[WIDE][6]; /* per child: lo_0 .. lo_g-1, hi_0 .. hi_g-1 */
-    i64 child[WIDE];    /* row index, leaf code -1 - (8 start + count), or EMPTY */
+    float lo[3][WIDE], hi[3][WIDE]; /* the children's boxes, by coordinate then child */
+    i64 child[WIDE];                /* row index, leaf code -1 - (8 start + count), or EMPTY */
 } node_t;
 
 /* the rows of a tree buffer of at least (m + 1) sizeof(node_t) + 128 bytes, 128-byte
@@ -189,9 +189,9 @@ INLINE i64 leaf_code(const fit_t *F, i64 i) { return -1 - (8 * (-F->a[i] - 1) + 
 
 INLINE void store_box(node_t *N, int slot, int g, const double *B)
 {
-    for (int k = 0; k < g; k++) {
-        N->box[slot][k] = down(B[k]);
-        N->box[slot][g + k] = up(B[g + k]);
+    for (int k = 0; k < 3; k++) { /* an unused coordinate (2D) at 0: no distance */
+        N->lo[k][slot] = k < g ? down(B[k]) : 0.0f;
+        N->hi[k][slot] = k < g ? up(B[g + k]) : 0.0f;
     }
 }
 
@@ -225,6 +225,7 @@ static i64 fit(fit_t *F, i64 i, double *box)
     }
     for (int c = 0; c < WIDE; c++) {
         if (c >= slots) {
+            for (int k = 0; k < 3; k++) N->lo[k][c] = N->hi[k][c] = 0.0f;
             N->child[c] = EMPTY;
             continue;
         }
@@ -248,7 +249,10 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
         node_t *R = F.T + m;
         store_box(R, 0, g, B);
         R->child[0] = code;
-        for (int c = 1; c < WIDE; c++) R->child[c] = EMPTY;
+        for (int c = 1; c < WIDE; c++) {
+            for (int k = 0; k < 3; k++) R->lo[k][c] = R->hi[k][c] = 0.0f;
+            R->child[c] = EMPTY;
+        }
     }
     return F.finite == 0.0 ? sqrt(F.r2max) : -2.0;
 }
@@ -586,17 +590,18 @@ INLINE double box_distance2(int g, const double *B, const double *x)
     return s;
 }
 
-INLINE double box_distance2f(int g, const float *B, const double *x)
+/* The squared distances d (WIDE) from x to the children's boxes of row N (box_distance2 of
+ * the single-precision boxes, their bounds exact in double), the children side by side. */
+INLINE void row_distance2(int g, const node_t *N, const double *x, double *d)
 {
-    /* box_distance2 of a single-precision box (its bounds exact in double) */
-    double s = 0.0;
-    for (int k = 0; k < g; k++) {
-        double lo = (double)B[k] - x[k], hi = x[k] - (double)B[g + k];
-        double d = lo > hi ? lo : hi;
-        d = d > 0.0 ? d : 0.0;
-        s += d * d;
-    }
-    return s;
+    for (int c = 0; c < WIDE; c++) d[c] = 0.0;
+    for (int k = 0; k < g; k++)
+        for (int c = 0; c < WIDE; c++) {
+            double lo = (double)N->lo[k][c] - x[k], hi = x[k] - (double)N->hi[k][c];
+            double e = lo > hi ? lo : hi;
+            e = e > 0.0 ? e : 0.0;
+            d[c] += e * e;
+        }
 }
 
 /* Whether the surface facet X (kind 1 or 2) is certainly farther than bound from x: the
@@ -796,7 +801,9 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
         i64 nh = 0, top = 0;
         count[p] = 0;
         if (m == 0) continue;
-        double d0 = box_distance2f(g, T[m].box[0], xp);
+        double root[WIDE];
+        row_distance2(g, T + m, xp, root);
+        double d0 = root[0];
         if (d0 <= bound2) {
             stack[0] = T[m].child[0];
             lower[0] = d0;
@@ -809,19 +816,19 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
             if (code >= 0) {
                 /* the children within the bound, pushed farthest first */
                 const node_t *N = T + code;
-                double d[WIDE];
+                double d[WIDE], ds[WIDE];
                 i64 c[WIDE];
                 int k = 0;
+                row_distance2(g, N, xp, ds);
                 for (int slot = 0; slot < WIDE; slot++) {
-                    double ds = box_distance2f(g, N->box[slot], xp);
-                    if (N->child[slot] == EMPTY || ds > bound2) continue;
+                    if (N->child[slot] == EMPTY || ds[slot] > bound2) continue;
                     int at = k++; /* insertion by decreasing distance */
-                    while (at > 0 && d[at - 1] < ds) {
+                    while (at > 0 && d[at - 1] < ds[slot]) {
                         d[at] = d[at - 1];
                         c[at] = c[at - 1];
                         at--;
                     }
-                    d[at] = ds;
+                    d[at] = ds[slot];
                     c[at] = N->child[slot];
                 }
                 if (top + k > STACK) {
