@@ -174,6 +174,9 @@ def _open(ffi: cffi.FFI, library: Path, compiler: list[str]) -> object:
     stale: :func:`remove_stale`); built again if it was removed meanwhile."""
     try:
         os.utime(library)
+    except OSError:  # a read-only cache: nothing is removed from it either
+        pass
+    try:
         return ffi.dlopen(str(library))
     except OSError:
         _build(library, compiler)
