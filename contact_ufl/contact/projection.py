@@ -620,7 +620,8 @@ class _Hierarchy:
         search (point nodes, point normals, facet nodes, facet centre normals). ``out``: a
         :class:`Projection` (C-contiguous fields) in which each point with one pair gets its
         closest point, at its row of ``index`` (its count set to 0 if it is beyond
-        ``radius``)."""
+        ``radius``; its pair is then not written: its rows of the arrays returned are left
+        untouched, their memory pages never written)."""
         npts, fdim = x.shape[0], self.gdim - 1
         count = np.zeros(npts, dtype=np.int64)
         f = np.empty((npts, cap), dtype=np.int64)

@@ -641,7 +641,7 @@ INLINE int beyond_slab(int kind, const double *X, const double *x, double bound,
 }
 
 /* Start loading what the walk reads of a child (code as in node_t): its row, or the nodes
- * of the leaf's first facets. */
+ * of the leaf's facets. */
 INLINE void prefetch_child(const node_t *T, const double *leaf_nodes, int w, i64 code)
 {
     if (code >= 0) {
@@ -649,9 +649,7 @@ INLINE void prefetch_child(const node_t *T, const double *leaf_nodes, int w, i64
         PREFETCH((const char *)(T + code) + 64);
     } else {
         const double *X = leaf_nodes + ((-code - 1) >> 3) * w;
-        PREFETCH(X);
-        PREFETCH(X + 8);
-        PREFETCH(X + 16);
+        for (int q = 0; q < ((-code - 1) & 7) * w; q += 8) PREFETCH(X + q);
     }
 }
 
@@ -771,13 +769,13 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
 /* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose
  * exact distance is within reach() of the smallest one, if that smallest one is within
  * reach(radius). count[p] is their number; up to cap of them are written at p * cap of f,
- * xi (fdim per pair), dist, edge, vertex (projection._Pairs). Where one facet is within that
- * reach (count 1) and y is not NULL, the fields of its closest point are written at row
- * index[p] (p if index is NULL) of facet, oxi, y, normal, gap, distance and sliding (a
- * projection.Projection; count set to 0 and the placeholders written if it is beyond
- * radius). Self-contact (pnodes not NULL): only the admissible facets, with
- * pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its normal,
- * fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
+ * xi (fdim per pair), dist, edge, vertex (projection._Pairs), unless y is given and the count
+ * is 1: where one facet is within that reach and y is not NULL, the fields of its closest
+ * point are written instead at row index[p] (p if index is NULL) of facet, oxi, y, normal,
+ * gap, distance and sliding (a projection.Projection; count set to 0 and the placeholders
+ * written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible
+ * facets, with pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its
+ * normal, fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
  * Returns the number of exact projections made, or -1 when out of memory. */
 INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
               const void *tree, double rmax, i64 npts,
@@ -896,20 +894,22 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
             }
         }
         i64 k = 0, last = 0;
-        for (i64 h = 0; h < nh; h++) {
-            if (hits[h].q.dist > bound) continue;
-            last = h;
-            if (k < cap) {
-                i64 o = p * cap + k;
-                f[o] = perm[hits[h].j];
-                for (int j = 0; j < fdim; j++) xi[o * fdim + j] = hits[h].q.xi[j];
-                dist[o] = hits[h].q.dist;
-                edge[o] = hits[h].q.edge;
-                vertex[o] = (unsigned char)hits[h].q.vertex;
+        for (i64 h = 0; h < nh; h++)
+            if (hits[h].q.dist <= bound) {
+                last = h;
+                k++;
             }
-            k++;
-        }
         count[p] = k;
+        /* the pairs, unless the point's one pair is finished below (their rows untouched) */
+        for (i64 h = 0, c = 0; h < nh && c < cap && (k > 1 || !y); h++) {
+            if (hits[h].q.dist > bound) continue;
+            i64 o = p * cap + c++;
+            f[o] = perm[hits[h].j];
+            for (int j = 0; j < fdim; j++) xi[o * fdim + j] = hits[h].q.xi[j];
+            dist[o] = hits[h].q.dist;
+            edge[o] = hits[h].q.edge;
+            vertex[o] = (unsigned char)hits[h].q.vertex;
+        }
         if (k == 1 && y) {
             /* one facet within the tie reach: the closest point, no tie-break */
             const pair_t *q = &hits[last].q;
