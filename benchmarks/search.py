@@ -79,6 +79,20 @@ segments 8.1e5 / 3.6e5; 1e4 triangles 3.8e5 / 6.1e4; 1e5 triangles 2.6e5 / 3.3e4
 quadrilaterals 3.0e5 / 6.8e4; 1e5 quadrilaterals 2.6e5 / 4.3e4 (graded master 0.034 s,
 self-contact slit 0.11 / 0.25 s).
 
+Fifth round (issue 12 item 4; README): the compiled walk reads rows of four children with
+single-precision boxes rounded outwards (one row per two levels of the binary tree),
+prefetches what it pushes, skips the quadrilaterals beyond the bound by their slab along the
+centre normal, and is built with ``-O3``; the unchanged-master check is one sequential
+comparison, the refit one prefetched pass, the points' Z-order a radix sort in C.
+``search.json`` (now) against the fourth round's code run with this script just before it
+(CPU points/s at radius h / infinity, before -> now): 1e4 segments 3.1e6 -> 5.6e6 / 1.9e6 ->
+2.4e6; 1e6 segments 1.3e6 -> 2.0e6 / 8.7e5 -> 1.3e6; 1e4 triangles 1.1e6 -> 1.8e6 / 2.2e5 ->
+2.9e5; 1e5 triangles 9.4e5 -> 1.4e6 / 1.6e5 -> 2.1e5; 1e6 triangles 6.1e5 -> 9.6e5 / 1.2e5 ->
+1.8e5; 1e4 quadrilaterals 1.1e6 -> 1.6e6 / 2.1e5 -> 3.0e5; 1e5 quadrilaterals 9.4e5 -> 1.3e6 /
+1.4e5 -> 2.1e5; 1e6 quadrilaterals 6.2e5 -> 8.7e5 / 1.1e5 -> 1.8e5 (self-contact slit, second
+call: 0.021 / 0.026 -> 0.011 / 0.016 s, its bins' trees now kept). The fourth round's own
+``search.json`` is in the history (commit c78de93).
+
 The distance sweep of the third round showed where the time went: at a given distance the
 cost is flat in the radius (within the timing noise, e.g. 1e5 triangles at 1 h: 1.2e5
 points/s at radii 2 h, 10 h and infinity), but it falls with the distance (1e5 triangles:

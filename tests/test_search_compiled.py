@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -137,3 +138,132 @@ def test_numpy_search_on_request(monkeypatch):
     monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
     assert not projection._compiled(3, 3)
     assert not projection._compiled(6, 3)  # quadratic facets: NumPy in any case
+
+
+@pytest.mark.parametrize("search", ["compiled", "numpy"])
+def test_non_finite_input_is_an_error(search, monkeypatch):
+    """A NaN or infinite slave point or master node is a clear error in either search (the
+    compiled one paired such points silently), also when the same non-finite master is
+    searched again with the same trees; finite nodes after it are searched as usual."""
+    monkeypatch.setenv("CONTACT_UFL_SEARCH", search)
+    rng = np.random.default_rng(4)
+    nodes = triangle_soup(rng, 50)
+    points = near_and_far(rng, nodes, 20)
+    expected = closest_points(points, nodes, np.inf)
+    bad_points = points.copy()
+    bad_points[3, 1] = np.nan
+    with pytest.raises(ValueError, match="slave points .* non-finite"):
+        closest_points(bad_points, nodes, np.inf)
+    trees = TreeCache()
+    closest_points(points, nodes, np.inf, trees)
+    for value in (np.nan, np.inf):
+        bad_nodes = nodes.copy()
+        bad_nodes[7, 2, 0] = value
+        for _ in range(2):  # the second time with the trees of the first
+            with pytest.raises(ValueError, match="master nodes .* non-finite"):
+                closest_points(points, bad_nodes, np.inf, trees)
+    got = closest_points(points, nodes, np.inf, trees)
+    np.testing.assert_array_equal(got.facet, expected.facet)
+
+
+def test_non_finite_points_raised_on_every_rank():
+    """The search of a contact problem (collective) raises a non-finite slave point of one
+    rank on every rank."""
+    comm = MPI.COMM_WORLD
+    problem = ContactProblem(scenes.hertz_2d(h_contact=0.05, depth=0.01).scene, verbose=False)
+    search = problem.contacts[0].kinematics.search
+    points = search.slave.X.reshape(-1, search.gdim).copy()
+    if comm.rank == 0 and len(points):
+        points[0, 0] = np.inf
+    elif comm.rank == 0:
+        points = np.full((1, search.gdim), np.inf)
+    with pytest.raises(ValueError, match="slave points .* non-finite"):
+        search.exchange(search.master.X_nodes, points)
+
+
+def test_stale_kernels_are_removed(tmp_path):
+    """Of the kernels in the cache directory, those of other source hashes and the leftover
+    temporary files changed over a day ago are removed; the current one, recent ones and
+    other files are kept."""
+    current = tmp_path / "search_kernel_current.so"
+    names = [
+        "search_kernel_old.so",
+        "search_kernel_old.x1.tmp",
+        "search_kernel_recent.so",
+        "other_old.so",
+        current.name,
+    ]
+    day_ago = time.time() - 2 * compiled.STALE_AGE
+    for name in names:
+        (tmp_path / name).write_text("")
+        if name != "search_kernel_recent.so":
+            os.utime(tmp_path / name, (day_ago, day_ago))
+    removed = compiled.remove_stale(current)
+    assert sorted(p.name for p in removed) == ["search_kernel_old.so", "search_kernel_old.x1.tmp"]
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == sorted(["search_kernel_recent.so", "other_old.so", current.name])
+    assert compiled.remove_stale(tmp_path / "missing" / "search_kernel_x.so") == []
+
+
+def test_self_contact_bins_keep_their_trees(monkeypatch):
+    """A self-contact search by normal bins keeps the trees of its bins in the caller's
+    cache: a second search of the unchanged surface builds none, with the same results."""
+    n = 4000
+    t = -np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    ring = np.stack([np.cos(t), 0.06 * np.sin(t)], axis=1)
+    facet_nodes = np.stack([np.arange(n), (np.arange(n) + 1) % n], axis=1)
+    nodes = ring[facet_nodes]
+    a1 = nodes[:, 1] - nodes[:, 0]
+    normals = np.stack([a1[:, 1], -a1[:, 0]], axis=1)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    rule = projection.SelfContact(facet_nodes, facet_nodes, normals)
+    points = nodes.mean(axis=1)
+    assert n > projection._DIRECTIONS_MIN
+    built = []
+    init = projection._Hierarchy.__init__
+
+    def counted(self, nodes):
+        built.append(len(nodes))
+        init(self, nodes)
+
+    monkeypatch.setattr(projection._Hierarchy, "__init__", counted)
+    trees = TreeCache()
+    first = closest_points(points, nodes, 0.05, trees, rule)
+    assert len(built) > 1 and len(trees.parts) > 1
+    built.clear()
+    second = closest_points(points, nodes, 0.05, trees, rule)
+    assert built == []
+    np.testing.assert_array_equal(second.facet, first.facet)
+    assert np.count_nonzero(first.facet >= 0) > n // 5
+
+
+def test_compiled_order_is_the_cell_order():
+    """The Z-order of the points computed in C (a radix sort) is the NumPy one
+    (:func:`projection._cell_order`, stable), in 2D and 3D, with repeated points; the
+    identity for points that all coincide."""
+    rng = np.random.default_rng(9)
+    nodes = triangle_soup(rng, 20)
+    tree = TreeCache().hierarchy(np.ascontiguousarray(nodes))
+    for g in (2, 3):
+        points = rng.normal(size=(3000, g)) * [1.0, 0.01, 5.0][:g]
+        points = np.concatenate([points, points[:500]])  # equal keys: the given order kept
+        np.testing.assert_array_equal(tree.order(points), projection._cell_order(points))
+        same = np.ones((7, g))
+        np.testing.assert_array_equal(tree.order(same), np.arange(7))
+
+
+@pytest.mark.parametrize("offset", [-1e5, 3e4])
+def test_far_from_the_origin(offset, monkeypatch):
+    """Masters and points far from the origin (the single-precision boxes of the walk much
+    wider than the facets): the compiled search finds the NumPy search's facets."""
+    rng = np.random.default_rng(13)
+    for make, nf in ((wavy_quads, 400), (triangle_soup, 300)):
+        base = make(rng, nf)
+        points = near_and_far(rng, base, 300) * 1e-3 + offset
+        nodes = base * 1e-3 + offset
+        fast = closest_points(points, nodes, np.inf)
+        monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
+        slow = closest_points(points, nodes, np.inf)
+        monkeypatch.delenv("CONTACT_UFL_SEARCH")
+        np.testing.assert_array_equal(fast.facet, slow.facet)
+        np.testing.assert_allclose(fast.y, slow.y, rtol=0, atol=1e-9)

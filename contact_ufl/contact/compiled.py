@@ -9,10 +9,14 @@ compiler command and the platform: a changed source builds a new library, an unc
 is built once per machine and user. Several processes (MPI ranks) may build at once without
 any collective call: each compiles into a file of its own and renames it atomically onto the
 cached name (the last rename wins; every candidate is a complete library of the same source),
-so no process ever loads a half-written file.
+so no process ever loads a half-written file. A process that builds a library removes the
+libraries of other source hashes (and leftover temporary files) last changed over a day ago
+(:func:`remove_stale`; loading a library sets its time of change, so a library loaded within
+the day is kept, and a process that finds its library removed between its check and its
+load builds it again).
 
 The compiler is ``$CC`` if set, else the one Python was built with, else ``cc``; the flags
-``-O2 -fPIC -shared -ffp-contract=off -fno-fast-math`` (no fused multiply-add: the kernels
+``-O3 -fPIC -shared -ffp-contract=off -fno-fast-math`` (no fused multiply-add: the kernels
 repeat the NumPy operations to the last bit).
 """
 
@@ -27,23 +31,24 @@ import subprocess
 import sysconfig
 import tempfile
 import threading
+import time
 from pathlib import Path
 
 import cffi
 from mpi4py import MPI
 
-__all__ = ["CompilerNotFound", "cache_dir", "kernel", "require"]
+__all__ = ["CompilerNotFound", "cache_dir", "kernel", "remove_stale", "require"]
 
 CDEF = """
 typedef long long i64;
 i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b);
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, double *tree, double *leaf_nodes);
+                 const i64 *a, const i64 *b, void *tree, double *leaf_nodes);
 double largest_change(i64 len, const double *p, const double *q);
-int same_nodes(i64 n, int width, const double *nodes, const i64 *perm,
-               const double *leaf_nodes);
+int same_values(i64 len, const double *p, const double *q);
+int morton_order(int g, i64 n, const double *x, i64 *order);
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const double *tree, double rmax, i64 npts,
+              const void *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
               double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
               double *oxi, double *y, double *normal, double *gap, double *distance,
@@ -51,8 +56,9 @@ i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm
               const i64 *fnodes, const double *axis);
 """
 
-FLAGS = ("-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
+FLAGS = ("-O3", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 SOURCE = Path(__file__).with_name("search_kernel.c")
+STALE_AGE = 86400.0  # seconds after which a kernel of another source hash is removed
 
 _lock = threading.Lock()
 _loaded: tuple[cffi.FFI, object] | None = None
@@ -113,6 +119,29 @@ def _build(library: Path, compiler: list[str]) -> None:
             os.unlink(private)
 
 
+def remove_stale(library: Path, age: float = STALE_AGE) -> list[Path]:
+    """Remove the kernels of other source hashes from ``library``'s directory, and the
+    temporary files of builds, last changed over ``age`` seconds ago (a day by default: no
+    process is still building or loading them), best effort: a file that cannot be removed
+    (gone already, no permission) is left. Returns the files removed."""
+    removed = []
+    now = time.time()
+    try:
+        candidates = list(library.parent.glob("search_kernel_*"))
+    except OSError:
+        return removed
+    for path in candidates:
+        if path.name == library.name or not path.name.endswith((".so", ".tmp")):
+            continue
+        try:
+            if now - path.stat().st_mtime > age:
+                path.unlink()
+                removed.append(path)
+        except OSError:
+            continue
+    return removed
+
+
 def kernel() -> tuple[cffi.FFI, object]:
     """The cffi interface and the loaded library of the search kernel (built if needed)."""
     global _loaded
@@ -133,10 +162,25 @@ def kernel() -> tuple[cffi.FFI, object]:
             library = cache_dir() / f"search_kernel_{key}.so"
             if not library.exists():
                 _build(library, compiler)
+                remove_stale(library)
             ffi = cffi.FFI()
             ffi.cdef(CDEF)
-            _loaded = (ffi, ffi.dlopen(str(library)))
+            _loaded = (ffi, _open(ffi, library, compiler))
         return _loaded
+
+
+def _open(ffi: cffi.FFI, library: Path, compiler: list[str]) -> object:
+    """The loaded ``library``, its time of change set to now (a library in use is never
+    stale: :func:`remove_stale`); built again if it was removed meanwhile."""
+    try:
+        os.utime(library)
+    except OSError:  # a read-only cache: nothing is removed from it either
+        pass
+    try:
+        return ffi.dlopen(str(library))
+    except OSError:
+        _build(library, compiler)
+        return ffi.dlopen(str(library))
 
 
 def require(comm: MPI.Comm) -> None:

@@ -138,6 +138,7 @@ _FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
 #: The facet kinds of the compiled search (kind numbers of ``search_kernel.c``).
 _COMPILED_KINDS = {"segment": 0, "triangle": 1, "quadrilateral": 2}
 _CAP = 4  # pairs per point returned by the compiled query (more: that point is queried again)
+NON_FINITE = "{what} of the closest-point search hold non-finite values (NaN or infinity)"
 
 #: An admissibility test of (point, facet) pairs: point and facet indices in, mask out.
 Admit = Callable[[IntArray, IntArray], npt.NDArray[np.bool_]]
@@ -390,6 +391,7 @@ def _by_direction(
     radius: float,
     rule: SelfContact,
     out: Projection,
+    trees: TreeCache,
 ) -> None:
     """Self-contact search by normal bins: the points of a bin are searched against the
     facets of the bins that may face them only.
@@ -401,6 +403,8 @@ def _by_direction(
     such bins are inadmissible for those points and skipped (the facets around a point on its
     own side, which otherwise fill every query up to the partner across the gap). The
     admissible pairs are all kept (facets in their given order): the same closest points.
+    The search trees of each point bin are kept in ``trees`` (its part of that bin) for the
+    next call.
     """
     g = points.shape[1]
     X = [[np.ascontiguousarray(nodes[:, a, k]) for k in range(g)] for a in range(nodes.shape[1])]
@@ -417,7 +421,7 @@ def _by_direction(
             continue
         part = Projection(*(getattr(out, k)[p] for k in _FIELDS))
         sub = SelfContact(rule.point_nodes[p], rule.facet_nodes[f], rule.point_normals[p])
-        _search(points[p], nodes[f], radius, TreeCache(), sub, part)
+        _search(points[p], nodes[f], radius, trees.part(("bin", int(A))), sub, part)
         part.facet[part.facet >= 0] = f[part.facet[part.facet >= 0]]
         for k in _FIELDS:
             getattr(out, k)[p] = getattr(part, k)
@@ -533,8 +537,11 @@ class _Hierarchy:
 
     Built once over the facets' centroids (median splits on the longest axis, two to four
     facets a leaf: ``O(n log n)``), its boxes refitted over the current nodes at every search
-    (``O(n)``, with a copy of the nodes in the order of the leaves): exact however far the
-    nodes moved since the build (only slower once they moved far).
+    whose nodes differ from the last one's (``O(n)``, one pass with a copy of the nodes in the
+    order of the leaves; an unchanged master costs one comparison with the nodes of the last
+    refit): exact however far the nodes moved since the build (only slower once they moved
+    far). The walk reads rows of four children (two levels of the binary tree) with their
+    boxes in single precision, rounded outwards.
     """
 
     def __init__(self, nodes: FloatArray) -> None:
@@ -542,13 +549,21 @@ class _Hierarchy:
         nf, self.nn, self.gdim = nodes.shape
         self.kind = _COMPILED_KINDS[facet_kind(self.nn, self.gdim)]
         centroid = np.ascontiguousarray(nodes.mean(axis=1))
+        if not np.isfinite(centroid).all():
+            raise ValueError(NON_FINITE.format(what="the master nodes"))
         self.perm = np.empty(nf, dtype=np.int64)
         self.a = np.empty(nf + 2, dtype=np.int64)  # leaves of 2 to 4 facets: < nf tree nodes
         self.b = np.empty(nf + 2, dtype=np.int64)
         p = self._pointers
         self.m = int(self.lib.bvh_build(self.gdim, nf, *p(centroid, self.perm, self.a, self.b)))
-        self.tree = np.empty((self.m, 2 * self.gdim + 2))  # boxes and children, packed
+        # the rows of the walk: 128 bytes a tree node at most, one more, 128 to align them
+        self.tree = np.empty((self.m + 2) * 128, dtype=np.uint8)
         self.leaf_nodes = np.empty_like(nodes)
+        self.fitted_nodes = np.empty_like(nodes)  # the nodes of the last refit, as given
+        self.is_fitted = False
+        #: a bound of the largest node movement since the build (the sum of the largest
+        #: movements from one refit to the next)
+        self.moved = 0.0
         self.R_max = 0.0
         self.projections = 0
 
@@ -557,22 +572,38 @@ class _Hierarchy:
 
     def fitted(self, nodes: FloatArray) -> bool:
         """Whether the boxes are those of ``nodes`` (C-contiguous): the nodes of the last
-        refit, to the last bit."""
-        nf, nn, g = nodes.shape
+        (successful) refit, to the last bit."""
         p = self._pointers
-        return bool(self.lib.same_nodes(nf, nn * g, *p(nodes, self.perm, self.leaf_nodes)))
+        return self.is_fitted and bool(
+            self.lib.same_values(nodes.size, *p(nodes, self.fitted_nodes))
+        )
 
     def refit(self, nodes: FloatArray) -> None:
         """The boxes, largest facet radius and leaf-ordered nodes of the current ``nodes``
-        (C-contiguous)."""
+        (C-contiguous); a ``ValueError`` if a coordinate is not finite."""
         nf, nn, g = nodes.shape
         p = self._pointers
-        self.R_max = float(
+        self.is_fitted = False
+        R_max = float(
             self.lib.bvh_refit(
                 g, nn, nf, *p(nodes, self.perm), self.m,
                 *p(self.a, self.b, self.tree, self.leaf_nodes),
             )
         )  # fmt: skip
+        if R_max == -2.0:
+            raise ValueError(NON_FINITE.format(what="the master nodes"))
+        self.R_max = R_max
+        np.copyto(self.fitted_nodes, nodes)
+        self.is_fitted = True
+
+    def order(self, points: FloatArray) -> IntArray:
+        """The order of :func:`_cell_order` (a Z-order curve through the cells of a
+        ``1024^gdim`` grid over the points), by a radix sort in C."""
+        order = np.empty(len(points), dtype=np.int64)
+        x = np.ascontiguousarray(points)
+        if self.lib.morton_order(x.shape[1], len(x), *self._pointers(x, order)) != 0:
+            raise MemoryError("the compiled closest-point search ran out of memory")
+        return order
 
     def query(
         self,
@@ -589,7 +620,8 @@ class _Hierarchy:
         search (point nodes, point normals, facet nodes, facet centre normals). ``out``: a
         :class:`Projection` (C-contiguous fields) in which each point with one pair gets its
         closest point, at its row of ``index`` (its count set to 0 if it is beyond
-        ``radius``)."""
+        ``radius``; its pair is then not written: its rows of the arrays returned are left
+        untouched, their memory pages never written)."""
         npts, fdim = x.shape[0], self.gdim - 1
         count = np.zeros(npts, dtype=np.int64)
         f = np.empty((npts, cap), dtype=np.int64)
@@ -952,11 +984,21 @@ class TreeCache:
     :func:`closest_points`.
 
     One entry per shape ``(nf, nn, gdim)`` of the node array and KD-tree level or hierarchy (the
-    ``_TREES`` most recent): the nodes the tree was built from and the tree.
+    ``_TREES`` most recent): the nodes the tree was built from (``None`` for a hierarchy, which
+    keeps the nodes of its last refit) and the tree. A search in parts (the normal bins of a
+    self-contact search) keeps the trees of each part in a cache of its own (:meth:`part`).
     """
 
     def __init__(self) -> None:
-        self.entries: OrderedDict[tuple, tuple[FloatArray, cKDTree | _Hierarchy]] = OrderedDict()
+        self.entries: OrderedDict[tuple, tuple[FloatArray | None, cKDTree | _Hierarchy]] = (
+            OrderedDict()
+        )
+        #: the caches of the parts of a search (a self-contact search's normal bins)
+        self.parts: dict[object, TreeCache] = {}
+
+    def part(self, key: object) -> TreeCache:
+        """The cache of the part ``key`` of a search (made on first use)."""
+        return self.parts.setdefault(key, TreeCache())
 
     def tree(
         self, nodes: FloatArray, centroid: FloatArray, R_max: float, level: int = 0
@@ -986,31 +1028,35 @@ class TreeCache:
         to them: the one of an earlier call on a master of the same shape while no node has
         moved more than ``_MOVE R_max`` since it was built (a tree of the earlier order stays
         exact once refitted, and stays good while the facets barely moved; not refitted if
-        no node moved since the last call), else a new one."""
+        no node moved since the last call), else a new one. The movement since the build is
+        bounded by the sum of the largest movements from one refit to the next (the hierarchy
+        keeps the nodes of its last refit only)."""
         key = (*nodes.shape, "hierarchy")
         entry = self.entries.get(key)
         tree = None
         if entry is not None:
-            built, tree = entry
+            tree = entry[1]
             if tree.fitted(nodes):  # the master has not moved since the last search
                 self.entries.move_to_end(key)
                 return tree
-            change = tree.lib.largest_change(
-                nodes.size, _ptr(tree, nodes), _ptr(tree, built)
-            ) * np.sqrt(nodes.shape[2])
-            if change <= _MOVE * tree.R_max:
+            if tree.is_fitted:
+                tree.moved += tree.lib.largest_change(
+                    nodes.size, _ptr(tree, nodes), _ptr(tree, tree.fitted_nodes)
+                ) * np.sqrt(nodes.shape[2])
+            if tree.is_fitted and tree.moved <= _MOVE * tree.R_max:
                 self.entries.move_to_end(key)
             else:
                 tree = None
         if tree is None:
             tree = _Hierarchy(nodes)
-            self._keep(key, nodes, tree)
+            self._keep(key, None, tree)
         tree.refit(nodes)
         return tree
 
-    def _keep(self, key: tuple, nodes: FloatArray, tree: object) -> None:
-        """Keep ``tree``, built over ``nodes``, as the most recent entry."""
-        self.entries[key] = (nodes.copy(), tree)
+    def _keep(self, key: tuple, nodes: FloatArray | None, tree: object) -> None:
+        """Keep ``tree``, built over ``nodes`` (a copy kept; ``None``: a hierarchy, which
+        keeps its own), as the most recent entry."""
+        self.entries[key] = (None if nodes is None else nodes.copy(), tree)
         self.entries.move_to_end(key)
         while len(self.entries) > _TREES:
             self.entries.popitem(last=False)
@@ -1340,7 +1386,9 @@ def _spread_bits(v: npt.NDArray[np.uint64]) -> npt.NDArray[np.uint64]:
 def _cell_order(points: FloatArray) -> IntArray:
     """An order of the points along a Z-order (Morton) curve through the cells of a
     ``1024^gdim`` grid over their bounding box: the points of a cell, then of its neighbours,
-    come one after the other (they walk the same branches of a tree while it is in cache)."""
+    come one after the other (they walk the same branches of a tree while it is in cache).
+    Stable: equal keys in the given order. The compiled search computes the same order in C
+    (``_Hierarchy.order``); this is its reference."""
     lo = points.min(axis=0)
     span = float((points.max(axis=0) - lo).max())
     if not (np.isfinite(span) and span > 0.0):
@@ -1349,7 +1397,7 @@ def _cell_order(points: FloatArray) -> IntArray:
     key = _spread_bits(cell[:, 0])
     for k in range(1, points.shape[1]):
         key |= _spread_bits(cell[:, k]) << np.uint64(k)
-    return np.argsort(key)
+    return np.argsort(key, kind="stable")
 
 
 def closest_points(
@@ -1391,10 +1439,13 @@ def closest_points(
     ``CONTACT_UFL_SEARCH=numpy``): a bounding-volume hierarchy of axis-aligned boxes over the
     facets' nodes (median splits, 2 to 4 facets a leaf; built once per master shape and
     kept in ``trees`` while no node has moved more than ``0.25 R_max``, its boxes refitted
-    to the current nodes at every call) is walked per point in C, nearer child first,
-    skipping every box (and facet box) farther than ``r = min(d, radius)`` with ``d`` the
-    smallest exact distance met so far (widened by ``1e-9 (r + 2 R_max)``, beyond the
-    tie tolerance): the work follows the point's distance to the surface, not the radius.
+    to the current nodes at every call where they changed; walked four children a step,
+    their boxes in single precision rounded outwards) is walked per point in C, nearest
+    child first, skipping every box (and facet box; of a quadrilateral, also the slab
+    between its corners' heights along its centre normal) farther than ``r = min(d,
+    radius)`` with ``d`` the smallest exact distance met so far (widened by ``1e-9 (r + 2
+    R_max)``, beyond the tie tolerance): the work follows the point's distance to the
+    surface, not the radius.
     The exact projections are those of the NumPy kernels, in the same operations. A point
     with one facet within that reach gets its closest point, normal, proximity and ``M``
     from C; the points with several go through the NumPy tie-break below. Self-contact:
@@ -1458,6 +1509,8 @@ def closest_points(
     radius = float(radius)
     if not radius >= 0.0:
         raise ValueError(f"radius must be non-negative, got {radius}")
+    if not np.isfinite(points).all():
+        raise ValueError(NON_FINITE.format(what="the slave points"))
     npts, fdim = points.shape[0], gdim - 1
     out = Projection(
         facet=np.full(npts, -1, dtype=np.int64),
@@ -1474,7 +1527,7 @@ def closest_points(
     if self_contact is not None:
         _check_self_contact(self_contact, npts, nf, gdim)
         if nf > _DIRECTIONS_MIN:
-            _by_direction(points, nodes, radius, self_contact, out)
+            _by_direction(points, nodes, radius, self_contact, out, trees)
             return out
     _search(points, nodes, radius, trees, self_contact, out)
     return out
@@ -1502,11 +1555,11 @@ def _search_compiled(
     exact projections of the NumPy kernels, in C). A point with one facet there gets its
     closest point from C; :func:`_select` picks among the others' pairs (the tie-break).
     On a master of over ``_SORT`` facets the points are walked in a Z-order of cells
-    (:func:`_cell_order`)."""
+    (:func:`_cell_order`, computed in C)."""
     nodes = np.ascontiguousarray(nodes)
     tree = trees.hierarchy(nodes)
     rule = None if self_contact is None else _self_contact_arrays(self_contact, nodes)
-    order = _cell_order(points) if nodes.shape[0] > _SORT else None
+    order = tree.order(points) if nodes.shape[0] > _SORT else None
     x = np.ascontiguousarray(points if order is None else points[order])
     if rule is not None and order is not None:
         rule = (rule[0][order], rule[1][order], rule[2], rule[3])
@@ -1553,6 +1606,8 @@ def _search_numpy(
     """Fill ``out`` with the closest points of :func:`closest_points` (checked input) by
     KD-trees of the facet centroids and the NumPy kernels."""
     npts, nf = points.shape[0], nodes.shape[0]
+    if not np.isfinite(nodes).all():
+        raise ValueError(NON_FINITE.format(what="the master nodes"))
     master = _Master(nodes, trees)
     # on a large master the points in the order of a grid of cells (neighbours searched
     # together: the KD-tree and the gathers of facet data stay in cache), results scattered
@@ -1602,9 +1657,10 @@ def _tied_pairs(
     ``f``, ``pairs``: the query's result, at most ``_CAP`` a point; the points with more
     queried again with room for all): point rows, facets and projections."""
     fields = ("xi", "dist", "edge", "vertex")
-    kept = (np.arange(_CAP) < count[:, None]) & (count[:, None] > 1)
-    rows, fid = np.nonzero(kept)[0], f[kept]
-    pairs = _Pairs(*(getattr(pairs, k)[kept] for k in fields))
+    several = np.flatnonzero(count > 1)
+    kept = np.arange(_CAP) < count[several, None]
+    rows, fid = several[np.nonzero(kept)[0]], f[several][kept]
+    pairs = _Pairs(*(getattr(pairs, k)[several][kept] for k in fields))
     more = np.flatnonzero(count > _CAP)
     if more.size:
         cap = int(count[more].max())

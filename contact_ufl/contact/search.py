@@ -25,6 +25,7 @@ from contact_ufl.contact import compiled
 from contact_ufl.contact.facets import on_edges
 from contact_ufl.contact.master import MeshMaster, smoothed_normals, smoothed_normals_3d
 from contact_ufl.contact.projection import (
+    NON_FINITE,
     Projection,
     SelfContact,
     TreeCache,
@@ -118,15 +119,22 @@ class ClosestPointSearch:
     def exchange(self, master_nodes: np.ndarray, points: np.ndarray, payload=None):
         """Master facets of all ranks near this rank's ``points`` (bounding-box filter).
 
-        Returns the received facet nodes and their ``payload`` rows.
+        Returns the received facet nodes and their ``payload`` rows. Raises a
+        ``ValueError`` on every rank if a rank's points or master nodes are not all finite
+        (the search would pair them silently).
         """
         comm = self.comm
         box = self.slave.bounding_box(points, comm)
-        boxes = comm.allgather(box)
         n = len(master_nodes)
         payload = np.zeros((n, 0)) if payload is None else payload
         if n:
             lo, hi = master_nodes.min(axis=1), master_nodes.max(axis=1)
+        problem = _non_finite(points, lo if n else None, hi if n else None)
+        gathered = comm.allgather((box, problem))
+        problems = [p for _, p in gathered if p is not None]
+        if problems:
+            raise ValueError(problems[0])
+        boxes = [b for b, _ in gathered]
         sends = []
         for b in boxes:
             if n == 0:
@@ -232,6 +240,17 @@ class ClosestPointSearch:
         neighbourhood[paired] = fans
         self.time += time.perf_counter() - start
         return Pairing(points, proj, gathered, gather, flags, neighbourhood)
+
+
+def _non_finite(points: np.ndarray, lo: np.ndarray | None, hi: np.ndarray | None) -> str | None:
+    """The message naming what is not finite among a rank's slave ``points`` and its master
+    facets' node bounds ``lo``, ``hi`` (a NaN or infinite node makes its facet's bound
+    non-finite), or ``None``."""
+    if not np.isfinite(points).all():
+        return NON_FINITE.format(what="the slave points")
+    if lo is not None and not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+        return NON_FINITE.format(what="the master nodes")
+    return None
 
 
 def fan_columns(columns: np.ndarray, nn: int, facets: np.ndarray) -> np.ndarray:

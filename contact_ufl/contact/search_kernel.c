@@ -10,20 +10,48 @@
  * are those of the NumPy kernels to the last bit.
  *
  * Tree layout: nodes in preorder; node i is a leaf when a[i] < 0 (its facets are
- * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query reads
- * the packed rows of bvh_refit: (lo_0 .. lo_g-1, hi_0 .. hi_g-1, a, b), one cache line in 3D.
+ * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query walks
+ * the rows of bvh_refit (node_t, two 64-byte cache lines), a tree of four children a node:
+ * the row of an internal node holds the boxes of its children's children (of a child that is
+ * a leaf, that leaf; by coordinate, the four side by side for the compiler to vectorise), in
+ * single precision rounded outwards (a box holding the exact one: the pruning is as safe,
+ * the closest points are the same), and their codes (a row index, or -1 - (8 start + count)
+ * for a leaf, EMPTY for an unused slot), so that two levels of the binary tree cost one row. The rows are in preorder; row m holds the root's box and code
+ * as its first child.
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 typedef long long i64;
 
+#define WIDE 4
+#define EMPTY ((i64)1 << 62) /* the code of an unused slot of a row */
+
+typedef struct {
+    float lo[3][WIDE], hi[3][WIDE]; /* the children's boxes, by coordinate then child */
+    i64 child[WIDE];                /* row index, leaf code -1 - (8 start + count), or EMPTY */
+} node_t;
+
+/* the rows of a tree buffer of at least (m + 1) sizeof(node_t) + 128 bytes, 128-byte
+ * aligned (a row in two cache lines that are loaded together) */
+static node_t *rows(const void *buffer)
+{
+    return (node_t *)(((uintptr_t)buffer + 127) & ~(uintptr_t)127);
+}
+
 #define LEAF 4
 #define NEWTON_ITERATIONS 25
 #define NEWTON_TOL 1e-13
 #define STACK 512
+#define AHEAD 16 /* facets ahead whose nodes the refit prefetches */
 #define INLINE static inline __attribute__((always_inline))
+#if defined(__GNUC__) || defined(__clang__)
+#define PREFETCH(address) __builtin_prefetch(address)
+#else
+#define PREFETCH(address) ((void)0)
+#endif
 
 /* -- build ------------------------------------------------------------------------------ */
 
@@ -89,15 +117,50 @@ i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b)
     return count;
 }
 
-INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                    const i64 *a, const i64 *b, double *tree, double *leaf_nodes)
+INLINE float down(double v)
 {
-    int W = 2 * g + 2;
-    double r2max = 0.0;
-    for (i64 j = 0; j < n; j++) {
-        const double *X = nodes + perm[j] * nn * g;
-        double *Y = leaf_nodes + j * nn * g, c[3];
-        for (int q = 0; q < nn * g; q++) Y[q] = X[q];
+    /* the largest float not above v */
+    float f = (float)v;
+    return (double)f > v ? nextafterf(f, -INFINITY) : f;
+}
+
+INLINE float up(double v)
+{
+    float f = (float)v;
+    return (double)f < v ? nextafterf(f, INFINITY) : f;
+}
+
+typedef struct {
+    int g, nn;
+    i64 n;
+    const double *nodes; /* (n, nn, g) as given */
+    const i64 *perm, *a, *b;
+    double *leaf_nodes; /* (n, nn, g) in the order of perm */
+    node_t *T;
+    i64 used; /* rows written */
+    double r2max, finite;
+} fit_t;
+
+/* The facets of a leaf copied in the order of perm, their box (lo, hi), and the largest
+ * facet radius and finiteness so far updated. */
+INLINE void fit_leaf(fit_t *F, i64 i, double *box)
+{
+    const int g = F->g, nn = F->nn, w = nn * g;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double r2max = F->r2max, zero = 0.0;
+    i64 start = -F->a[i] - 1;
+    for (i64 j = start; j < start + F->b[i]; j++) {
+        const double *X = F->nodes + F->perm[j] * w;
+        double *Y = F->leaf_nodes + j * w, c[3];
+        for (int q = 0; q < w; q++) {
+            Y[q] = X[q];
+            zero += 0.0 * X[q]; /* stays 0 unless a coordinate is NaN or infinite */
+        }
+        if (j + AHEAD < F->n) { /* the nodes of a facet a few leaves on: the gather's latency hidden */
+            const double *next = F->nodes + F->perm[j + AHEAD] * w;
+            PREFETCH(next);
+            PREFETCH(next + w - 1);
+        }
         for (int k = 0; k < g; k++) {
             double s = X[k];
             for (int q = 1; q < nn; q++) s += X[q * g + k];
@@ -106,49 +169,101 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
         for (int q = 0; q < nn; q++) {
             double d2 = 0.0;
             for (int k = 0; k < g; k++) {
-                double d = X[q * g + k] - c[k];
+                double v = X[q * g + k], d = v - c[k];
                 d2 += d * d;
+                lo[k] = v < lo[k] ? v : lo[k];
+                hi[k] = v > hi[k] ? v : hi[k];
             }
-            if (d2 > r2max) r2max = d2;
+            r2max = d2 > r2max ? d2 : r2max;
         }
     }
-    for (i64 i = m - 1; i >= 0; i--) {
-        double *B = tree + i * W;
-        for (int k = 0; k < g; k++) {
-            B[k] = INFINITY;
-            B[g + k] = -INFINITY;
-        }
-        B[2 * g] = (double)a[i];
-        B[2 * g + 1] = (double)b[i];
-        if (a[i] < 0) {
-            i64 start = -a[i] - 1;
-            for (i64 j = start; j < start + b[i]; j++) {
-                const double *X = leaf_nodes + j * nn * g;
-                for (int q = 0; q < nn; q++)
-                    for (int k = 0; k < g; k++) {
-                        double v = X[q * g + k];
-                        if (v < B[k]) B[k] = v;
-                        if (v > B[g + k]) B[g + k] = v;
-                    }
-            }
-        } else {
-            const double *L = tree + a[i] * W, *R = tree + b[i] * W;
-            for (int k = 0; k < g; k++) {
-                B[k] = L[k] < R[k] ? L[k] : R[k];
-                B[g + k] = L[g + k] > R[g + k] ? L[g + k] : R[g + k];
-            }
-        }
+    F->r2max = r2max;
+    F->finite += zero;
+    for (int k = 0; k < g; k++) {
+        box[k] = lo[k];
+        box[g + k] = hi[k];
     }
-    return sqrt(r2max);
 }
 
-/* The tree over the current nodes (n, nn, g) of the facets: tree (m, 2 g + 2) holds per tree
- * node its box (lo_0 .. lo_g-1, hi_0 .. hi_g-1; every facet point lies in the convex hull of
- * its nodes) and a, b as doubles; leaf_nodes (n, nn, g) the nodes in the order of perm (the
- * facets of a leaf contiguous). Returns the largest facet radius (node distance from the
- * mean of the nodes), or -1 for an unknown facet kind. */
+INLINE i64 leaf_code(const fit_t *F, i64 i) { return -1 - (8 * (-F->a[i] - 1) + F->b[i]); }
+
+INLINE void store_box(node_t *N, int slot, int g, const double *B)
+{
+    for (int k = 0; k < 3; k++) { /* an unused coordinate (2D) at 0: no distance */
+        N->lo[k][slot] = k < g ? down(B[k]) : 0.0f;
+        N->hi[k][slot] = k < g ? up(B[g + k]) : 0.0f;
+    }
+}
+
+/* The box (lo, hi) of binary node i and its code (leaf code, or the row written for it, its
+ * subtree's rows after it). */
+static i64 fit(fit_t *F, i64 i, double *box)
+{
+    const int g = F->g;
+    if (F->a[i] < 0) {
+        fit_leaf(F, i, box);
+        return leaf_code(F, i);
+    }
+    i64 row = F->used++, grand[WIDE];
+    int slots = 0;
+    for (int c = 0; c < 2; c++) {
+        i64 child = c ? F->b[i] : F->a[i];
+        if (F->a[child] < 0) {
+            grand[slots++] = child;
+        } else {
+            grand[slots++] = F->a[child];
+            grand[slots++] = F->b[child];
+        }
+    }
+    double B[WIDE][6];
+    i64 code[WIDE];
+    for (int c = 0; c < slots; c++) code[c] = fit(F, grand[c], B[c]);
+    node_t *N = F->T + row;
+    for (int k = 0; k < g; k++) {
+        box[k] = INFINITY;
+        box[g + k] = -INFINITY;
+    }
+    for (int c = 0; c < WIDE; c++) {
+        if (c >= slots) {
+            for (int k = 0; k < 3; k++) N->lo[k][c] = N->hi[k][c] = 0.0f;
+            N->child[c] = EMPTY;
+            continue;
+        }
+        store_box(N, c, g, B[c]);
+        N->child[c] = code[c];
+        for (int k = 0; k < g; k++) {
+            box[k] = B[c][k] < box[k] ? B[c][k] : box[k];
+            box[g + k] = B[c][g + k] > box[g + k] ? B[c][g + k] : box[g + k];
+        }
+    }
+    return row;
+}
+
+INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
+                    const i64 *a, const i64 *b, void *tree, double *leaf_nodes)
+{
+    fit_t F = {g, nn, n, nodes, perm, a, b, leaf_nodes, rows(tree), 0, 0.0, 0.0};
+    if (m > 0) {
+        double B[6];
+        i64 code = fit(&F, 0, B);
+        node_t *R = F.T + m;
+        store_box(R, 0, g, B);
+        R->child[0] = code;
+        for (int c = 1; c < WIDE; c++) {
+            for (int k = 0; k < 3; k++) R->lo[k][c] = R->hi[k][c] = 0.0f;
+            R->child[c] = EMPTY;
+        }
+    }
+    return F.finite == 0.0 ? sqrt(F.r2max) : -2.0;
+}
+
+/* The tree over the current nodes (n, nn, g) of the facets: tree (a buffer of (m + 1)
+ * sizeof(node_t) + 128 bytes) gets the rows of the walk (every facet point lies in the box of
+ * its nodes' convex hull); leaf_nodes (n, nn, g) the nodes in the order of perm (the facets
+ * of a leaf contiguous). Returns the largest facet radius (node distance from the mean of
+ * the nodes), -1 for an unknown facet kind, -2 if a coordinate is not finite. */
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, double *tree, double *leaf_nodes)
+                 const i64 *a, const i64 *b, void *tree, double *leaf_nodes)
 {
     if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaf_nodes);
     if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaf_nodes);
@@ -156,15 +271,81 @@ double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64
     return -1.0;
 }
 
-/* Whether the nodes (n, nn, g) are those of the last bvh_refit (leaf_nodes, in the order of
- * perm), to the last bit (stops at the first difference). */
-int same_nodes(i64 n, int width, const double *nodes, const i64 *perm,
-               const double *leaf_nodes)
+/* Whether two arrays of len values are equal to the last bit (memcmp: one sequential sweep,
+ * stopped at the first difference). */
+int same_values(i64 len, const double *p, const double *q)
 {
-    for (i64 j = 0; j < n; j++)
-        if (memcmp(nodes + perm[j] * width, leaf_nodes + j * width, width * sizeof(double)))
-            return 0;
-    return 1;
+    return memcmp(p, q, (size_t)len * sizeof(double)) == 0;
+}
+
+/* -- the order of the points: a Z-order (Morton) curve ----------------------------------- */
+
+INLINE unsigned long long spread_bits(unsigned long long v, int g)
+{
+    /* the 10 low bits of v to every g-th bit (bit i to bit g i) */
+    unsigned long long out = 0;
+    for (int i = 0; i < 10; i++) out |= ((v >> i) & 1ULL) << (g * i);
+    return out;
+}
+
+/* An order (n) of the points x (n, g) along a Z-order curve through the cells of a 1024^g
+ * grid over their bounding box (the cell of a coordinate: min((x - lo) 1024 / span, 1023)
+ * with span the box's largest side): the points of a cell, then of its neighbours, come one
+ * after the other. A radix sort of the keys (stable: equal keys in the given order); the
+ * identity if the span is not positive and finite. Returns 0, or -1 when out of memory. */
+int morton_order(int g, i64 n, const double *x, i64 *order)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (i64 i = 0; i < n; i++)
+        for (int k = 0; k < g; k++) {
+            double v = x[i * g + k];
+            if (v < lo[k]) lo[k] = v;
+            if (v > hi[k]) hi[k] = v;
+        }
+    double span = 0.0;
+    for (int k = 0; k < g; k++)
+        if (hi[k] - lo[k] > span) span = hi[k] - lo[k];
+    for (i64 i = 0; i < n; i++) order[i] = i;
+    if (!(span > 0.0 && span < INFINITY)) return 0;
+    unsigned *key = malloc(2 * n * sizeof(unsigned));
+    i64 *other = malloc(n * sizeof(i64));
+    if (!key || !other) {
+        free(key);
+        free(other);
+        return -1;
+    }
+    for (i64 i = 0; i < n; i++) {
+        unsigned k3 = 0;
+        for (int k = 0; k < g; k++) {
+            double c = (x[i * g + k] - lo[k]) * (1024.0 / span);
+            unsigned long long cell = c < 1023.0 ? (unsigned long long)c : 1023ULL;
+            k3 |= (unsigned)(spread_bits(cell, g) << k);
+        }
+        key[i] = k3;
+    }
+    /* least significant digit first, 10 bits a pass, over the 10 g bits of the keys */
+    unsigned *kin = key, *kout = key + n;
+    i64 *oin = order, *oout = other;
+    for (int shift = 0; shift < 10 * g; shift += 10) {
+        i64 start[1025] = {0};
+        for (i64 i = 0; i < n; i++) start[((kin[i] >> shift) & 1023) + 1]++;
+        for (int d = 0; d < 1024; d++) start[d + 1] += start[d];
+        for (i64 i = 0; i < n; i++) {
+            i64 at = start[(kin[i] >> shift) & 1023]++;
+            kout[at] = kin[i];
+            oout[at] = oin[i];
+        }
+        unsigned *kt = kin;
+        kin = kout;
+        kout = kt;
+        i64 *ot = oin;
+        oin = oout;
+        oout = ot;
+    }
+    if (oin != order) memcpy(order, oin, n * sizeof(i64));
+    free(key);
+    free(other);
+    return 0;
 }
 
 /* The largest coordinate change between two node arrays of len values. */
@@ -409,6 +590,69 @@ INLINE double box_distance2(int g, const double *B, const double *x)
     return s;
 }
 
+/* The squared distances d (WIDE) from x to the children's boxes of row N (box_distance2 of
+ * the single-precision boxes, their bounds exact in double), the children side by side. */
+INLINE void row_distance2(int g, const node_t *N, const double *x, double *d)
+{
+    for (int c = 0; c < WIDE; c++) d[c] = 0.0;
+    for (int k = 0; k < g; k++)
+        for (int c = 0; c < WIDE; c++) {
+            double lo = (double)N->lo[k][c] - x[k], hi = x[k] - (double)N->hi[k][c];
+            double e = lo > hi ? lo : hi;
+            e = e > 0.0 ? e : 0.0;
+            d[c] += e * e;
+        }
+}
+
+/* Whether the surface facet X (kind 1 or 2) is certainly farther than bound from x: the
+ * facet lies in a slab along its normal n at the centre (a triangle in its plane; a bilinear
+ * quadrilateral between its corners' heights, n . X(s, t) being bilinear), so the distance
+ * from x to the slab is a lower bound of its distance. The slab must be beyond bound by a
+ * margin (1e-10 (bound + rmax), far above the round-off of either distance), so that no
+ * facet within bound of x by its exact projection is ever skipped. Used before the
+ * quadrilaterals' projections (several Newton steps); a triangle's costs no more than it. */
+INLINE int beyond_slab(int kind, const double *X, const double *x, double bound, double rmax)
+{
+    double a1[3], a2[3], n[3], h[4] = {0.0}, r[3];
+    for (int k = 0; k < 3; k++) {
+        a1[k] = X[3 + k] - X[k];
+        a2[k] = X[6 + k] - X[k];
+        r[k] = x[k] - X[k];
+    }
+    if (kind == 2) /* the tangents at the centre */
+        for (int k = 0; k < 3; k++) {
+            double c3 = 0.5 * (X[k] - X[3 + k] - X[6 + k] + X[9 + k]);
+            a1[k] += c3;
+            a2[k] += c3;
+        }
+    n[0] = a1[1] * a2[2] - a1[2] * a2[1];
+    n[1] = a1[2] * a2[0] - a1[0] * a2[2];
+    n[2] = a1[0] * a2[1] - a1[1] * a2[0];
+    double lo = 0.0, hi = 0.0, hx = dot3(n, r);
+    for (int q = 1; q < (kind == 2 ? 4 : 3); q++) {
+        double e[3] = {X[3 * q] - X[0], X[3 * q + 1] - X[1], X[3 * q + 2] - X[2]};
+        h[q] = dot3(n, e);
+        lo = h[q] < lo ? h[q] : lo;
+        hi = h[q] > hi ? h[q] : hi;
+    }
+    double excess = hx > hi ? hx - hi : (hx < lo ? lo - hx : 0.0);
+    double margin = bound + 1e-10 * (bound + rmax);
+    return excess * excess > margin * margin * dot3(n, n);
+}
+
+/* Start loading what the walk reads of a child (code as in node_t): its row, or the nodes
+ * of the leaf's facets. */
+INLINE void prefetch_child(const node_t *T, const double *leaf_nodes, int w, i64 code)
+{
+    if (code >= 0) {
+        PREFETCH(T + code);
+        PREFETCH((const char *)(T + code) + 64);
+    } else {
+        const double *X = leaf_nodes + ((-code - 1) >> 3) * w;
+        for (int q = 0; q < ((-code - 1) & 7) * w; q += 8) PREFETCH(X + q);
+    }
+}
+
 /* the distance below which a facet may tie with the closest one at distance v (wider than
  * the tie tolerance 1e-10 (v + 2 R_f) of projection._select) */
 INLINE double reach(double v, double rmax) { return v + 1e-9 * (v + 2.0 * rmax); }
@@ -522,25 +766,27 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
     return s < 0.0;
 }
 
-/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose exact distance is within reach() of the
- * smallest one, if that smallest one is within reach(radius). count[p] is their number; up
- * to cap of them are written at p * cap of f, xi (fdim per pair), dist, edge, vertex
- * (projection._Pairs). Where one facet is within that reach (count 1) and y is not NULL,
- * the fields of its closest point are written at index[p] (p if index is NULL) of facet,
- * oxi, y, normal, gap, distance and sliding (a projection.Projection; count set to 0 and
- * the placeholders written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible facets, with
- * pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its normal,
- * fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
+/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose
+ * exact distance is within reach() of the smallest one, if that smallest one is within
+ * reach(radius). count[p] is their number; up to cap of them are written at p * cap of f,
+ * xi (fdim per pair), dist, edge, vertex (projection._Pairs), unless y is given and the count
+ * is 1: where one facet is within that reach and y is not NULL, the fields of its closest
+ * point are written instead at row index[p] (p if index is NULL) of facet, oxi, y, normal,
+ * gap, distance and sliding (a projection.Projection; count set to 0 and the placeholders
+ * written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible
+ * facets, with pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its
+ * normal, fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
  * Returns the number of exact projections made, or -1 when out of memory. */
 INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const double *tree, double rmax, i64 npts,
+              const void *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
               double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
               double *oxi, double *y, double *normal, double *gap, double *distance,
               double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
               const i64 *fnodes, const double *axis)
 {
-    int fdim = g - 1, W = 2 * g + 2;
+    int fdim = g - 1;
+    const node_t *T = rows(tree);
     i64 room = 64, projected = 0;
     hit_t *hits = malloc(room * sizeof(hit_t));
     if (!hits) return -1;
@@ -553,39 +799,50 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
         i64 nh = 0, top = 0;
         count[p] = 0;
         if (m == 0) continue;
-        double d0 = box_distance2(g, tree, xp);
+        double root[WIDE];
+        row_distance2(g, T + m, xp, root);
+        double d0 = root[0];
         if (d0 <= bound2) {
-            stack[0] = 0;
+            stack[0] = T[m].child[0];
             lower[0] = d0;
             top = 1;
         }
         while (top > 0) {
             top--;
-            i64 i = stack[top];
+            i64 code = stack[top];
             if (lower[top] > bound2) continue;
-            const double *T = tree + i * W;
-            i64 ai = (i64)T[2 * g], bi = (i64)T[2 * g + 1];
-            if (ai >= 0) {
-                double dl = box_distance2(g, tree + ai * W, xp);
-                double dr = box_distance2(g, tree + bi * W, xp);
-                i64 near = dl <= dr ? ai : bi, far = dl <= dr ? bi : ai;
-                double dfar = dl <= dr ? dr : dl, dnear = dl <= dr ? dl : dr;
-                if (top + 2 > STACK) {
+            if (code >= 0) {
+                /* the children within the bound, pushed farthest first */
+                const node_t *N = T + code;
+                double d[WIDE], ds[WIDE];
+                i64 c[WIDE];
+                int k = 0;
+                row_distance2(g, N, xp, ds);
+                for (int slot = 0; slot < WIDE; slot++) {
+                    if (N->child[slot] == EMPTY || ds[slot] > bound2) continue;
+                    int at = k++; /* insertion by decreasing distance */
+                    while (at > 0 && d[at - 1] < ds[slot]) {
+                        d[at] = d[at - 1];
+                        c[at] = c[at - 1];
+                        at--;
+                    }
+                    d[at] = ds[slot];
+                    c[at] = N->child[slot];
+                }
+                if (top + k > STACK) {
                     free(hits);
                     return -1;
                 }
-                if (dfar <= bound2) {
-                    stack[top] = far;
-                    lower[top++] = dfar;
-                }
-                if (dnear <= bound2) {
-                    stack[top] = near;
-                    lower[top++] = dnear;
+                for (int j = 0; j < k; j++) {
+                    stack[top] = c[j];
+                    lower[top++] = d[j];
+                    prefetch_child(T, leaf_nodes, nn * g, c[j]);
                 }
                 continue;
             }
-            i64 start = -ai - 1;
-            for (i64 j = start; j < start + bi; j++) {
+            i64 start = (-code - 1) >> 3, end = start + ((-code - 1) & 7);
+            PREFETCH(perm + start);
+            for (i64 j = start; j < end; j++) {
                 const double *X = leaf_nodes + j * nn * g;
                 {  /* the facet's box before its exact projection */
                     double B[6];
@@ -599,6 +856,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                     }
                     if (box_distance2(g, B, xp) > bound2) continue;
                 }
+                if (kind == 2 && beyond_slab(kind, X, xp, bound, rmax)) continue;
                 if (pnodes && !admissible(g, mp, pnodes + p * mp, pnormal + p * g, mf,
                                           fnodes + perm[j] * mf, axis + perm[j] * g))
                     continue;
@@ -636,20 +894,22 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
             }
         }
         i64 k = 0, last = 0;
-        for (i64 h = 0; h < nh; h++) {
-            if (hits[h].q.dist > bound) continue;
-            last = h;
-            if (k < cap) {
-                i64 o = p * cap + k;
-                f[o] = perm[hits[h].j];
-                for (int j = 0; j < fdim; j++) xi[o * fdim + j] = hits[h].q.xi[j];
-                dist[o] = hits[h].q.dist;
-                edge[o] = hits[h].q.edge;
-                vertex[o] = (unsigned char)hits[h].q.vertex;
+        for (i64 h = 0; h < nh; h++)
+            if (hits[h].q.dist <= bound) {
+                last = h;
+                k++;
             }
-            k++;
-        }
         count[p] = k;
+        /* the pairs, unless the point's one pair is finished below (their rows untouched) */
+        for (i64 h = 0, c = 0; h < nh && c < cap && (k > 1 || !y); h++) {
+            if (hits[h].q.dist > bound) continue;
+            i64 o = p * cap + c++;
+            f[o] = perm[hits[h].j];
+            for (int j = 0; j < fdim; j++) xi[o * fdim + j] = hits[h].q.xi[j];
+            dist[o] = hits[h].q.dist;
+            edge[o] = hits[h].q.edge;
+            vertex[o] = (unsigned char)hits[h].q.vertex;
+        }
         if (k == 1 && y) {
             /* one facet within the tie reach: the closest point, no tie-break */
             const pair_t *q = &hits[last].q;
@@ -661,13 +921,13 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                 for (int j = 0; j < fdim; j++) oxi[o * fdim + j] = q->xi[j];
             } else {
                 count[p] = 0;
-                for (int k2 = 0; k2 < g; k2++) {  /* the placeholders of an unpaired point */
-                    y[o * g + k2] = xp[k2];
-                    normal[o * g + k2] = 0.0;
+                for (int c = 0; c < g; c++) {  /* the placeholders of an unpaired point */
+                    y[o * g + c] = xp[c];
+                    normal[o * g + c] = 0.0;
                 }
                 gap[o] = -INFINITY;
                 distance[o] = INFINITY;
-                for (int j = 0; j < fdim * fdim; j++) sliding[o * fdim * fdim + j] = 0.0;
+                for (int c = 0; c < fdim * fdim; c++) sliding[o * fdim * fdim + c] = 0.0;
             }
         }
     }
@@ -676,7 +936,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
 }
 
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const double *tree, double rmax, i64 npts,
+              const void *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
               double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
               double *oxi, double *y, double *normal, double *gap, double *distance,
