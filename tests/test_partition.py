@@ -1,5 +1,7 @@
 """The partition of a multi-body mesh: every body split over all the ranks (issue 12, item 5)."""
 
+from pathlib import Path
+
 import dolfinx
 import numpy as np
 import numpy.typing as npt
@@ -7,10 +9,14 @@ import pytest
 import scipy.sparse
 from mpi4py import MPI
 
+from contact_ufl.contact import ContactPair
 from contact_ufl.errors import ContactInputError
 from contact_ufl.gmshio import PARTITION_VARIABLE
+from contact_ufl.materials import LinearElastic
 from contact_ufl.partition import body_partitioner, surface_cells
 from contact_ufl.problem import ContactProblem
+from contact_ufl.scene import Body, Scene
+from contact_ufl.verification.geometries import sphere_on_block_3d
 from contact_ufl.verification.scenes import hertz_3d, patch
 
 PRESSURE = 0.01
@@ -176,3 +182,27 @@ def test_hertz_3d_slave_points_are_shared_evenly_and_answers_unchanged(monkeypat
         return comm.allreduce(low, MPI.MIN), comm.allreduce(high, MPI.MAX), u
 
     assert np.allclose(summary(bodies), summary(graph), rtol=1e-10)
+
+
+def test_scene_from_gmsh_splits_its_pairs_surfaces_evenly(tmp_path):
+    """``Scene.from_gmsh`` hands its pairs' facet groups to the partition: on the coarse 3D
+    Hertz mesh read back from a file, every rank owns an equal share (within 10%) of the
+    slave and of the master facets (counted by the owner of their cell)."""
+    comm = MPI.COMM_WORLD
+    path = Path(comm.bcast(str(tmp_path), root=0)) / "sphere_on_block.msh"
+    sphere_on_block_3d(h_contact=0.05, h_far=0.25, master_ratio=1.0, msh_file=path, comm=comm)
+    material = LinearElastic(1.0, 0.3)
+    scene = Scene.from_gmsh(
+        path,
+        bodies=[Body("sphere", material, "sphere"), Body("block", material, "block")],
+        contacts=[ContactPair("sphere_contact", "block_contact")],
+    )
+    mesh = scene.mesh
+    mesh.topology.create_connectivity(2, 3)
+    f2c = mesh.topology.connectivity(2, 3)
+    owned = mesh.topology.index_map(3).size_local
+    for name in ("sphere_contact", "block_contact"):
+        cells = f2c.array[f2c.offsets[scene.facet_tags.find(scene.tags[name])]]
+        count = np.array(comm.allgather(int(np.sum(cells < owned))))
+        assert count.sum() > 50, (name, count)
+        assert count.min() >= 0.9 * count.mean() and count.max() <= 1.1 * count.mean(), count
