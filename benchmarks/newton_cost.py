@@ -42,7 +42,9 @@ slave points and its share of the rows and nonzeros of ``K`` and ``T``: where th
 ``--partition graph`` distributes the meshes with DOLFINx's graph partition (whole bodies on
 ranks) instead of the default that splits every body over all ranks
 (:mod:`contact_ufl.partition`); the records say which (``partition``).
-``--option`` passes PETSc options to the solver (e.g. ``mat_mumps_icntl_7=3``); ``--dump
+``--option`` passes PETSc options to the solver (e.g. ``mat_mumps_icntl_7=3``; with ``pc_type
+fieldsplit`` the bulk case, which has no multipliers, takes the ``fieldsplit_u_pc_*`` options
+as its preconditioner: GAMG on the whole for README's field split); ``--dump
 FILE`` writes the contact tangent at the end of the solve for ``benchmarks/linear_solvers.py``
 (orderings, MUMPS options, iterative solvers on it).
 
@@ -244,7 +246,7 @@ def run(
     """Solve one scene and return its record (``glue``: with the glued baseline, its
     factorisations repeated ``glue`` times; ``dump``: write the contact tangent there)."""
     scene, steps, t_end = make(size, contact)
-    options = options or {}
+    options = (options or {}) if contact else bulk_options(options or {})
     problem = ContactProblem(scene, verbose=False, petsc_options=options)
     timings = problem.solver.timings
     timings.reset()
@@ -287,6 +289,20 @@ def run(
         J = problem.solver.evaluate_jacobian(problem.solver.x)
         record["tangent"] = _factorise(J, options, glue)
     return record
+
+
+def bulk_options(options: dict) -> dict:
+    """The solver options of the bulk case: a ``fieldsplit`` (displacements ``u``, multipliers
+    ``lambda``) has one field without contact, so its ``u`` split's solver becomes the whole
+    preconditioner (e.g. GAMG); other options are kept."""
+    if options.get("pc_type") != "fieldsplit":
+        return options
+    kept = {k: v for k, v in options.items() if not k.startswith(("pc_", "fieldsplit_"))}
+    prefix = "fieldsplit_u_pc_"
+    return {
+        **kept,
+        **{k[len("fieldsplit_u_") :]: v for k, v in options.items() if k.startswith(prefix)},
+    }
 
 
 def fastest(records: list[dict]) -> dict:

@@ -20,7 +20,7 @@ on every rank.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -155,6 +155,7 @@ def read_gmsh(
     require_names: bool = False,
     tdim: int | None = None,
     partition: str | None = None,
+    contact_surfaces: Sequence[str | int] = (),
 ) -> MeshData:
     """Read a mesh and its physical groups from a ``.msh`` file or a live gmsh model.
 
@@ -183,6 +184,11 @@ def read_gmsh(
         contact surface (:mod:`contact_ufl.partition`); ``"graph"`` is DOLFINx's partition
         of the whole mesh, which puts whole bodies on ranks. Default: the environment
         variable ``CONTACT_UFL_PARTITION``, else ``"bodies"``.
+    contact_surfaces
+        The facet groups (names or tags) of the contact pairs: with ``"bodies"`` every rank
+        also gets an equal share of the cells along them (of the slave points and master
+        facets, where the contact work is). Names and tags the mesh has no facet group of are
+        passed over (a scene checks its pairs' names itself).
 
     Returns
     -------
@@ -204,9 +210,8 @@ def read_gmsh(
     mine = comm.rank == rank
 
     def distribute(model: Any, origin: str) -> MeshData:
-        return _distribute(
-            model, comm, rank, gdim, (ghost_mode, partition), require_names, tdim, origin
-        )
+        how = (ghost_mode, partition, tuple(contact_surfaces))
+        return _distribute(model, comm, rank, gdim, how, require_names, tdim, origin)
 
     if not is_file:
         return distribute(source if mine else None, "the gmsh model")
@@ -240,7 +245,7 @@ def _distribute(
     comm: MPI.Comm,
     rank: int,
     gdim: int | None,
-    how: tuple[dolfinx.mesh.GhostMode, str],
+    how: tuple[dolfinx.mesh.GhostMode, str, tuple[str | int, ...]],
     require_names: bool,
     tdim: int | None,
     origin: str,
@@ -255,7 +260,10 @@ def _distribute(
     error, model_dim, groups, name = comm.bcast(summary, root=rank)
     _raise_from(comm, rank, error)
     gdim = model_dim if gdim is None else gdim
-    partitioner = cell_partitioner(how[1], how[0])
+    facets = None
+    if comm.rank == rank and how[1] == "bodies":
+        facets = _facet_vertices(model, model_dim - 1, _facet_groups(groups, model_dim, how[2]))
+    partitioner = cell_partitioner(how[1], how[0], facets)
     data = dolfinx.io.gmsh.model_to_mesh(
         model if comm.rank == rank else None, comm, rank, gdim=gdim, partitioner=partitioner
     )
@@ -265,6 +273,36 @@ def _distribute(
         empty = np.empty(0, dtype=np.int32)
         facet_tags = dolfinx.mesh.meshtags(data.mesh, model_dim - 1, empty, empty)
     return MeshData(data.mesh, data.cell_tags, facet_tags, groups)
+
+
+def _facet_groups(groups: Groups, dim: int, surfaces: tuple[str | int, ...]) -> list[int]:
+    """The tags of the facet groups among ``surfaces`` (names or tags; others passed over)."""
+    tags = []
+    for key in surfaces:
+        if isinstance(key, str):
+            if key in groups and groups[key][0] == dim - 1:
+                tags.append(groups[key][1])
+        elif isinstance(key, int | np.integer):
+            tags.append(int(key))
+    return sorted(set(tags))
+
+
+def _facet_vertices(model: Any, fdim: int, tags: list[int]) -> list[npt.NDArray[np.int64]]:
+    """The vertices (gmsh node tags - 1: the mesh's input numbering) of the facets of the
+    physical groups ``tags`` of dimension ``fdim``, one ``(n, k)`` array per facet shape."""
+    known = {int(t) for d, t in model.getPhysicalGroups() if d == fdim}
+    by_width: dict[int, list[npt.NDArray[np.int64]]] = {}
+    for tag in tags:
+        if tag not in known:
+            continue
+        for entity in model.getEntitiesForPhysicalGroup(fdim, tag):
+            types, _, nodes = model.mesh.getElements(fdim, int(entity))
+            for kind, block in zip(types, nodes, strict=True):
+                properties = model.mesh.getElementProperties(kind)
+                count, corners = int(properties[3]), int(properties[5])
+                vertices = np.asarray(block, dtype=np.int64).reshape(-1, count)[:, :corners] - 1
+                by_width.setdefault(corners, []).append(vertices)
+    return [np.concatenate(blocks) for blocks in by_width.values()]
 
 
 def _inspect(
@@ -343,12 +381,13 @@ def generate_mesh(
     ghost_mode: dolfinx.mesh.GhostMode = dolfinx.mesh.GhostMode.shared_facet,
     rank: int = 0,
     partition: str | None = None,
+    contact_surfaces: Sequence[str] = (),
 ) -> MeshData:
     """Run ``build`` (geometry, size fields, named groups, meshing) in a fresh gmsh model on
     rank ``rank`` and distribute the mesh (:func:`read_gmsh`).
 
     Errors of ``build`` on that rank are raised on every rank. With ``msh_file`` the gmsh
-    mesh is also written there. ``partition``: see :func:`read_gmsh`.
+    mesh is also written there. ``partition``, ``contact_surfaces``: see :func:`read_gmsh`.
     """
     error = None
     with _session_on(comm, rank, name, options):
@@ -366,5 +405,12 @@ def generate_mesh(
             raise RuntimeError(f"building the gmsh model '{name}' failed: {error}")
         model = gmsh.model if comm.rank == rank else None
         return read_gmsh(
-            model, comm, gdim, rank, ghost_mode, require_names=True, partition=partition
+            model,
+            comm,
+            gdim,
+            rank,
+            ghost_mode,
+            require_names=True,
+            partition=partition,
+            contact_surfaces=contact_surfaces,
         )

@@ -8,6 +8,17 @@ most of the tangent. :func:`body_partitioner` partitions each connected componen
 into ``nparts`` parts with the graph partitioner (SCOTCH by default), so every body is split
 over all the ranks and its share of the contact surfaces with it.
 
+A body's cells split evenly need not split its contact surface evenly (the graph partitioner
+knows nothing of it: on the 3D Hertz sphere one rank got 962 slave facets, the other 492), and
+the contact work (search, contact assembly, the gathered rows of ``T``, PtAP) goes with the
+surface. Given the cells that touch a contact surface (:func:`surface_cells`, from the contact
+facets of the mesh being read), each component is split in two stages: its surface cells
+first, into equal parts (the graph partitioner on the graph joining surface cells within two
+facet steps of each other), then the rest grown from them breadth first, one layer per round,
+every part up to an equal share of the component's cells (:func:`_grow`). Every rank then
+holds an equal share of each body and of its contact surface. (DOLFINx's graph partitioners
+take no vertex weights, so a two-constraint split cannot be asked of them directly.)
+
 The dual graph is gathered on one rank (a mesh read from gmsh is there already), partitioned
 there one component at a time, and each rank gets back the destinations of its cells: the
 owner first, then (with ghosting) the ranks of the cells that share a facet with it.
@@ -18,6 +29,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import basix
 import dolfinx
 import dolfinx.cpp
 import dolfinx.graph
@@ -27,7 +39,7 @@ import scipy.sparse
 import scipy.sparse.csgraph
 from mpi4py import MPI
 
-__all__ = ["PARTITIONS", "body_partitioner", "cell_partitioner"]
+__all__ = ["PARTITIONS", "body_partitioner", "cell_partitioner", "surface_cells"]
 
 #: The partitions :func:`cell_partitioner` knows: each body over all ranks, or DOLFINx's.
 PARTITIONS = ("bodies", "graph")
@@ -43,13 +55,19 @@ def _default_graph_partitioner() -> GraphPartitioner:
     raise RuntimeError("this DOLFINx build has no graph partitioner")
 
 
-def body_partitioner(graph_partitioner: GraphPartitioner | None = None) -> GraphPartitioner:
+def body_partitioner(
+    graph_partitioner: GraphPartitioner | None = None,
+    on_surface: npt.NDArray[np.bool_] | None = None,
+) -> GraphPartitioner:
     """A graph partitioner that splits each connected component over all the parts.
 
     Parameters
     ----------
     graph_partitioner
         Partitions one component (called on ``MPI.COMM_SELF``); default SCOTCH.
+    on_surface
+        This rank's nodes (cells, in the order of the graph's nodes) that touch a contact
+        surface: each component's share of them is split evenly too. Default: none.
 
     Returns
     -------
@@ -62,13 +80,17 @@ def body_partitioner(graph_partitioner: GraphPartitioner | None = None) -> Graph
     def partition(comm: MPI.Comm, nparts: int, graph: Any, ghosting: bool) -> Any:
         offsets = np.asarray(graph.offsets, dtype=np.int64)
         edges = np.asarray(graph.array, dtype=np.int64)
-        gathered = comm.gather((offsets, edges), root=0)
+        marks = np.zeros(len(offsets) - 1, dtype=bool) if on_surface is None else on_surface
+        if len(marks) != len(offsets) - 1:
+            raise ValueError(f"on_surface has {len(marks)} entries for {len(offsets) - 1} cells")
+        gathered = comm.gather((offsets, edges, marks), root=0)
         pieces = None
         if comm.rank == 0:
-            sizes = [len(o) - 1 for o, _ in gathered]
-            degrees = np.concatenate([np.diff(o) for o, _ in gathered])
-            adjacency = _csr(np.concatenate([e for _, e in gathered]), degrees)
-            owner = _split_components(adjacency, nparts, split)
+            sizes = [len(o) - 1 for o, _, _ in gathered]
+            degrees = np.concatenate([np.diff(o) for o, _, _ in gathered])
+            adjacency = _csr(np.concatenate([e for _, e, _ in gathered]), degrees)
+            surface = np.concatenate([m for _, _, m in gathered]).astype(bool)
+            owner = _split_components(adjacency, nparts, split, surface)
             data, offs = _destinations(adjacency, owner, nparts, ghosting)
             bounds = np.concatenate([[0], np.cumsum(sizes)])
             pieces = [
@@ -91,9 +113,13 @@ def _csr(edges: npt.NDArray[np.int64], degrees: npt.NDArray[np.int64]) -> scipy.
 
 
 def _split_components(
-    adjacency: scipy.sparse.csr_array, nparts: int, split: GraphPartitioner
+    adjacency: scipy.sparse.csr_array,
+    nparts: int,
+    split: GraphPartitioner,
+    on_surface: npt.NDArray[np.bool_],
 ) -> npt.NDArray[np.int32]:
-    """The part of each node: every connected component split into ``nparts`` parts."""
+    """The part of each node: every connected component split into ``nparts`` parts (and its
+    nodes ``on_surface`` evenly too)."""
     count, label = scipy.sparse.csgraph.connected_components(adjacency, directed=False)
     owner = np.zeros(adjacency.shape[0], dtype=np.int32)
     order = np.argsort(label, kind="stable")
@@ -106,12 +132,78 @@ def _split_components(
             shift += 1
             continue
         sub = adjacency[nodes][:, nodes].tocsr()
-        local = dolfinx.cpp.graph.AdjacencyList_int64(
-            np.asarray(sub.indices, dtype=np.int64), np.asarray(sub.indptr, dtype=np.int32)
-        )
-        parts = np.asarray(split(MPI.COMM_SELF, nparts, local, False).array, dtype=np.int32)
+        surface = np.flatnonzero(on_surface[nodes])
+        if len(surface) < 2 * nparts:
+            parts = _split(sub, nparts, split)
+        else:
+            parts = _split_surface_first(sub, surface, nparts, split)
         owner[nodes] = (parts + shift) % nparts  # rotate: the bodies' remainders spread
         shift += 1
+    return owner
+
+
+def _split(
+    graph: scipy.sparse.csr_array, nparts: int, split: GraphPartitioner
+) -> npt.NDArray[np.int32]:
+    """The graph partitioner's parts of a (serial) graph."""
+    local = dolfinx.cpp.graph.AdjacencyList_int64(
+        np.asarray(graph.indices, dtype=np.int64), np.asarray(graph.indptr, dtype=np.int32)
+    )
+    return np.asarray(split(MPI.COMM_SELF, nparts, local, False).array, dtype=np.int32)
+
+
+def _split_surface_first(
+    graph: scipy.sparse.csr_array,
+    surface: npt.NDArray[np.int64],
+    nparts: int,
+    split: GraphPartitioner,
+) -> npt.NDArray[np.int32]:
+    """Parts of one component: the ``surface`` nodes split evenly first (the graph
+    partitioner on the graph joining surface nodes within two steps of each other: the
+    cells along a surface often share only an edge), the other nodes grown from them."""
+    touching = graph[surface].astype(np.int32)
+    near = (touching @ graph.astype(np.int32) + touching)[:, surface].tocsr()
+    near.setdiag(0)
+    near.eliminate_zeros()
+    owner = np.full(graph.shape[0], -1, dtype=np.int32)
+    owner[surface] = _split(near, nparts, split)
+    return _grow(graph, owner, nparts)
+
+
+def _grow(
+    graph: scipy.sparse.csr_array, owner: npt.NDArray[np.int32], nparts: int
+) -> npt.NDArray[np.int32]:
+    """Assign the unassigned nodes (``owner < 0``) breadth first from the assigned ones, one
+    layer per round, every part up to an equal share of the nodes.
+
+    A node claimed by several parts in a round goes to the smallest of them. Nodes that no
+    part below its share reaches (cut off by full parts) fill those parts last.
+    """
+    owner = owner.copy()
+    share = -(-len(owner) // nparts)
+    sizes = np.bincount(owner[owner >= 0], minlength=nparts)
+    frontier = np.flatnonzero(owner >= 0)
+    while len(frontier) > 0:
+        step = graph[frontier].tocoo()
+        nodes, parts = step.col.astype(np.int64), owner[frontier[step.row]]
+        free = owner[nodes] < 0
+        nodes, parts = nodes[free], parts[free]
+        order = np.lexsort((parts, sizes[parts], nodes))  # by node, then the smaller part
+        nodes, parts = nodes[order], parts[order]
+        first = np.ones(len(nodes), dtype=bool)
+        first[1:] = nodes[1:] != nodes[:-1]
+        nodes, parts = nodes[first], parts[first]
+        order = np.argsort(parts, kind="stable")
+        nodes, parts = nodes[order], parts[order]
+        room = np.maximum(share - sizes, 0)
+        keep = _rank_within(parts.astype(np.int64)) < room[parts]
+        nodes, parts = nodes[keep], parts[keep]
+        owner[nodes] = parts
+        sizes += np.bincount(parts, minlength=nparts)
+        frontier = nodes
+    rest = np.flatnonzero(owner < 0)
+    room = np.maximum(share - sizes, 0)
+    owner[rest] = np.repeat(np.arange(nparts, dtype=np.int32), room)[: len(rest)]
     return owner
 
 
@@ -146,8 +238,79 @@ def _rank_within(sorted_keys: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
     return np.arange(len(sorted_keys)) - run
 
 
-def cell_partitioner(partition: str, ghost_mode: dolfinx.mesh.GhostMode) -> Callable[..., Any]:
-    """The cell partitioner of ``partition`` (one of :data:`PARTITIONS`)."""
+def surface_cells(
+    cell_types: list[Any], cells: list[npt.NDArray[np.int64]], facets: list[npt.NDArray[np.int64]]
+) -> npt.NDArray[np.bool_]:
+    """The cells that have a facet among ``facets``.
+
+    Parameters
+    ----------
+    cell_types
+        DOLFINx cell type of each block of ``cells``.
+    cells
+        The cells' vertices (input numbering, DOLFINx's local vertex order), one flat array
+        per cell type: what a cell partitioner is given.
+    facets
+        Facets by their vertices (the same numbering), one ``(n, k)`` array per facet shape.
+
+    Returns
+    -------
+    numpy.ndarray
+        One flag per cell, the blocks in order.
+    """
+    flags = []
+    for cell_type, block in zip(cell_types, cells, strict=True):
+        nv = dolfinx.cpp.mesh.cell_num_vertices(cell_type)
+        vertices = np.asarray(block, dtype=np.int64).reshape(-1, nv)
+        tdim = dolfinx.cpp.mesh.cell_dim(cell_type)
+        hit = np.zeros(len(vertices), dtype=bool)
+        for local in basix.topology(basix.CellType[cell_type.name])[tdim - 1]:
+            keys = np.sort(vertices[:, local], axis=1)
+            for table in facets:
+                if table.shape[1] == len(local) and len(table) > 0:
+                    hit |= _rows_in(keys, np.sort(table, axis=1))
+        flags.append(hit)
+    return np.concatenate(flags) if flags else np.zeros(0, dtype=bool)
+
+
+def _rows_in(rows: npt.NDArray[np.int64], table: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
+    """Which rows of ``rows`` are rows of ``table``."""
+    _, label = np.unique(np.concatenate([table, rows]), axis=0, return_inverse=True)
+    label = label.reshape(-1)
+    return np.isin(label[len(table) :], label[: len(table)])
+
+
+def cell_partitioner(
+    partition: str,
+    ghost_mode: dolfinx.mesh.GhostMode,
+    contact_facets: list[npt.NDArray[np.int64]] | None = None,
+) -> Callable[..., Any]:
+    """The cell partitioner of ``partition`` (one of :data:`PARTITIONS`).
+
+    Parameters
+    ----------
+    partition
+        ``"bodies"`` (:func:`body_partitioner`) or ``"graph"`` (DOLFINx's).
+    ghost_mode
+        Ghost mode of the mesh.
+    contact_facets
+        ``"bodies"``: the contact facets by their vertices (input numbering, one ``(n, k)``
+        array per facet shape) on the rank that holds the cells; the cells touching them are
+        split evenly too. Default: none.
+
+    Returns
+    -------
+    Callable
+        ``(comm, nparts, cell_types, cells) -> destinations``, for
+        :func:`dolfinx.mesh.create_mesh`.
+    """
     if partition == "graph":
         return dolfinx.mesh.create_cell_partitioner(ghost_mode, 2)
-    return dolfinx.mesh.create_cell_partitioner(body_partitioner(), ghost_mode, 2)
+    facets = contact_facets or []
+
+    def partition_cells(comm: MPI.Comm, nparts: int, cell_types: list, cells: list) -> Any:
+        split = body_partitioner(on_surface=surface_cells(cell_types, cells, facets))
+        by_graph = dolfinx.cpp.mesh.create_cell_partitioner(split, ghost_mode, 2)
+        return by_graph(comm, nparts, cell_types, cells)
+
+    return partition_cells

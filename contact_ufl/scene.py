@@ -634,7 +634,13 @@ def _read(source, parts, contacts, comm, gdim, rank, ghost_mode) -> MeshData:
         ghost_mode=ghost_mode,
         require_names=any(isinstance(k, str) for k in keys),
         tdim=tdim,
+        contact_surfaces=[k for c in contacts for k in (c.slave, c.master) if _is_tag(k)],
     )
+
+
+def _is_tag(key: Any) -> bool:
+    """Whether ``key`` names a physical group (a name or an integer tag, not an obstacle)."""
+    return isinstance(key, str | int | np.integer)
 
 
 def _validate_load(comm: MPI.Comm, load: Load, gdim: int, where: str) -> None:

@@ -1,16 +1,23 @@
 """The partition of a multi-body mesh: every body split over all the ranks (issue 12, item 5)."""
 
+from pathlib import Path
+
 import dolfinx
 import numpy as np
+import numpy.typing as npt
 import pytest
 import scipy.sparse
 from mpi4py import MPI
 
+from contact_ufl.contact import ContactPair
 from contact_ufl.errors import ContactInputError
 from contact_ufl.gmshio import PARTITION_VARIABLE
-from contact_ufl.partition import body_partitioner
+from contact_ufl.materials import LinearElastic
+from contact_ufl.partition import body_partitioner, surface_cells
 from contact_ufl.problem import ContactProblem
-from contact_ufl.verification.scenes import patch
+from contact_ufl.scene import Body, Scene
+from contact_ufl.verification.geometries import sphere_on_block_3d
+from contact_ufl.verification.scenes import hertz_3d, patch
 
 PRESSURE = 0.01
 TIGHT = {"snes_rtol": 1e-13, "snes_atol": 1e-15}
@@ -60,6 +67,63 @@ def test_body_partitioner_splits_every_body(nparts):
         assert np.array_equal(data[offsets[cell] + 1 : offsets[cell + 1]], expected)
 
 
+def contact_cells(scene) -> dict[int, npt.NDArray[np.int32]]:
+    """The cells (serial mesh) of each contact facet group of the scene's pair."""
+    f2c = scene.mesh.topology.connectivity(scene.mesh.topology.dim - 1, scene.mesh.topology.dim)
+    pair = scene.contacts[0]
+    tags = scene.facet_tags
+    return {
+        key: f2c.array[f2c.offsets[tags.indices[tags.values == key]]]
+        for key in (pair.slave, pair.master)
+    }
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize("nparts", [2, 3])
+def test_contact_surfaces_are_split_evenly(nparts):
+    """3D Hertz, coarse: the plain bodies split (each body cut where SCOTCH cuts it least)
+    puts the ball's contact cap on one part and the block's contact face on another; with
+    the contact cells marked, every part gets an equal share (within 10%) of each body and
+    of each contact surface."""
+    scene = hertz_3d(h_contact=0.05).scene
+    graph = dual_graph(scene.mesh)
+    adjacency = dolfinx.cpp.graph.AdjacencyList_int64(
+        graph.indices.astype(np.int64), graph.indptr.astype(np.int32)
+    )
+    surfaces = contact_cells(scene)
+    on_surface = np.zeros(graph.shape[0], dtype=bool)
+    for cells in surfaces.values():
+        on_surface[cells] = True
+
+    def shares(partitioner) -> list[npt.NDArray[np.int64]]:
+        dest = partitioner(MPI.COMM_SELF, nparts, adjacency, False)
+        owner = np.asarray(dest.array)
+        bodies = [scene.cell_tags.find(b.tag) for b in scene.bodies]
+        return [np.bincount(owner[c], minlength=nparts) for c in (*bodies, *surfaces.values())]
+
+    plain = shares(body_partitioner())
+    assert max(c.max() / c.mean() for c in plain[2:]) > 1.5, plain  # the case worth testing
+    for count in shares(body_partitioner(on_surface=on_surface)):
+        assert count.max() <= 1.1 * count.mean() and count.min() >= 0.9 * count.mean(), count
+
+
+@pytest.mark.serial
+def test_surface_cells_are_the_cells_of_the_contact_facets():
+    """:func:`surface_cells` finds, from vertex numbers alone, the cells of the facets given
+    by their vertices (in any vertex order)."""
+    scene = hertz_3d(h_contact=0.05).scene
+    mesh = scene.mesh
+    mesh.topology.create_connectivity(2, 0)
+    c2v, f2v = mesh.topology.connectivity(3, 0), mesh.topology.connectivity(2, 0)
+    surfaces = contact_cells(scene)
+    facets = np.concatenate([scene.facet_tags.find(key) for key in surfaces])
+    vertices = f2v.array.reshape(-1, 3)[facets][:, ::-1]
+    flags = surface_cells([mesh.topology.cell_type], [c2v.array.astype(np.int64)], [vertices])
+    expected = np.zeros(len(flags), dtype=bool)
+    expected[np.concatenate(list(surfaces.values()))] = True
+    assert expected.sum() > 100 and np.array_equal(flags, expected)
+
+
 def test_unknown_partition_is_refused(monkeypatch):
     monkeypatch.setenv(PARTITION_VARIABLE, "metis")
     with pytest.raises(ContactInputError, match="CONTACT_UFL_PARTITION = 'metis' is unknown"):
@@ -91,3 +155,54 @@ def test_every_rank_owns_slave_points_and_answers_are_unchanged(monkeypatch):
         return comm.allreduce(lam.min(), MPI.MIN), comm.allreduce(lam.max(), MPI.MAX), u
 
     assert np.allclose(summary(bodies), summary(graph), rtol=1e-9)
+
+
+def test_hertz_3d_slave_points_are_shared_evenly_and_answers_unchanged(monkeypatch):
+    """3D Hertz, coarse (the graph partition and the plain bodies split both put the ball's
+    whole contact cap on one of two ranks): with the default partition every rank owns an
+    equal share of the slave points (within 10%), and the contact force, the multiplier's
+    extremes and the displacement norm are the graph partition's to solver tolerance."""
+
+    def solve_hertz(partition: str) -> ContactProblem:
+        monkeypatch.setenv(PARTITION_VARIABLE, partition)
+        problem = ContactProblem(hertz_3d(h_contact=0.05).scene, verbose=False, petsc_options=TIGHT)
+        problem.solve(num_steps=1)
+        return problem
+
+    bodies, graph = solve_hertz("bodies"), solve_hertz("graph")
+    comm = bodies.comm
+    points = np.array(comm.allgather(len(bodies.contacts[0].projection.facet)))
+    assert points.min() >= 0.9 * points.mean() and points.max() <= 1.1 * points.mean(), points
+    assert np.allclose(bodies.contact_force(), graph.contact_force(), rtol=1e-10, atol=1e-15)
+
+    def summary(problem):  # (the graph partition leaves one rank without multipliers)
+        lam = problem.contacts[0].lambda_N.x.array
+        u = problem.bulks[0].u.x.petsc_vec.norm()
+        low, high = np.min(lam, initial=np.inf), np.max(lam, initial=-np.inf)
+        return comm.allreduce(low, MPI.MIN), comm.allreduce(high, MPI.MAX), u
+
+    assert np.allclose(summary(bodies), summary(graph), rtol=1e-10)
+
+
+def test_scene_from_gmsh_splits_its_pairs_surfaces_evenly(tmp_path):
+    """``Scene.from_gmsh`` hands its pairs' facet groups to the partition: on the coarse 3D
+    Hertz mesh read back from a file, every rank owns an equal share (within 10%) of the
+    slave and of the master facets (counted by the owner of their cell)."""
+    comm = MPI.COMM_WORLD
+    path = Path(comm.bcast(str(tmp_path), root=0)) / "sphere_on_block.msh"
+    sphere_on_block_3d(h_contact=0.05, h_far=0.25, master_ratio=1.0, msh_file=path, comm=comm)
+    material = LinearElastic(1.0, 0.3)
+    scene = Scene.from_gmsh(
+        path,
+        bodies=[Body("sphere", material, "sphere"), Body("block", material, "block")],
+        contacts=[ContactPair("sphere_contact", "block_contact")],
+    )
+    mesh = scene.mesh
+    mesh.topology.create_connectivity(2, 3)
+    f2c = mesh.topology.connectivity(2, 3)
+    owned = mesh.topology.index_map(3).size_local
+    for name in ("sphere_contact", "block_contact"):
+        cells = f2c.array[f2c.offsets[scene.facet_tags.find(scene.tags[name])]]
+        count = np.array(comm.allgather(int(np.sum(cells < owned))))
+        assert count.sum() > 50, (name, count)
+        assert count.min() >= 0.9 * count.mean() and count.max() <= 1.1 * count.mean(), count

@@ -415,7 +415,16 @@ def hertz_2d(
     def build() -> None:
         _disc_on_block(radius, gap, width, height, None, grading, order, x_disc, axis)
 
-    return generate_mesh(comm, "hertz_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        "hertz_2d",
+        build,
+        2,
+        _mesh_options(order),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("cylinder_contact", "block_contact"),
+    )
 
 
 def curved_2d(
@@ -469,7 +478,16 @@ def curved_2d(
     def build() -> None:
         _disc_on_block(radius, gap, width, height, lower_radius, grading, order)
 
-    return generate_mesh(comm, "curved_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        "curved_2d",
+        build,
+        2,
+        _mesh_options(order),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("cylinder_contact", "block_contact"),
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -568,7 +586,16 @@ def patch_2d(
         _sizes_per_body(2, [(h_upper, [up]), (h_lower, [lo])])
         _generate(2, order)
 
-    return generate_mesh(comm, "patch_2d", build, 2, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        "patch_2d",
+        build,
+        2,
+        _mesh_options(order),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("upper_contact", "lower_contact"),
+    )
 
 
 def patch_3d(
@@ -660,7 +687,16 @@ def patch_3d(
         _sizes_per_body(3, [(h_upper, [up]), (h_lower, [lo])])
         _generate(3, order)
 
-    return generate_mesh(comm, "patch_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        "patch_3d",
+        build,
+        3,
+        _mesh_options(order),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("upper_contact", "lower_contact"),
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -772,7 +808,16 @@ def cylinders_3d(
         grading.set_background(_distance_to((0.0, 0.0, gap)), R, 3, [up], [lo])
         _generate(3, order)
 
-    return generate_mesh(comm, "cylinders_3d", build, 3, _mesh_options(order), msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        "cylinders_3d",
+        build,
+        3,
+        _mesh_options(order),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("upper_contact", "lower_contact"),
+    )
 
 
 def hemisphere_3d(
@@ -842,7 +887,14 @@ def hemisphere_3d(
         _generate(3, order)
 
     return generate_mesh(
-        comm, "hemisphere_3d", build, 3, _mesh_options(order), msh_file, ghost_mode
+        comm,
+        "hemisphere_3d",
+        build,
+        3,
+        _mesh_options(order),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("indenter_contact",),
     )
 
 
@@ -966,7 +1018,16 @@ def ironing_2d(
         _ironing_size_field(punch, body, block_top, h_punch, h_block, height)
         _generate(2)
 
-    return generate_mesh(comm, "ironing_2d", build, 2, _mesh_options(1), msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        "ironing_2d",
+        build,
+        2,
+        _mesh_options(1),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("punch_contact", "block_contact"),
+    )
 
 
 def ironing_3d(
@@ -1040,7 +1101,16 @@ def ironing_3d(
         _sizes_per_body(3, [(h_die, [die]), (h_slab, [slab_v])])
         _generate(3)
 
-    return generate_mesh(comm, "ironing_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        "ironing_3d",
+        build,
+        3,
+        _mesh_options(1),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("die_contact", "slab_contact"),
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -1210,7 +1280,16 @@ def beams_3d(
         )
         _generate(3)
 
-    return generate_mesh(comm, "beams_3d", build, 3, _mesh_options(1), msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        "beams_3d",
+        build,
+        3,
+        _mesh_options(1),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("upper_contact", "lower_contact"),
+    )
 
 
 def split_by_cells(data: MeshData, cell_groups: list[int | str]) -> list[MeshData]:
@@ -1465,7 +1544,14 @@ def sphere_on_block_3d(
         _generate(3, order)
 
     return generate_mesh(
-        comm, "sphere_on_block_3d", build, 3, _mesh_options(order), msh_file, ghost_mode
+        comm,
+        "sphere_on_block_3d",
+        build,
+        3,
+        _mesh_options(order),
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("sphere_contact", "block_contact"),
     )
 
 
@@ -1582,4 +1668,13 @@ def ironing_extruded(
         "Mesh.RecombinationAlgorithm": 3.0,  # Blossom full-quad: no triangle left
     }
     name = "ironing_2d_quadrilaterals" if thickness is None else "ironing_extruded"
-    return generate_mesh(comm, name, build, dim, options, msh_file, ghost_mode)
+    return generate_mesh(
+        comm,
+        name,
+        build,
+        dim,
+        options,
+        msh_file,
+        ghost_mode,
+        contact_surfaces=("punch_contact", "block_contact"),
+    )
