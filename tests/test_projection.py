@@ -11,6 +11,10 @@ from scipy.optimize import minimize
 
 from contact_ufl.contact.projection import closest_points, shape_functions
 
+#: rank-local NumPy and C kernels on arrays made here: the 2-rank run would repeat them
+#: on each rank
+pytestmark = pytest.mark.serial
+
 # -- random master surfaces ------------------------------------------------------------------
 
 

@@ -18,6 +18,10 @@ from contact_ufl.contact import projection
 from contact_ufl.contact.projection import TreeCache, closest_points, shape_functions
 from contact_ufl.contact.search import fan_columns
 
+#: rank-local NumPy and C kernels on arrays made here: the 2-rank run would repeat them
+#: on each rank
+pytestmark = pytest.mark.serial
+
 FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
 
 
