@@ -331,6 +331,8 @@ def main() -> None:
         "--repeat", type=int, default=1, help="2D: solves per mesh, the fastest kept"
     )
     args = parser.parse_args()
+    if args.repeat < 1 or (args.repeat > 1 and args.dim == 3):
+        parser.error("--repeat is a positive number of 2D solves per mesh")
     if args.dim == 3:
         args.depth = 0.01 if args.depth is None else args.depth
         args.steps = 2 if args.steps is None else args.steps

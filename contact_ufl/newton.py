@@ -234,6 +234,7 @@ class NewtonSolver:
         #: signature of the pairing and status of this rank's points), for :meth:`diagnose`
         self.iterates: list[tuple[float, int]] = []
         self._not_finite = None
+        self._callback_error: Exception | None = None  # raised in a callback (see _newton)
         #: try a closing iterate where a pair has no point in contact (:meth:`solve_step`)
         self.close_gaps = True
         self._pieces = None  # (piece, its pairs) of the pieces free in some direction
@@ -418,6 +419,21 @@ class NewtonSolver:
         return out
 
     def _residual(self, snes, x, F) -> None:
+        if self._in_snes and self._callback_error is not None:
+            F.set(np.nan)  # stop this SNES solve: :meth:`_newton` raises the error
+            return
+        if self._in_snes and not self.comm.allreduce(bool(np.isfinite(x.array_r).all()), MPI.LAND):
+            F.set(np.nan)  # the iterate left the numbers: a failed try, no search on it
+            return
+        try:
+            self._evaluate_residual_callback(x, F)
+        except Exception as error:  # raised from _newton once SNES has unlocked its vectors
+            if not self._in_snes:
+                raise
+            self._callback_error = error
+            F.set(np.nan)
+
+    def _evaluate_residual_callback(self, x, F) -> None:
         start = time.perf_counter()
         self._set_state(x)
         problem = self.problem
@@ -511,9 +527,16 @@ class NewtonSolver:
         J.zeroRows(rows, diag=problem.dirichlet_scale)
 
     def _jacobian(self, snes, x, J, P) -> None:
+        if self._in_snes and self._callback_error is not None:
+            return  # the next residual stops the solve
         start = time.perf_counter()
-        self._set_state(x)
-        self._assemble_jacobian_matrix()
+        try:
+            self._set_state(x)
+            self._assemble_jacobian_matrix()
+        except Exception as error:  # see _residual
+            if not self._in_snes:
+                raise
+            self._callback_error = error
         if self._in_snes:
             self.timings.callbacks += time.perf_counter() - start
 
@@ -814,6 +837,7 @@ class NewtonSolver:
         self._state = None
         self.iterates = []
         self._not_finite = None  # inverted cells of an iterate whose residual is NaN/inf
+        self._callback_error = None
         start = time.perf_counter()
         self._in_snes = True
         try:
@@ -826,6 +850,11 @@ class NewtonSolver:
         finally:
             self._in_snes = False
             self.timings.newton += time.perf_counter() - start
+        if self._callback_error is not None:
+            # an exception in a callback is not a failed try: PETSc would have kept the
+            # iterate's vector locked (every later try failing), and it names the problem
+            error, self._callback_error = self._callback_error, None
+            raise error
         self.timings.iterations += self.snes.getIterationNumber()
         if reason <= 0:
             self._reset_pc()  # no stale factorisation in the next try

@@ -39,6 +39,8 @@ import scipy.sparse
 import scipy.sparse.csgraph
 from mpi4py import MPI
 
+from contact_ufl.errors import collective_check
+
 __all__ = ["PARTITIONS", "body_partitioner", "cell_partitioner", "surface_cells"]
 
 #: The partitions :func:`cell_partitioner` knows: each body over all ranks, or DOLFINx's.
@@ -81,8 +83,12 @@ def body_partitioner(
         offsets = np.asarray(graph.offsets, dtype=np.int64)
         edges = np.asarray(graph.array, dtype=np.int64)
         marks = np.zeros(len(offsets) - 1, dtype=bool) if on_surface is None else on_surface
-        if len(marks) != len(offsets) - 1:
-            raise ValueError(f"on_surface has {len(marks)} entries for {len(offsets) - 1} cells")
+        collective_check(
+            comm,
+            len(marks) == len(offsets) - 1,
+            f"on_surface has {len(marks)} entries for {len(offsets) - 1} cells",
+            ValueError,
+        )
         gathered = comm.gather((offsets, edges, marks), root=0)
         pieces = None
         if comm.rank == 0:

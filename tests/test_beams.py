@@ -53,6 +53,16 @@ def contact_zone(problem) -> tuple[np.ndarray, np.ndarray]:
     return tuple(np.concatenate(problem.comm.allgather(a)) for a in (x, t_N))
 
 
+def slave_state(problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Reference positions of all slave points (sorted), their normal tractions t_N and
+    whether they are in contact, all ranks."""
+    c = problem.contacts[0]
+    parts = (c.slave.X.reshape(-1, 3), c.normal_traction_at_points(), c.active())
+    X, t_N, active = (np.concatenate(problem.comm.allgather(a)) for a in parts)
+    order = np.lexsort(np.round(X, 9).T)
+    return X[order], t_N[order], active[order]
+
+
 @pytest.fixture(scope="module")
 def showcase():
     """The demo's scene (divisions 3, load 6 EI/L^2, 20 steps) without and with friction,
@@ -185,7 +195,13 @@ def test_showcase_on_any_number_of_ranks(showcase):
     assert np.allclose(world.contact_force(), alone.contact_force(), rtol=1e-6, atol=1e-10)
     tip = world.scene.tags["upper_tip"]
     assert np.allclose(section_motion(world, tip)[0], section_motion(alone, tip)[0], atol=1e-8)
-    assert np.array_equal(np.sort(contact_zone(world)[0]), np.sort(contact_zone(alone)[0]))
+    (X, t_N, active), (X1, t_N1, active1) = slave_state(world), slave_state(alone)
+    assert np.allclose(X, X1)
+    # the same points in contact, but for those at the zone's edge whose normal traction
+    # is zero to solver tolerance (MUMPS's round-off on 2 ranks varies from run to run)
+    edge = np.maximum(t_N, t_N1) < 1e-8 * t_N.max()
+    assert np.array_equal(active[~edge], active1[~edge])
+    assert np.count_nonzero(active != active1) <= 2
     assert [s.newton_iterations for s in world.history.steps] == [
         s.newton_iterations for s in alone.history.steps
     ]

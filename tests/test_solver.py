@@ -251,3 +251,46 @@ def test_solver_matrix_rebuilt_inside_a_newton_solve():
     assert rebuilt._retired is not None  # replaced inside a Newton solve
     assert rebuilt.timings.iterations == kept.timings.iterations
     np.testing.assert_allclose(x_rebuilt, x_kept, rtol=0, atol=1e-10 * np.abs(x_kept).max())
+
+
+def test_a_non_finite_iterate_is_a_failed_try():
+    """A Newton update with a NaN (here put into the second line-search direction) makes a
+    trial iterate that is not a number: its residual is NaN, with no search on it, and the
+    step goes on (another try, a cut-back) to the same solution. When the search raised on
+    it inside the SNES callback, PETSc kept the iterate's vector locked and every later try
+    of the step failed: 8 cut-backs, then a ConvergenceError."""
+    reference = ContactProblem(scenes.hertz_2d(h_contact=0.05, depth=0.01).scene, verbose=False)
+    reference.solve(num_steps=1)
+    problem = ContactProblem(scenes.hertz_2d(h_contact=0.05, depth=0.01).scene, verbose=False)
+    calls = []
+
+    def poison(x, y):
+        calls.append(1)
+        if len(calls) == 2:
+            y.array[:1] = np.nan  # on every rank that owns a dof
+            return True
+        return False
+
+    problem.solver.snes.setLineSearchPreCheck(poison)
+    problem.solve(num_steps=1)
+    assert len(calls) > 2 and problem.t == pytest.approx(1.0)
+    assert np.allclose(problem.contact_force(), reference.contact_force(), rtol=1e-8)
+
+
+def test_an_error_in_a_callback_is_raised_and_leaves_the_problem_usable(monkeypatch):
+    """An exception inside the residual callback (here from the contact update) is raised
+    as itself from the solve, not turned into failed tries; the next solve works (the
+    SNES's vectors are not left locked)."""
+    problem = ContactProblem(scenes.hertz_2d(h_contact=0.05, depth=0.01).scene, verbose=False)
+    solver = problem.solver
+    update = solver._update_contact
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("a bug in the contact update")
+
+    monkeypatch.setattr(solver, "_update_contact", broken)
+    with pytest.raises(RuntimeError, match="a bug in the contact update"):
+        problem.solve(num_steps=1)
+    monkeypatch.setattr(solver, "_update_contact", update)
+    problem.solve(num_steps=1)
+    assert problem.t == pytest.approx(1.0) and not problem.history.cutbacks

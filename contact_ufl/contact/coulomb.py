@@ -49,25 +49,42 @@ MasterKinematics = MeshKinematics | ObstacleKinematics
 
 
 def disc_projection(q, radius, in_contact=None, round_off=0.0):
-    """Projection of the vector ``q`` onto the disc of radius ``radius >= 0``.
+    """Projection of the vector ``q`` onto the disc of radius ``max(radius, 0)``.
 
-    A disc of radius 0 (no contact pressure) projects everything to 0, with a zero
-    derivative, also at ``q = 0``: an open point has ``lambda_T = 0`` whatever q is.
+    Without ``in_contact``, a disc of radius 0 (no contact pressure) projects everything
+    to 0, with a zero derivative, also at ``q = 0``: an open point has ``lambda_T = 0``
+    whatever q is.
 
     ``in_contact`` (a UFL condition: the normal bracket counts as positive) decides, where
     given, which points may stick, instead of ``radius > 0``; a trial traction within
-    ``round_off`` of the disc sticks. A point that starts touching (``g = 0``, ``lambda = 0``,
-    no slip) has ``q = 0`` and a disc of radius 0, each up to round-off: without the two,
-    round-off alone would choose between stick (tangential stiffness ``eps_T``) and slip
-    (none) for its first iterate, and the Newton path would depend on the number of ranks
-    (the block of ``scenes.pushed_block``: 8 and 32 iterations on 1 and 2 ranks; 3 and 3
-    now). The value changes by at most ``round_off``.
+    ``round_off`` of the disc sticks (value ``q``, derivative the identity). A point that
+    starts touching (``g = 0``, ``lambda = 0``, no slip) has ``q = 0`` and a disc of radius
+    0, each up to round-off: without the two, round-off alone would choose between stick
+    (tangential stiffness ``eps_T``) and slip (none) for its first iterate, and the Newton
+    path would depend on the number of ranks (the block of ``scenes.pushed_block``: 8 and
+    32 iterations on 1 and 2 ranks; 3 and 3 now). The value changes by at most
+    ``round_off``. The NumPy twin is :func:`disc_projection_at_points`.
     """
     qq = ufl.dot(q, q)
     safe_norm = ufl.sqrt(qq + ufl.conditional(ufl.eq(qq, 0.0), 1.0, 0.0))
     may_stick = ufl.gt(radius, 0.0) if in_contact is None else in_contact
-    stick = ufl.And(ufl.le(qq, (ufl.max_value(radius, 0.0) + round_off) ** 2), may_stick)
+    radius = ufl.max_value(radius, 0.0)  # a bracket within its touching band may be < 0
+    stick = ufl.And(ufl.le(qq, (radius + round_off) ** 2), may_stick)
     return ufl.conditional(stick, q, radius / safe_norm * q)
+
+
+def disc_projection_at_points(
+    q: np.ndarray, radius: np.ndarray, in_contact: np.ndarray | None = None, round_off=0.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`disc_projection` at points: ``q`` ``(n, gdim)``, ``radius`` and ``in_contact``
+    ``(n,)``. Returns the mask of the points that stick and the projections ``(n, gdim)``."""
+    qq = np.einsum("pd,pd->p", q, q)
+    may_stick = radius > 0.0 if in_contact is None else in_contact
+    radius = np.maximum(radius, 0.0)
+    stick = (qq <= (radius + round_off) ** 2) & may_stick
+    norm = np.sqrt(np.where(qq > 0.0, qq, 1.0))
+    scale = np.where(stick, 1.0, radius / norm)
+    return stick, scale[:, None] * q
 
 
 class CoulombLaw:
@@ -232,22 +249,25 @@ class CoulombLaw:
     def stick(
         self, normal_traction: np.ndarray, in_contact: np.ndarray | None = None
     ) -> np.ndarray:
-        """Mask of the owned slave points in stick (``|q| <= mu t_N``), of those in contact;
-        ``normal_traction``: ``t_N`` at the owned points; ``in_contact``: the mask of the
-        points in contact (default: ``t_N > 0``; see :func:`disc_projection`)."""
-        q, radius = self._trial_and_radius(normal_traction)
-        may_stick = radius > 0 if in_contact is None else in_contact
-        bound = np.maximum(radius, 0.0) + float(self.eps_T.value) * self.touching
-        return (np.einsum("pd,pd->p", q, q) <= bound**2) & may_stick
+        """Mask of the owned slave points in stick (``|q| <= mu t_N``, within the round-off
+        band ``eps_T touching``), of those in contact; ``normal_traction``: ``t_N`` at the
+        owned points; ``in_contact``: the mask of the points in contact (default:
+        ``t_N > 0``; see :func:`disc_projection`)."""
+        return self._disc_at_points(normal_traction, in_contact)[0]
 
-    def traction_at_points(self, normal_traction: np.ndarray) -> np.ndarray:
+    def traction_at_points(
+        self, normal_traction: np.ndarray, in_contact: np.ndarray | None = None
+    ) -> np.ndarray:
         """The frictional traction on the slave body at the owned slave points, ``-P(q)``
         (``q`` projected onto the Coulomb disc of radius ``mu t_N``; the term of
-        :meth:`traction`), ``(n, gdim)``: it opposes the slip."""
+        :meth:`traction`), ``(n, gdim)``: it opposes the slip. ``in_contact`` as in
+        :meth:`stick`."""
+        return -self._disc_at_points(normal_traction, in_contact)[1]
+
+    def _disc_at_points(self, normal_traction: np.ndarray, in_contact: np.ndarray | None):
         q, radius = self._trial_and_radius(normal_traction)
-        norm = np.linalg.norm(q, axis=1)
-        scale = np.where(norm <= radius, 1.0, radius / np.where(norm > 0.0, norm, 1.0))
-        return np.where(radius[:, None] > 0.0, -scale[:, None] * q, 0.0)
+        round_off = float(self.eps_T.value) * self.touching
+        return disc_projection_at_points(q, radius, in_contact, round_off)
 
     def _tangential(self, w: np.ndarray) -> np.ndarray:
         nu = self.kinematics.projection.normal

@@ -421,7 +421,9 @@ class ContactInterface:
         integrand of :meth:`traction` (nominal, per unit reference area)."""
         t_N = self.normal_traction_at_points()
         T = t_N[:, None] * self.projection.normal
-        return T + self.friction.traction_at_points(t_N) if self.friction else T
+        if not self.friction:
+            return T
+        return T + self.friction.traction_at_points(t_N, self.active())
 
     def stick(self) -> np.ndarray:
         """Mask of the owned points in stick (with friction; see :meth:`.CoulombLaw.stick`)."""

@@ -33,6 +33,8 @@ typedef struct {
     float lo[3][WIDE], hi[3][WIDE]; /* the children's boxes, by coordinate then child */
     i64 child[WIDE];                /* row index, leaf code -1 - (8 start + count), or EMPTY */
 } node_t;
+/* projection.py allocates the tree buffer as (m + 2) * 128 bytes */
+_Static_assert(sizeof(node_t) == 128, "a row of the tree is 128 bytes");
 
 /* the rows of a tree buffer of at least (m + 1) sizeof(node_t) + 128 bytes, 128-byte
  * aligned (a row in two cache lines that are loaded together) */
