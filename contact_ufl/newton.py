@@ -13,6 +13,7 @@ met (:attr:`NewtonSolver.pattern_superset`). The solver times its parts
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
 import weakref
@@ -425,13 +426,21 @@ class NewtonSolver:
         if self._in_snes and not self.comm.allreduce(bool(np.isfinite(x.array_r).all()), MPI.LAND):
             F.set(np.nan)  # the iterate left the numbers: a failed try, no search on it
             return
-        try:
+        with self._holding_errors():
             self._evaluate_residual_callback(x, F)
-        except Exception as error:  # raised from _newton once SNES has unlocked its vectors
+        if self._callback_error is not None:
+            F.set(np.nan)
+
+    @contextlib.contextmanager
+    def _holding_errors(self):
+        """Inside a SNES solve, keep an exception of a callback in :attr:`_callback_error`
+        (raised by :meth:`_newton` once SNES has returned and unlocked its vectors)."""
+        try:
+            yield
+        except Exception as error:
             if not self._in_snes:
                 raise
             self._callback_error = error
-            F.set(np.nan)
 
     def _evaluate_residual_callback(self, x, F) -> None:
         start = time.perf_counter()
@@ -530,13 +539,9 @@ class NewtonSolver:
         if self._in_snes and self._callback_error is not None:
             return  # the next residual stops the solve
         start = time.perf_counter()
-        try:
+        with self._holding_errors():
             self._set_state(x)
             self._assemble_jacobian_matrix()
-        except Exception as error:  # see _residual
-            if not self._in_snes:
-                raise
-            self._callback_error = error
         if self._in_snes:
             self.timings.callbacks += time.perf_counter() - start
 

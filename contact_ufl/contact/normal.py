@@ -66,13 +66,17 @@ class NormalLaw:
 
     def traction(self, gap: ufl.core.expr.Expr, mask: ufl.core.expr.Expr):
         """The normal contact traction ``t_N = <lambda_N + eps_N g>`` (0 where ``mask`` is 0)."""
-        return mask * macaulay(self.lambda_N + self.eps_N * gap, self.eps_N * self.closing)
+        return mask * macaulay(self._argument(gap), self.eps_N * self.closing)
 
     def in_contact_condition(self, gap: ufl.core.expr.Expr, mask: ufl.core.expr.Expr):
         """Where the bracket of :meth:`traction` counts as positive (a UFL condition; the
         forms' twin of :meth:`in_contact`)."""
-        argument = self.lambda_N + self.eps_N * gap
-        return ufl.And(ufl.gt(mask, 0.5), ufl.gt(argument, -self.eps_N * self.closing))
+        positive = ufl.gt(self._argument(gap), -self.eps_N * self.closing)  # see macaulay
+        return ufl.And(ufl.gt(mask, 0.5), positive)
+
+    def _argument(self, gap: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """The bracket's argument ``lambda_N + eps_N g``."""
+        return self.lambda_N + self.eps_N * gap
 
     def residual(self, t_N: ufl.core.expr.Expr) -> ufl.Form:
         """The multiplier equation, times ``eps_N``: its rows are forces like those of the
