@@ -90,6 +90,8 @@ BEAMS_FULL = [3, 4]
 BEAMS_QUICK = [3]
 HERTZ3D_FULL = [0.025, 0.0125]
 HERTZ3D_QUICK = [0.025]
+#: ``"scene"``: each scene's eps_N (E / h); ``"default"``: the package's (``--eps``)
+EPS = "scene"
 PARTS = ("search", "residual_assembly", "jacobian_assembly", "ptap", "linear_solve")
 
 
@@ -246,6 +248,9 @@ def run(
     """Solve one scene and return its record (``glue``: with the glued baseline, its
     factorisations repeated ``glue`` times; ``dump``: write the contact tangent there)."""
     scene, steps, t_end = make(size, contact)
+    if EPS == "default":  # the package's default eps_N (E / L) instead of the scene's E / h
+        pairs = [dataclasses.replace(p, eps_N=None) for p in scene.contacts]
+        scene = dataclasses.replace(scene, contacts=pairs)
     options = (options or {}) if contact else bulk_options(options or {})
     problem = ContactProblem(scene, verbose=False, petsc_options=options)
     timings = problem.solver.timings
@@ -279,6 +284,7 @@ def run(
         "ranks": problem.comm.size,
         "options": options,
         "partition": os.environ.get(PARTITION_VARIABLE, "bodies"),
+        "eps": EPS,
     }
     record["per_rank"] = _per_rank(problem, cpu, timings)
     if dump and contact:
@@ -378,6 +384,7 @@ def _arguments() -> argparse.Namespace:
     parser.add_argument("--ranks", nargs="+", type=int, help="run under mpirun -n k for each k")
     parser.add_argument("--option", nargs="*", default=[], help="PETSc options KEY=VALUE")
     parser.add_argument("--partition", choices=PARTITIONS, default="bodies", help="mesh partition")
+    parser.add_argument("--eps", choices=("scene", "default"), default="scene", help="eps_N")
     parser.add_argument("--dump", default="", help="write the contact tangent (last size)")
     return parser.parse_args()
 
@@ -418,7 +425,9 @@ def _by_ranks(args: argparse.Namespace) -> None:
 
 
 def main() -> None:
+    global EPS
     args = _arguments()
+    EPS = args.eps
     os.environ[PARTITION_VARIABLE] = args.partition  # read by every mesh made (and mpirun's)
     if args.ranks:
         _by_ranks(args)

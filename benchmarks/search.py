@@ -256,6 +256,8 @@ def offset_points(gdim: int, npts: int, offset: float, rng: np.random.Generator)
     return np.stack([u[:, 0], u[:, 1], surface_3d(u[:, 0], u[:, 1]) + dz], axis=1)
 
 
+SWEEPS = ("graded", "self_contact", "radius", "distance", "points")
+
 MAKERS = {
     "segment": lambda nf, rng: segments(nf),
     "triangle": triangles,
@@ -423,6 +425,76 @@ def self_contact_sweep(n: int) -> list[dict]:
     return records
 
 
+def _searcher(points, masters: list, radius: float, trees, moved: bool) -> Callable:
+    """A search of ``points`` on ``masters[0]``; each call first swaps the two masters if
+    ``moved`` (so that every call meets a moved master)."""
+
+    def call():
+        if moved:
+            masters.reverse()
+        return closest_points(points, masters[0], radius, trees=trees)
+
+    return call
+
+
+def points_sweep(nf: int, counts) -> list[dict]:
+    """Search time against the number of points on the largest master, radius h, with the
+    master unchanged between calls (the other sweeps) and moved at every call (as in a
+    Newton iteration: each call refits the tree), and the line ``seconds = per_call_s +
+    points / per_point_rate`` fitted to them: a per-call cost that follows the facets (the
+    unchanged check, or the refit) and a per-point one."""
+    records = []
+    print(f"{'facets':>8} {'kind':>13} {'master':>9} {'points':>8} {'cpu s':>8} {'points/s':>10}")
+    for kind, make in MAKERS.items():
+        rng = np.random.default_rng(nf)
+        nodes, h = make(nf, rng)
+        # a translation by 1e-9 h: a moved master (refitted), the same tree and closest facets
+        shifted = np.ascontiguousarray(nodes + 1e-9 * h)
+        for moved in (False, True):
+            times = []
+            for n in counts:
+                points = slave_points(nodes.shape[2], n, h, rng)
+                trees = projection.TreeCache()
+                closest_points(points, nodes, h, trees=trees)
+                _, cpu, _ = best_of(_searcher(points, [shifted, nodes], h, trees, moved))
+                times.append(cpu)
+                records.append(
+                    {
+                        "sweep": "points",
+                        "kind": kind,
+                        "gdim": int(nodes.shape[2]),
+                        "facets": int(nodes.shape[0]),
+                        "master": "moved" if moved else "unchanged",
+                        "points": int(n),
+                        "radius_over_h": 1.0,
+                        "cpu_seconds": cpu,
+                        "cpu_points_per_s": n / cpu,
+                    }
+                )
+                print(
+                    f"{nodes.shape[0]:8d} {kind:>13} {records[-1]['master']:>9} {n:8d} "
+                    f"{cpu:8.4f} {n / cpu:10.3g}",
+                    flush=True,
+                )
+            slope, per_call = np.polyfit(np.asarray(counts, float), times, 1)
+            records.append(
+                {
+                    "sweep": "points_fit",
+                    "kind": kind,
+                    "facets": int(nodes.shape[0]),
+                    "master": "moved" if moved else "unchanged",
+                    "per_call_s": float(per_call),
+                    "per_point_rate": float(1.0 / slope),
+                }
+            )
+            print(
+                f"{'':8} {kind:>13} {records[-1]['master']:>9} per call {per_call * 1e3:.1f} ms, "
+                f"per point {1.0 / slope:.3g} points/s",
+                flush=True,
+            )
+    return records
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--json", required=True)
@@ -430,18 +502,27 @@ def main() -> None:
     parser.add_argument(
         "--largest", type=float, default=1e6, help="largest number of facets (full run)"
     )
+    parser.add_argument(
+        "--sweeps", nargs="+", default=list(SWEEPS), choices=list(SWEEPS), help="which sweeps"
+    )
     args = parser.parse_args()
     sizes = [1_000, 10_000] if args.quick else [1_000, 10_000, 100_000]
     if not args.quick and args.largest > 100_000:
         sizes.append(int(args.largest))
     npts = 10_000 if args.quick else 50_000
     factors = (1.0, 10.0, np.inf) if args.quick else (1.0, 10.0, 100.0, np.inf)
-    records = graded_sweep(npts // 2)
-    records += self_contact_sweep(2_000 if args.quick else 10_000)
-    records += radius_sweep(sizes, npts, factors)
-    records += distance_sweep(
-        100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
-    )
+    largest = sizes[-1]
+    counts = [npts // 5, npts, 4 * npts, 20 * npts] if largest >= 1e6 else [npts // 5, npts]
+    run = {
+        "graded": lambda: graded_sweep(npts // 2),
+        "self_contact": lambda: self_contact_sweep(2_000 if args.quick else 10_000),
+        "radius": lambda: radius_sweep(sizes, npts, factors),
+        "distance": lambda: distance_sweep(
+            100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
+        ),
+        "points": lambda: points_sweep(largest, counts),
+    }
+    records = [r for name in args.sweeps for r in run[name]()]
     with open(args.json, "w") as f:
         json.dump({"quick": args.quick, "records": records}, f, indent=1)
 

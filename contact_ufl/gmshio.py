@@ -260,9 +260,14 @@ def _distribute(
     error, model_dim, groups, name = comm.bcast(summary, root=rank)
     _raise_from(comm, rank, error)
     gdim = model_dim if gdim is None else gdim
-    facets = None
+    facets, error = None, None
     if comm.rank == rank and how[1] == "bodies":
-        facets = _facet_vertices(model, model_dim - 1, _facet_groups(groups, model_dim, how[2]))
+        try:  # a gmsh error here must not leave the other ranks waiting
+            tags = _facet_groups(groups, model_dim, how[2])
+            facets = [_facet_vertices(model, model_dim - 1, [tag]) for tag in tags]
+        except Exception as e:
+            error = f"could not read the contact surfaces' facets from the gmsh model: {e}"
+    _raise_from(comm, rank, error)
     partitioner = cell_partitioner(how[1], how[0], facets)
     data = dolfinx.io.gmsh.model_to_mesh(
         model if comm.rank == rank else None, comm, rank, gdim=gdim, partitioner=partitioner

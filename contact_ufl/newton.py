@@ -119,12 +119,16 @@ class NewtonTimings:
         return out
 
 
-def _weakly(method: Callable) -> Callable:
-    """A callback calling the bound ``method`` through a weak reference to its object."""
+def weak_callback(method: Callable) -> Callable:
+    """A callback calling the bound ``method`` through a weak reference to its object (a
+    PETSc object holding it does not keep that object alive; once it is gone, the callback
+    does nothing)."""
     ref = weakref.WeakMethod(method)
 
     def call(*args):
-        return ref()(*args)
+        if (bound := ref()) is not None:
+            return bound(*args)
+        return None
 
     return call
 
@@ -256,9 +260,9 @@ class NewtonSolver:
             opts[f"{prefix}{key}"] = value
         # weak callbacks: the SNES must not keep the solver (and its problem, meshes, spaces
         # and communicators) alive through a reference cycle that Python's collector cannot see
-        snes.setFunction(_weakly(self._residual), self._R)
-        snes.setJacobian(_weakly(self._jacobian), self._J)
-        snes.setMonitor(_weakly(self._monitor))
+        snes.setFunction(weak_callback(self._residual), self._R)
+        snes.setJacobian(weak_callback(self._jacobian), self._J)
+        snes.setMonitor(weak_callback(self._monitor))
         snes.setFromOptions()
         snes.getKSP().setFromOptions()
         if snes.getKSP().getPC().getType() == PETSc.PC.Type.FIELDSPLIT:
@@ -497,7 +501,7 @@ class NewtonSolver:
             self._wide_keys = self._wide_current
             if not new:  # the SNES's matrix from now on (the old one kept for its caller)
                 self._retired, self._J = self._J, J
-                self.snes.setJacobian(_weakly(self._jacobian), J)
+                self.snes.setJacobian(weak_callback(self._jacobian), J)
         else:
             J = self._J
             J.zeroEntries()
@@ -526,7 +530,7 @@ class NewtonSolver:
         J.axpy(1.0, self._JT, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         self._zero_dirichlet_rows(J)
         self._J = J
-        self.snes.setJacobian(_weakly(self._jacobian), J)
+        self.snes.setJacobian(weak_callback(self._jacobian), J)
         self._reset_pc()
 
     def _zero_dirichlet_rows(self, J: PETSc.Mat) -> None:

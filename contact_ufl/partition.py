@@ -11,13 +11,15 @@ over all the ranks and its share of the contact surfaces with it.
 A body's cells split evenly need not split its contact surface evenly (the graph partitioner
 knows nothing of it: on the 3D Hertz sphere one rank got 962 slave facets, the other 492), and
 the contact work (search, contact assembly, the gathered rows of ``T``, PtAP) goes with the
-surface. Given the cells that touch a contact surface (:func:`surface_cells`, from the contact
-facets of the mesh being read), each component is split in two stages: its surface cells
-first, into equal parts (the graph partitioner on the graph joining surface cells within two
-facet steps of each other), then the rest grown from them breadth first, one layer per round,
-every part up to an equal share of the component's cells (:func:`_grow`). Every rank then
-holds an equal share of each body and of its contact surface. (DOLFINx's graph partitioners
-take no vertex weights, so a two-constraint split cannot be asked of them directly.)
+surface. Given the cells that touch each contact surface (:func:`surface_cells`, from the
+contact facets of the mesh being read), each component is split in two stages: the cells of
+each of its surfaces first, each surface into equal parts (the graph partitioner on the graph
+joining that surface's cells within two facet steps of each other), then the rest grown from
+them breadth first, one layer per round, every part up to an equal share of the component's
+cells (:func:`_grow`). Every rank then holds an equal share of each body and of each of its
+contact surfaces (a body with two, split as one, could get one on each rank). (DOLFINx's
+graph partitioners take no vertex weights, so a two-constraint split cannot be asked of them
+directly.)
 
 The dual graph is gathered on one rank (a mesh read from gmsh is there already), partitioned
 there one component at a time, and each rank gets back the destinations of its cells: the
@@ -59,7 +61,7 @@ def _default_graph_partitioner() -> GraphPartitioner:
 
 def body_partitioner(
     graph_partitioner: GraphPartitioner | None = None,
-    on_surface: npt.NDArray[np.bool_] | None = None,
+    on_surface: npt.NDArray[np.integer] | npt.NDArray[np.bool_] | None = None,
 ) -> GraphPartitioner:
     """A graph partitioner that splits each connected component over all the parts.
 
@@ -68,8 +70,9 @@ def body_partitioner(
     graph_partitioner
         Partitions one component (called on ``MPI.COMM_SELF``); default SCOTCH.
     on_surface
-        This rank's nodes (cells, in the order of the graph's nodes) that touch a contact
-        surface: each component's share of them is split evenly too. Default: none.
+        The contact surface that this rank's nodes (cells, in the order of the graph's nodes)
+        touch: 0 none, ``k > 0`` the k-th (``True``: one surface); each component's share of
+        each surface is split evenly too. Default: none.
 
     Returns
     -------
@@ -82,11 +85,12 @@ def body_partitioner(
     def partition(comm: MPI.Comm, nparts: int, graph: Any, ghosting: bool) -> Any:
         offsets = np.asarray(graph.offsets, dtype=np.int64)
         edges = np.asarray(graph.array, dtype=np.int64)
-        marks = np.zeros(len(offsets) - 1, dtype=bool) if on_surface is None else on_surface
+        n = len(offsets) - 1
+        marks = np.zeros(n, np.int32) if on_surface is None else np.asarray(on_surface, np.int32)
         collective_check(
             comm,
-            len(marks) == len(offsets) - 1,
-            f"on_surface has {len(marks)} entries for {len(offsets) - 1} cells",
+            len(marks) == n,
+            f"on_surface has {len(marks)} entries for {n} cells",
             ValueError,
         )
         gathered = comm.gather((offsets, edges, marks), root=0)
@@ -95,7 +99,7 @@ def body_partitioner(
             sizes = [len(o) - 1 for o, _, _ in gathered]
             degrees = np.concatenate([np.diff(o) for o, _, _ in gathered])
             adjacency = _csr(np.concatenate([e for _, e, _ in gathered]), degrees)
-            surface = np.concatenate([m for _, _, m in gathered]).astype(bool)
+            surface = np.concatenate([m for _, _, m in gathered])
             owner = _split_components(adjacency, nparts, split, surface)
             data, offs = _destinations(adjacency, owner, nparts, ghosting)
             bounds = np.concatenate([[0], np.cumsum(sizes)])
@@ -122,10 +126,10 @@ def _split_components(
     adjacency: scipy.sparse.csr_array,
     nparts: int,
     split: GraphPartitioner,
-    on_surface: npt.NDArray[np.bool_],
+    on_surface: npt.NDArray[np.int32],
 ) -> npt.NDArray[np.int32]:
     """The part of each node: every connected component split into ``nparts`` parts (and its
-    nodes ``on_surface`` evenly too)."""
+    nodes on each surface, ``on_surface == k > 0``, evenly too)."""
     count, label = scipy.sparse.csgraph.connected_components(adjacency, directed=False)
     owner = np.zeros(adjacency.shape[0], dtype=np.int32)
     order = np.argsort(label, kind="stable")
@@ -138,11 +142,13 @@ def _split_components(
             shift += 1
             continue
         sub = adjacency[nodes][:, nodes].tocsr()
-        surface = np.flatnonzero(on_surface[nodes])
-        if len(surface) < 2 * nparts:
-            parts = _split(sub, nparts, split)
+        labels = on_surface[nodes]
+        surfaces = [np.flatnonzero(labels == k) for k in np.unique(labels[labels > 0])]
+        surfaces = [nodes_k for nodes_k in surfaces if len(nodes_k) >= 2 * nparts]
+        if surfaces:
+            parts = _split_surfaces_first(sub, surfaces, nparts, split)
         else:
-            parts = _split_surface_first(sub, surface, nparts, split)
+            parts = _split(sub, nparts, split)
         owner[nodes] = (parts + shift) % nparts  # rotate: the bodies' remainders spread
         shift += 1
     return owner
@@ -158,21 +164,24 @@ def _split(
     return np.asarray(split(MPI.COMM_SELF, nparts, local, False).array, dtype=np.int32)
 
 
-def _split_surface_first(
+def _split_surfaces_first(
     graph: scipy.sparse.csr_array,
-    surface: npt.NDArray[np.int64],
+    surfaces: list[npt.NDArray[np.int64]],
     nparts: int,
     split: GraphPartitioner,
 ) -> npt.NDArray[np.int32]:
-    """Parts of one component: the ``surface`` nodes split evenly first (the graph
-    partitioner on the graph joining surface nodes within two steps of each other: the
-    cells along a surface often share only an edge), the other nodes grown from them."""
-    touching = graph[surface].astype(np.int32)
-    near = (touching @ graph.astype(np.int32) + touching)[:, surface].tocsr()
-    near.setdiag(0)
-    near.eliminate_zeros()
+    """Parts of one component: the nodes of each of its ``surfaces`` (disjoint) split evenly
+    first, one surface at a time (the graph partitioner on the graph joining that surface's
+    nodes within two steps of each other: the cells along a surface often share only an
+    edge), the other nodes grown from them."""
     owner = np.full(graph.shape[0], -1, dtype=np.int32)
-    owner[surface] = _split(near, nparts, split)
+    adjacency = graph.astype(np.int32)
+    for surface in surfaces:
+        touching = adjacency[surface]
+        near = (touching @ adjacency + touching)[:, surface].tocsr()
+        near.setdiag(0)
+        near.eliminate_zeros()
+        owner[surface] = _split(near, nparts, split)
     return _grow(graph, owner, nparts)
 
 
@@ -245,9 +254,11 @@ def _rank_within(sorted_keys: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
 
 
 def surface_cells(
-    cell_types: list[Any], cells: list[npt.NDArray[np.int64]], facets: list[npt.NDArray[np.int64]]
-) -> npt.NDArray[np.bool_]:
-    """The cells that have a facet among ``facets``.
+    cell_types: list[Any],
+    cells: list[npt.NDArray[np.int64]],
+    surfaces: list[list[npt.NDArray[np.int64]]],
+) -> npt.NDArray[np.int32]:
+    """The contact surface each cell has a facet on.
 
     Parameters
     ----------
@@ -256,27 +267,31 @@ def surface_cells(
     cells
         The cells' vertices (input numbering, DOLFINx's local vertex order), one flat array
         per cell type: what a cell partitioner is given.
-    facets
-        Facets by their vertices (the same numbering), one ``(n, k)`` array per facet shape.
+    surfaces
+        The facets of each contact surface by their vertices (the same numbering), one
+        ``(n, k)`` array per facet shape.
 
     Returns
     -------
     numpy.ndarray
-        One flag per cell, the blocks in order.
+        One label per cell, the blocks in order: 0 none, ``k + 1`` for ``surfaces[k]`` (the
+        first, for a cell on several).
     """
-    flags = []
+    labels = []
     for cell_type, block in zip(cell_types, cells, strict=True):
         nv = dolfinx.cpp.mesh.cell_num_vertices(cell_type)
         vertices = np.asarray(block, dtype=np.int64).reshape(-1, nv)
         tdim = dolfinx.cpp.mesh.cell_dim(cell_type)
-        hit = np.zeros(len(vertices), dtype=bool)
+        label = np.zeros(len(vertices), dtype=np.int32)
         for local in basix.topology(basix.CellType[cell_type.name])[tdim - 1]:
             keys = np.sort(vertices[:, local], axis=1)
-            for table in facets:
-                if table.shape[1] == len(local) and len(table) > 0:
-                    hit |= _rows_in(keys, np.sort(table, axis=1))
-        flags.append(hit)
-    return np.concatenate(flags) if flags else np.zeros(0, dtype=bool)
+            for k, surface in enumerate(surfaces):
+                for table in surface:
+                    if table.shape[1] == len(local) and len(table) > 0:
+                        hit = _rows_in(keys, np.sort(table, axis=1))
+                        label[hit & (label == 0)] = k + 1
+        labels.append(label)
+    return np.concatenate(labels) if labels else np.zeros(0, dtype=np.int32)
 
 
 def _rows_in(rows: npt.NDArray[np.int64], table: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
@@ -289,7 +304,7 @@ def _rows_in(rows: npt.NDArray[np.int64], table: npt.NDArray[np.int64]) -> npt.N
 def cell_partitioner(
     partition: str,
     ghost_mode: dolfinx.mesh.GhostMode,
-    contact_facets: list[npt.NDArray[np.int64]] | None = None,
+    contact_facets: list[list[npt.NDArray[np.int64]]] | None = None,
 ) -> Callable[..., Any]:
     """The cell partitioner of ``partition`` (one of :data:`PARTITIONS`).
 
@@ -300,9 +315,9 @@ def cell_partitioner(
     ghost_mode
         Ghost mode of the mesh.
     contact_facets
-        ``"bodies"``: the contact facets by their vertices (input numbering, one ``(n, k)``
-        array per facet shape) on the rank that holds the cells; the cells touching them are
-        split evenly too. Default: none.
+        ``"bodies"``: the facets of each contact surface by their vertices (input numbering,
+        one ``(n, k)`` array per facet shape) on the rank that holds the cells; the cells
+        touching each surface are split evenly too. Default: none.
 
     Returns
     -------

@@ -9,6 +9,7 @@ import pytest
 import scipy.sparse
 from mpi4py import MPI
 
+from contact_ufl import gmshio
 from contact_ufl.contact import ContactPair
 from contact_ufl.errors import ContactInputError
 from contact_ufl.gmshio import PARTITION_VARIABLE
@@ -108,6 +109,37 @@ def test_contact_surfaces_are_split_evenly(nparts):
 
 
 @pytest.mark.serial
+@pytest.mark.parametrize("nparts", [2, 3])
+def test_each_contact_surface_of_a_body_is_split_evenly(nparts):
+    """A body with two contact surfaces (the 3D Hertz block's top and bottom faces): marked
+    as one surface, SCOTCH's split of the pair gives a part more than its share of one face;
+    marked as two, every part gets an equal share (within 10%) of each."""
+    scene = hertz_3d(h_contact=0.05).scene
+    graph = dual_graph(scene.mesh)
+    adjacency = dolfinx.cpp.graph.AdjacencyList_int64(
+        graph.indices.astype(np.int64), graph.indptr.astype(np.int32)
+    )
+    f2c = scene.mesh.topology.connectivity(2, 3)
+    faces = [
+        f2c.array[f2c.offsets[scene.facet_tags.find(scene.tags[name])]]
+        for name in ("block_contact", "block_bottom")
+    ]
+
+    def shares(labels: list[int]) -> list[npt.NDArray[np.int64]]:
+        on_surface = np.zeros(graph.shape[0], dtype=np.int32)
+        for cells, label in zip(faces, labels, strict=True):
+            on_surface[cells] = label
+        dest = body_partitioner(on_surface=on_surface)(MPI.COMM_SELF, nparts, adjacency, False)
+        owner = np.asarray(dest.array)
+        return [np.bincount(owner[cells], minlength=nparts) for cells in faces]
+
+    union = shares([1, 1])
+    assert max(c.max() / c.mean() for c in union) > 1.2, union  # the case worth testing
+    for count in shares([1, 2]):
+        assert count.max() <= 1.1 * count.mean() and count.min() >= 0.9 * count.mean(), count
+
+
+@pytest.mark.serial
 def test_surface_cells_are_the_cells_of_the_contact_facets():
     """:func:`surface_cells` finds, from vertex numbers alone, the cells of the facets given
     by their vertices (in any vertex order)."""
@@ -118,10 +150,17 @@ def test_surface_cells_are_the_cells_of_the_contact_facets():
     surfaces = contact_cells(scene)
     facets = np.concatenate([scene.facet_tags.find(key) for key in surfaces])
     vertices = f2v.array.reshape(-1, 3)[facets][:, ::-1]
-    flags = surface_cells([mesh.topology.cell_type], [c2v.array.astype(np.int64)], [vertices])
-    expected = np.zeros(len(flags), dtype=bool)
-    expected[np.concatenate(list(surfaces.values()))] = True
-    assert expected.sum() > 100 and np.array_equal(flags, expected)
+    labels = surface_cells([mesh.topology.cell_type], [c2v.array.astype(np.int64)], [[vertices]])
+    expected = np.zeros(len(labels), dtype=np.int32)
+    expected[np.concatenate(list(surfaces.values()))] = 1
+    assert expected.sum() > 100 and np.array_equal(labels, expected)
+    # one label per surface, the first for a cell on two
+    slave, master = (f2v.array.reshape(-1, 3)[scene.facet_tags.find(key)] for key in surfaces)
+    both = [[master], [slave], [master]]
+    labels = surface_cells([mesh.topology.cell_type], [c2v.array.astype(np.int64)], both)
+    cells = list(surfaces.values())
+    assert set(labels[cells[0]]) == {2} and set(labels[cells[1]]) == {1}
+    assert np.count_nonzero(labels) == len(np.unique(np.concatenate(cells)))
 
 
 def test_unknown_partition_is_refused(monkeypatch):
@@ -206,3 +245,19 @@ def test_scene_from_gmsh_splits_its_pairs_surfaces_evenly(tmp_path):
         count = np.array(comm.allgather(int(np.sum(cells < owned))))
         assert count.sum() > 50, (name, count)
         assert count.min() >= 0.9 * count.mean() and count.max() <= 1.1 * count.mean(), count
+
+
+def test_a_failed_read_of_the_contact_facets_is_raised_on_every_rank(tmp_path, monkeypatch):
+    """A gmsh error while the reading rank reads the contact surfaces' facets for the
+    partition is a ``ContactInputError`` on every rank (no rank left waiting in the mesh's
+    distribution)."""
+    comm = MPI.COMM_WORLD
+    path = Path(comm.bcast(str(tmp_path), root=0)) / "sphere_on_block.msh"
+    sphere_on_block_3d(h_contact=0.1, h_far=0.3, master_ratio=1.0, msh_file=path, comm=comm)
+
+    def broken(*args):
+        raise RuntimeError("gmsh: unknown entity")
+
+    monkeypatch.setattr(gmshio, "_facet_vertices", broken)
+    with pytest.raises(ContactInputError, match="contact surfaces' facets.*unknown entity"):
+        gmshio.read_gmsh(path, comm=comm, contact_surfaces=["sphere_contact"])

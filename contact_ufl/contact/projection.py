@@ -140,6 +140,18 @@ _COMPILED_KINDS = {"segment": 0, "triangle": 1, "quadrilateral": 2}
 _CAP = 4  # pairs per point returned by the compiled query (more: that point is queried again)
 NON_FINITE = "{what} of the closest-point search hold non-finite values (NaN or infinity)"
 
+
+def non_finite(what: str, values: np.ndarray) -> str | None:
+    """The message of :data:`NON_FINITE` for ``what`` (points, or facets' nodes: the rows of
+    ``values``) naming how many rows hold a NaN or infinity and the first one, or ``None``
+    if every value is finite."""
+    bad = ~np.isfinite(values.reshape(len(values), -1)).all(axis=1)
+    if not bad.any():
+        return None
+    first = int(np.argmax(bad))
+    return NON_FINITE.format(what=what) + f": {int(bad.sum())} of {len(values)}, first row {first}"
+
+
 #: An admissibility test of (point, facet) pairs: point and facet indices in, mask out.
 Admit = Callable[[IntArray, IntArray], npt.NDArray[np.bool_]]
 
@@ -550,7 +562,7 @@ class _Hierarchy:
         self.kind = _COMPILED_KINDS[facet_kind(self.nn, self.gdim)]
         centroid = np.ascontiguousarray(nodes.mean(axis=1))
         if not np.isfinite(centroid).all():
-            raise ValueError(NON_FINITE.format(what="the master nodes"))
+            raise ValueError(non_finite("the master nodes", nodes))
         self.perm = np.empty(nf, dtype=np.int64)
         self.a = np.empty(nf + 2, dtype=np.int64)  # leaves of 2 to 4 facets: < nf tree nodes
         self.b = np.empty(nf + 2, dtype=np.int64)
@@ -591,14 +603,16 @@ class _Hierarchy:
             )
         )  # fmt: skip
         if R_max == -2.0:
-            raise ValueError(NON_FINITE.format(what="the master nodes"))
+            raise ValueError(non_finite("the master nodes", nodes))
         self.R_max = R_max
         np.copyto(self.fitted_nodes, nodes)
         self.is_fitted = True
 
     def order(self, points: FloatArray) -> IntArray:
-        """The order of :func:`_cell_order` (a Z-order curve through the cells of a
-        ``1024^gdim`` grid over the points), by a radix sort in C."""
+        """An order of the points along a Z-order (Morton) curve through the cells of a
+        ``1024^gdim`` grid over their bounding box, by a radix sort in C: the points of a
+        cell, then of its neighbours, come one after the other (they walk the same branches
+        of the tree while it is in cache). Stable: equal keys in the given order."""
         order = np.empty(len(points), dtype=np.int64)
         x = np.ascontiguousarray(points)
         if self.lib.morton_order(x.shape[1], len(x), *self._pointers(x, order)) != 0:
@@ -647,6 +661,11 @@ class _Hierarchy:
         )  # fmt: skip
         if status == -1:
             raise MemoryError("the compiled closest-point search ran out of memory")
+        if status == -3:
+            raise RuntimeError(
+                f"the compiled closest-point search's tree walk overflowed its stack (a tree "
+                f"of {self.m} rows deeper than a balanced one: please report the master)"
+            )
         if status < 0:
             raise ValueError(f"no compiled search for {self.nn}-node facets in {self.gdim}D")
         #: exact projections made by the last query (the work of its pruning)
@@ -1375,31 +1394,6 @@ def _spatial_order(points: FloatArray) -> IntArray:
     return np.argsort(key, kind="stable")
 
 
-def _spread_bits(v: npt.NDArray[np.uint64]) -> npt.NDArray[np.uint64]:
-    """The 10 low bits of ``v`` spread to every third bit (bit ``i`` to bit ``3 i``)."""
-    v = v & np.uint64(0x3FF)
-    for shift, mask in ((16, 0x030000FF), (8, 0x0300F00F), (4, 0x030C30C3), (2, 0x09249249)):
-        v = (v | (v << np.uint64(shift))) & np.uint64(mask)
-    return v
-
-
-def _cell_order(points: FloatArray) -> IntArray:
-    """An order of the points along a Z-order (Morton) curve through the cells of a
-    ``1024^gdim`` grid over their bounding box: the points of a cell, then of its neighbours,
-    come one after the other (they walk the same branches of a tree while it is in cache).
-    Stable: equal keys in the given order. The compiled search computes the same order in C
-    (``_Hierarchy.order``); this is its reference."""
-    lo = points.min(axis=0)
-    span = float((points.max(axis=0) - lo).max())
-    if not (np.isfinite(span) and span > 0.0):
-        return np.arange(points.shape[0])
-    cell = np.minimum((points - lo) * (1024.0 / span), 1023.0).astype(np.uint64)
-    key = _spread_bits(cell[:, 0])
-    for k in range(1, points.shape[1]):
-        key |= _spread_bits(cell[:, k]) << np.uint64(k)
-    return np.argsort(key, kind="stable")
-
-
 def closest_points(
     points: npt.ArrayLike,
     nodes: npt.ArrayLike,
@@ -1510,7 +1504,7 @@ def closest_points(
     if not radius >= 0.0:
         raise ValueError(f"radius must be non-negative, got {radius}")
     if not np.isfinite(points).all():
-        raise ValueError(NON_FINITE.format(what="the slave points"))
+        raise ValueError(non_finite("the slave points", points))
     npts, fdim = points.shape[0], gdim - 1
     out = Projection(
         facet=np.full(npts, -1, dtype=np.int64),
@@ -1555,7 +1549,7 @@ def _search_compiled(
     exact projections of the NumPy kernels, in C). A point with one facet there gets its
     closest point from C; :func:`_select` picks among the others' pairs (the tie-break).
     On a master of over ``_SORT`` facets the points are walked in a Z-order of cells
-    (:func:`_cell_order`, computed in C)."""
+    (:meth:`_Hierarchy.order`)."""
     nodes = np.ascontiguousarray(nodes)
     tree = trees.hierarchy(nodes)
     rule = None if self_contact is None else _self_contact_arrays(self_contact, nodes)
@@ -1607,7 +1601,7 @@ def _search_numpy(
     KD-trees of the facet centroids and the NumPy kernels."""
     npts, nf = points.shape[0], nodes.shape[0]
     if not np.isfinite(nodes).all():
-        raise ValueError(NON_FINITE.format(what="the master nodes"))
+        raise ValueError(non_finite("the master nodes", nodes))
     master = _Master(nodes, trees)
     # on a large master the points in the order of a grid of cells (neighbours searched
     # together: the KD-tree and the gathers of facet data stay in cache), results scattered

@@ -25,12 +25,12 @@ from contact_ufl.contact import compiled
 from contact_ufl.contact.facets import on_edges
 from contact_ufl.contact.master import MeshMaster, smoothed_normals, smoothed_normals_3d
 from contact_ufl.contact.projection import (
-    NON_FINITE,
     Projection,
     SelfContact,
     TreeCache,
     _compiled,
     closest_points,
+    non_finite,
 )
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
@@ -130,6 +130,7 @@ class ClosestPointSearch:
         if n:
             lo, hi = master_nodes.min(axis=1), master_nodes.max(axis=1)
         problem = _non_finite(points, lo if n else None, hi if n else None)
+        problem = None if problem is None else f"{problem} (on rank {comm.rank})"
         gathered = comm.allgather((box, problem))
         problems = [p for _, p in gathered if p is not None]
         if problems:
@@ -247,9 +248,9 @@ def _non_finite(points: np.ndarray, lo: np.ndarray | None, hi: np.ndarray | None
     facets' node bounds ``lo``, ``hi`` (a NaN or infinite node makes its facet's bound
     non-finite), or ``None``."""
     if not np.isfinite(points).all():
-        return NON_FINITE.format(what="the slave points")
+        return non_finite("the slave points", points)
     if lo is not None and not (np.isfinite(lo).all() and np.isfinite(hi).all()):
-        return NON_FINITE.format(what="the master nodes")
+        return non_finite("the master nodes", np.concatenate([lo, hi], axis=1))
     return None
 
 

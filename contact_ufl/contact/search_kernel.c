@@ -778,7 +778,9 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
  * written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible
  * facets, with pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its
  * normal, fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
- * Returns the number of exact projections made, or -1 when out of memory. */
+ * Returns the number of exact projections made, -1 when out of memory, -3 when the walk
+ * overflows its stack (a tree far deeper than a balanced one); bvh_query -2 for an unknown
+ * facet kind. */
 INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
               const void *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
@@ -833,7 +835,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                 }
                 if (top + k > STACK) {
                     free(hits);
-                    return -1;
+                    return -3; /* the walk's stack is full: a tree far deeper than log4(m) */
                 }
                 for (int j = 0; j < k; j++) {
                     stack[top] = c[j];

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import dataclasses
 import time
-import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -25,6 +24,7 @@ from contact_ufl.control import VolumeControl
 from contact_ufl.errors import ConvergenceError
 from contact_ufl.loads import FollowerPressure
 from contact_ufl.materials import NeoHookean
+from contact_ufl.newton import weak_callback
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import inverted_cells
 from contact_ufl.scene import Scene
@@ -278,13 +278,7 @@ class _FailureObserver:
         self._previous: list[np.ndarray] | None = None  # the status at the last iterate
         self._solve_step = problem.solver.solve_step
         problem.solver.solve_step = self._observed
-        monitor = weakref.WeakMethod(self._monitor)
-
-        def call(*args) -> None:
-            if (method := monitor()) is not None:
-                method(*args)
-
-        problem.solver.snes.setMonitor(call)
+        problem.solver.snes.setMonitor(weak_callback(self._monitor))
 
     def _status(self) -> list[np.ndarray]:
         """Each pair's status at its owned slave points: 0 open, 1 in contact (in slip,
