@@ -198,6 +198,8 @@ class ContactInterface:
         )
         #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see ``macaulay``)
         self.touching = 1e-12 * size
+        #: the margin of the points whose master terms enter the tangent (``_engaged_only``)
+        self.engaged_margin = 1e-6 * size
         radius = pair.search_radius or 0.25 * size
         collective_check(
             comm,
@@ -289,7 +291,31 @@ class ContactInterface:
         """
         gathers = self.kinematics.update(layout)
         self._set_geometric_shift()
-        return gathers + (self.friction.gathers() if self.friction else [])
+        gathers += self.friction.gathers() if self.friction else []
+        return gathers if self.pair.on_obstacle else self._engaged_only(gathers)
+
+    def _engaged_only(
+        self, gathers: list[tuple[dolfinx.fem.Function, np.ndarray]]
+    ) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """The gathers of the points in contact (the bracket positive, within a margin of a
+        millionth of the surfaces' size, far above the round-off between these NumPy values
+        and the forms'); -1 for the others. Their normal and frictional tractions and the
+        derivatives of both are exactly zero, so their rows of the master's residual are zero
+        and they would add only structural zeros to ``T^T K T``: couplings of the two bodies
+        that cost fill in the factorisation, and pairing changes away from the contact that
+        cost analyses (3D Hertz P1 at 50,000 unknowns: 3.8 s against 5.8 s per Newton
+        iteration, the same iterations and force to 1e-15). The values of the gathered
+        fields stay those of the search (the last step's master nodes of a frictional point
+        out of contact are not moved with the master: its slip is not used)."""
+        proj = self.kinematics.projection
+        engaged = self.normal.in_contact(proj, margin=self.engaged_margin)
+        masked = []
+        for f, cols in gathers:
+            bs = f.function_space.dofmap.index_map_bs
+            at_points = np.repeat(engaged[:, None], bs, axis=1)
+            mask = self.slave.unrolled(f.function_space, at_points, fill=False)
+            masked.append((f, np.where(mask, cols, -1)))
+        return masked
 
     def pattern_gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
         """A superset of the gathers of the last :meth:`update` (each dof may gather several

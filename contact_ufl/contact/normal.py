@@ -98,9 +98,10 @@ class NormalLaw:
         """``t_N = <lambda_N + eps_N g>`` at the owned slave points (0 where unpaired)."""
         return np.maximum(self._bracket_argument(proj), 0.0)
 
-    def in_contact(self, proj: Projection) -> np.ndarray:
-        """Mask of the owned points where the bracket counts as positive (:func:`macaulay`)."""
-        closing = float(self.closing.value)
+    def in_contact(self, proj: Projection, margin: float = 0.0) -> np.ndarray:
+        """Mask of the owned points where the bracket counts as positive (:func:`macaulay`);
+        with a ``margin`` (a length), also those within it of counting so."""
+        closing = float(self.closing.value) + margin
         return self._bracket_argument(proj) > -float(self.eps_N.value) * closing
 
     def nearest_open_gap(self, proj: Projection) -> float:
