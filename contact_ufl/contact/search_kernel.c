@@ -16,8 +16,14 @@
  * a leaf, that leaf; by coordinate, the four side by side for the compiler to vectorise), in
  * single precision rounded outwards (a box holding the exact one: the pruning is as safe,
  * the closest points are the same), and their codes (a row index, or -1 - (8 start + count)
- * for a leaf, EMPTY for an unused slot), so that two levels of the binary tree cost one row. The rows are in preorder; row m holds the root's box and code
- * as its first child.
+ * for a leaf, EMPTY for an unused slot), so that two levels of the binary tree cost one
+ * row. The rows are in preorder; row m holds the root's box and code as its first child.
+ *
+ * The query walks LANES points at a time, one step of each by turns (a row's children
+ * pushed, or a leaf's facets visited): the loads one walk has just started (prefetched)
+ * arrive while the others work, instead of stalling the one walk. Each walk is the same
+ * branch and bound as alone, so its facets, hence the results, are those of one point at a
+ * time.
  */
 #include <math.h>
 #include <stdint.h>
@@ -47,23 +53,11 @@ static node_t *rows(const void *buffer)
 #define NEWTON_ITERATIONS 25
 #define NEWTON_TOL 1e-13
 #define STACK 512
-#ifndef TRI_SLAB
-#define TRI_SLAB 0
-#endif
 #ifndef LANES
 #define LANES 4 /* points walked at a time (by turns) */
 #endif
-#ifndef WARM_START
-#define WARM_START 1 /* project on the closest facet of the point before first */
-#endif
 #define AHEAD 16 /* facets ahead whose nodes the refit prefetches */
 #define INLINE static inline __attribute__((always_inline))
-#ifdef SEARCH_STATS /* counters of the walk, for measurements only (see search_stats) */
-i64 search_stats[16];
-#define STAT(i) (search_stats[i]++)
-#else
-#define STAT(i) ((void)0)
-#endif
 #if defined(__GNUC__) || defined(__clang__)
 #define PREFETCH(address) __builtin_prefetch(address)
 #else
@@ -492,7 +486,6 @@ static double quad_newton(const double (*c)[3], const double *x, double *xi, int
     int fresh = 0; /* whether r already holds the residual at (s, t): that of the step taken */
     *conv = 0;
     for (int it = 0; it < NEWTON_ITERATIONS; it++) {
-        STAT(4);
         for (int k = 0; k < 3; k++) {
             a1[k] = c[1][k] + t * c[3][k];
             a2[k] = c[2][k] + s * c[3][k];
@@ -567,7 +560,6 @@ static void quadrilateral(const double *X, const double *x, pair_t *out)
     int conv, pd;
     double dist = quad_newton(c, x, xi, &conv, &pd);
     if (!conv || (inner(xi) && !pd)) {
-        STAT(8);
         for (int j = 0; j < 4; j++) {
             double xr[2] = {starts[j][0], starts[j][1]};
             int conv_r, pd_r;
@@ -620,28 +612,34 @@ INLINE double box_distance2(int g, const double *B, const double *x)
  * with the GNU vector extensions (GCC, Clang) the four at once, the same operations in the
  * same order per child. */
 #if defined(__GNUC__) || defined(__clang__)
-typedef double vd4 __attribute__((vector_size(4 * sizeof(double))));
-typedef float vf4 __attribute__((vector_size(4 * sizeof(float))));
-typedef long long vl4 __attribute__((vector_size(4 * sizeof(long long))));
+/* two lanes of doubles, two of 64-bit masks (SSE2, NEON): two children at a time */
+typedef double vd2 __attribute__((vector_size(2 * sizeof(double))));
+typedef long long vl2 __attribute__((vector_size(2 * sizeof(long long))));
 
-/* a > b ? a : b per lane (a macro: a function of vector arguments warns of its ABI) */
-#define LARGER(a, b, m) ((m) = (a) > (b), (vd4)(((vl4)(a) & (m)) | ((vl4)(b) & ~(m))))
+/* a > b ? a : b per lane */
+INLINE vd2 larger(vd2 a, vd2 b)
+{
+    vl2 m = a > b;
+    return (vd2)(((vl2)a & m) | ((vl2)b & ~m));
+}
 
 INLINE void row_distance2(int g, const node_t *N, const double *x, double *d)
 {
-    vd4 s = {0.0, 0.0, 0.0, 0.0}, zero = {0.0, 0.0, 0.0, 0.0};
+    const vd2 zero = {0.0, 0.0};
+    vd2 s0 = zero, s1 = zero; /* children 0, 1 and 2, 3 */
     for (int k = 0; k < g; k++) {
-        vf4 lo, hi;
-        memcpy(&lo, N->lo[k], sizeof lo);
-        memcpy(&hi, N->hi[k], sizeof hi);
-        vd4 xk = {x[k], x[k], x[k], x[k]};
-        vd4 below = __builtin_convertvector(lo, vd4) - xk, above = xk - __builtin_convertvector(hi, vd4);
-        vl4 m;
-        vd4 e = LARGER(below, above, m);
-        e = LARGER(e, zero, m);
-        s += e * e;
+        const float *lo = N->lo[k], *hi = N->hi[k];
+        vd2 xk = {x[k], x[k]};
+        vd2 lo0 = {lo[0], lo[1]}, lo1 = {lo[2], lo[3]}, hi0 = {hi[0], hi[1]}, hi1 = {hi[2], hi[3]};
+        vd2 e0 = larger(larger(lo0 - xk, xk - hi0), zero);
+        vd2 e1 = larger(larger(lo1 - xk, xk - hi1), zero);
+        s0 += e0 * e0;
+        s1 += e1 * e1;
     }
-    memcpy(d, &s, sizeof s);
+    d[0] = s0[0];
+    d[1] = s0[1];
+    d[2] = s1[0];
+    d[3] = s1[1];
 }
 #else
 INLINE void row_distance2(int g, const node_t *N, const double *x, double *d)
@@ -820,11 +818,11 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
 }
 
 /* The walk of one point: the facets met within the bound (hits, at leaf positions), the
- * closest (best_j at distance best) and the bound (reach of the best, at most reach of the
- * radius; bound2 its square). */
+ * smallest distance met (best), the bound (reach of the best, at most reach of the radius;
+ * bound2 its square), and the exact projections made by the walks of the lane so far. */
 typedef struct {
     hit_t *hits;
-    i64 nh, room, best_j, projected;
+    i64 nh, room, projected;
     double best, bound, bound2, radius;
 } walk_t;
 
@@ -837,7 +835,6 @@ INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                  const double *pnu, int mf, const i64 *fnodes, const double *axis)
 {
     const double *X = leaf_nodes + j * nn * g;
-    STAT(2);
     { /* the facet's box before its exact projection */
         double B[6];
         for (int k = 0; k < g; k++) {
@@ -850,13 +847,11 @@ INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
         }
         if (box_distance2(g, B, xp) > W->bound2) return 0;
     }
-    if ((kind == 2 || (TRI_SLAB && kind == 1)) && beyond_slab(kind, X, xp, W->bound, rmax))
-        return 0;
+    if (kind == 2 && beyond_slab(kind, X, xp, W->bound, rmax)) return 0;
     if (pn && !admissible(g, mp, pn, pnu, mf, fnodes + perm[j] * mf, axis + perm[j] * g))
         return 0;
     pair_t q;
     project(kind, X, xp, &q);
-    STAT(3);
     if (q.dist > W->bound) return 1;
     if (W->nh == W->room) {
         /* drop the hits beyond the bound, then grow */
@@ -876,7 +871,6 @@ INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
     W->nh++;
     if (q.dist < W->best) {
         W->best = q.dist;
-        W->best_j = j;
         double r = reach(q.dist < W->radius ? q.dist : W->radius, rmax);
         if (r < W->bound) {
             W->bound = r;
@@ -904,55 +898,34 @@ typedef struct {
     const double *pnormal, *axis;
 } query_t;
 
-/* The walk of one point in a lane (the lanes of a query walk their points by turns: one
- * lane's loads are under way while the others work) and its warm start (the closest facet
- * of the lane's last point, its distance from that point). */
+/* The walk of point p in a lane (the lanes of a query walk their points by turns: one
+ * lane's loads are under way while the others work): its stack of rows and leaves (codes)
+ * with their squared box distances. */
 typedef struct {
     walk_t W;
-    i64 p, top, skip, warm;
-    double warm_x[3], warm_d;
+    i64 p, top;
     i64 stack[STACK];
     double lower[STACK];
 } lane_t;
 
-/* Start the walk of point p in lane L: the root, and the warm start (a tight bound before
- * the walk: the lane's last closest facet, if it may be within the bound, its distance from
- * x being at most warm_d + |x - warm_x|; the walk then skips it, its hit, if any, kept).
- * Returns 0, or -1 when out of memory. */
-INLINE int start(int kind, int g, int nn, const query_t *Q, lane_t *L, i64 p)
+/* Start the walk of point p in lane L: its root pushed if within the bound. */
+INLINE void start(int g, const query_t *Q, lane_t *L, i64 p)
 {
-    const double *xp = Q->x + p * g;
     walk_t *W = &L->W;
     L->p = p;
     L->top = 0;
-    L->skip = -1;
     W->nh = 0;
     W->best = INFINITY;
-    W->best_j = -1;
     W->bound = reach(Q->radius, Q->rmax);
     W->bound2 = W->bound * W->bound;
     Q->count[p] = 0;
-    if (Q->m == 0) return 0;
-    STAT(7);
+    if (Q->m == 0) return;
     double root[WIDE];
-    row_distance2(g, Q->T + Q->m, xp, root);
-    if (!(root[0] <= W->bound2)) return 0;
+    row_distance2(g, Q->T + Q->m, Q->x + p * g, root);
+    if (!(root[0] <= W->bound2)) return;
     L->stack[0] = Q->T[Q->m].child[0];
     L->lower[0] = root[0];
     L->top = 1;
-    if (!WARM_START || L->warm < 0) return 0;
-    double s = 0.0;
-    for (int k = 0; k < g; k++) s += (xp[k] - L->warm_x[k]) * (xp[k] - L->warm_x[k]);
-    if (!(L->warm_d + sqrt(s) <= W->bound)) return 0;
-    STAT(5);
-    const i64 *pn = Q->pnodes ? Q->pnodes + p * Q->mp : NULL;
-    const double *pnu = Q->pnodes ? Q->pnormal + p * g : NULL;
-    int status = visit(kind, g, nn, Q->leaf_nodes, Q->perm, L->warm, xp, Q->rmax, W, Q->mp,
-                       pn, pnu, Q->mf, Q->fnodes, Q->axis);
-    if (status < 0) return -1;
-    W->projected += status;
-    L->skip = L->warm;
-    return 0;
 }
 
 /* One step of the walk of lane L (its stack not empty): the nearest entry popped, and
@@ -971,7 +944,6 @@ INLINE int step(int kind, int g, int nn, const query_t *Q, lane_t *L)
         double d[WIDE], ds[WIDE];
         i64 c[WIDE];
         int k = 0;
-        STAT(0);
         row_distance2(g, N, xp, ds);
         for (int slot = 0; slot < WIDE; slot++) {
             if (N->child[slot] == EMPTY || ds[slot] > W->bound2) continue;
@@ -993,12 +965,10 @@ INLINE int step(int kind, int g, int nn, const query_t *Q, lane_t *L)
         L->top = top;
         return 0;
     }
-    STAT(1);
     const i64 *pn = Q->pnodes ? Q->pnodes + L->p * Q->mp : NULL;
     const double *pnu = Q->pnodes ? Q->pnormal + L->p * g : NULL;
     i64 first = (-code - 1) >> 3, end = first + ((-code - 1) & 7);
     for (i64 j = first; j < end; j++) {
-        if (j == L->skip) continue;
         int status = visit(kind, g, nn, Q->leaf_nodes, Q->perm, j, xp, Q->rmax, W, Q->mp, pn,
                            pnu, Q->mf, Q->fnodes, Q->axis);
         if (status < 0) return -1;
@@ -1008,7 +978,7 @@ INLINE int step(int kind, int g, int nn, const query_t *Q, lane_t *L)
 }
 
 /* The results of the point of lane L, its walk done: its count, and its pairs at the next
- * row or its closest point (see bvh_query); the lane's warm start updated. */
+ * row or its closest point (see bvh_query). */
 INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
 {
     const int fdim = g - 1;
@@ -1016,14 +986,6 @@ INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
     const hit_t *hits = W->hits;
     const i64 p = L->p, nh = W->nh;
     const double *xp = Q->x + p * g, bound = W->bound;
-    if (W->best_j >= 0) {
-#ifdef SEARCH_STATS
-        if (W->best_j == L->skip) STAT(6);
-#endif
-        L->warm = W->best_j;
-        L->warm_d = W->best;
-        for (int k = 0; k < g; k++) L->warm_x[k] = xp[k];
-    }
     i64 k = 0, last = 0;
     for (i64 h = 0; h < nh; h++)
         if (hits[h].q.dist <= bound) {
@@ -1102,11 +1064,10 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
     lane_t *L = malloc(LANES * sizeof(lane_t));
     if (!L) return -1;
     for (int l = 0; l < LANES; l++) {
-        walk_t W = {malloc(64 * sizeof(hit_t)), 0, 64, -1, 0, INFINITY, 0.0, 0.0, radius};
+        walk_t W = {malloc(64 * sizeof(hit_t)), 0, 64, 0, INFINITY, 0.0, 0.0, radius};
         L[l].W = W;
         L[l].p = -1;
         L[l].top = 0;
-        L[l].warm = -1;
     }
     for (int l = 0; l < LANES; l++)
         if (!L[l].W.hits) {
@@ -1122,10 +1083,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                 if (A->p >= 0) conclude(kind, g, nn, &Q, A);
                 A->p = -1;
                 if (next == npts) break;
-                if (start(kind, g, nn, &Q, A, next++) < 0) {
-                    free_lanes(L, LANES);
-                    return -1;
-                }
+                start(g, &Q, A, next++);
             }
             if (A->p < 0) continue;
             busy = 1;
