@@ -19,11 +19,11 @@
  * for a leaf, EMPTY for an unused slot), so that two levels of the binary tree cost one
  * row. The rows are in preorder; row m holds the root's box and code as its first child.
  *
- * The query walks LANES points at a time, one step of each by turns (a row's children
- * pushed, or a leaf's facets visited): the loads one walk has just started (prefetched)
- * arrive while the others work, instead of stalling the one walk. Each walk is the same
- * branch and bound as alone, so its facets, hence the results, are those of one point at a
- * time.
+ * The query walks LANES points at a time on a surface, one step of each by turns (a row's
+ * children pushed, or a leaf's facets visited): the loads one walk has just started
+ * (prefetched) arrive while the others work, instead of stalling the one walk. Each walk is
+ * the same branch and bound as alone, so its facets, hence the results, are those of one
+ * point at a time.
  */
 #include <math.h>
 #include <stdint.h>
@@ -1047,7 +1047,7 @@ INLINE void free_lanes(lane_t *L, int lanes)
  * radius). Self-contact (pnodes not NULL): only the admissible facets, with pnodes (npts,
  * m) the node numbers of each point's facet, pnormal (npts, g) its normal, fnodes (n, mf)
  * the facets' node numbers, axis (n, g) their centre normals. The points are walked LANES
- * at a time, a step of each by turns. Returns the number of exact projections made, -1 when
+ * at a time (surfaces; segments one at a time), a step of each by turns. Returns the number of exact projections made, -1 when
  * out of memory, -3 when the walk overflows its stack (a tree far deeper than a balanced
  * one); bvh_query -2 for an unknown facet kind. */
 INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
@@ -1061,23 +1061,26 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
     query_t Q = {leaf_nodes, x, perm, rows(tree), m, rmax, radius, cap, mp, mf,
                  count, f, edge, point, 0, xi, dist, vertex, index, facet, oxi, y, normal,
                  gap, distance, sliding, pnodes, fnodes, pnormal, axis};
-    lane_t *L = malloc(LANES * sizeof(lane_t));
+    /* one lane for segments: their walks are short and their projections cheap, the turns
+     * cost more than they save */
+    const int lanes = kind == 0 ? 1 : LANES;
+    lane_t *L = malloc(lanes * sizeof(lane_t));
     if (!L) return -1;
-    for (int l = 0; l < LANES; l++) {
+    for (int l = 0; l < lanes; l++) {
         walk_t W = {malloc(64 * sizeof(hit_t)), 0, 64, 0, INFINITY, 0.0, 0.0, radius};
         L[l].W = W;
         L[l].p = -1;
         L[l].top = 0;
     }
-    for (int l = 0; l < LANES; l++)
+    for (int l = 0; l < lanes; l++)
         if (!L[l].W.hits) {
-            free_lanes(L, LANES);
+            free_lanes(L, lanes);
             return -1;
         }
     i64 next = 0;
     for (int busy = 1; busy;) {
         busy = 0;
-        for (int l = 0; l < LANES; l++) {
+        for (int l = 0; l < lanes; l++) {
             lane_t *A = L + l;
             while (A->top == 0) { /* the lane's point done (or none yet): the next point */
                 if (A->p >= 0) conclude(kind, g, nn, &Q, A);
@@ -1089,14 +1092,14 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
             busy = 1;
             int status = step(kind, g, nn, &Q, A);
             if (status < 0) {
-                free_lanes(L, LANES);
+                free_lanes(L, lanes);
                 return status;
             }
         }
     }
     i64 projected = 0;
-    for (int l = 0; l < LANES; l++) projected += L[l].W.projected;
-    free_lanes(L, LANES);
+    for (int l = 0; l < lanes; l++) projected += L[l].W.projected;
+    free_lanes(L, lanes);
     *written = Q.used;
     return projected;
 }
