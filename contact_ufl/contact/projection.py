@@ -1444,7 +1444,9 @@ def closest_points(
     between its corners' heights along its centre normal) farther than ``r = min(d,
     radius)`` with ``d`` the smallest exact distance met so far (widened by ``1e-9 (r + 2
     R_max)``, beyond the tie tolerance): the work follows the point's distance to the
-    surface, not the radius.
+    surface, not the radius. On a surface four points are walked by turns, a step of each
+    (the memory loads of one under way while the others work; each walk, so its result, as
+    alone).
     The exact projections are those of the NumPy kernels, in the same operations. A point
     with one facet within that reach gets its closest point, normal, proximity and ``M``
     from C; the points with several go through the NumPy tie-break below. Self-contact:
