@@ -93,6 +93,29 @@ comparison, the refit one prefetched pass, the points' Z-order a radix sort in C
 call: 0.021 / 0.026 -> 0.011 / 0.016 s, its bins' trees now kept). The fourth round's own
 ``search.json`` is in the history (commit c78de93).
 
+Sixth round (the compiled search per point, 3D): a profile (``perf``) of 1e4 triangles at
+radius h had 12% of the time in page faults of the query's pair arrays (rows for every point,
+written for the tied points only: spread over all pages) and 17% in the row distances (not
+vectorised by the compiler); at 1e6 facets the walk waits on memory. Now: the tied points'
+pairs go to the first rows (no fault beyond them), the row distances take two children at a
+time (SSE2/NEON vectors, the same operations), four points are walked by turns on a surface
+(a step of each: the loads one walk prefetched arrive while the others work; segments one
+at a time: 25% slower at 100 h by turns), the Newton step's residual is reused. Counted per
+point on 1e6 facets (radius h / 10 h / infinity): 2.1 / 8.0 / 51 exact projections on
+triangles, 1.2 / 4.0 / 21 on quadrilaterals (3.8 Newton iterations a projection). Measured
+and not kept: a warm start on the last point's closest facet (tried for 1% / 45% / 100% of
+the points, closest for 0 to 3%: slower at 10 h and infinity, 1.33e5 -> 1.18e5 on 1e6
+triangles) and the slab test for triangles (no gain). CPU points/s, best of two runs of
+``--sweeps radius`` before -> after (the machine shared with other jobs: +-10% noise),
+radius h: 1e4 triangles 1.29e6 -> 1.59e6, 1e5 1.25e6 -> 1.38e6, 1e6 8.7e5 -> 1.03e6; 1e4
+quadrilaterals 1.30e6 -> 1.53e6, 1e5 1.07e6 -> 1.22e6, 1e6 7.9e5 -> 9.4e5; radius 10 h on 1e6:
+triangles 4.8e5 -> 5.0e5, quadrilaterals 4.4e5 -> 4.7e5; 100 h and infinity unchanged within
+the noise. ``--sweeps points`` (1e6 facets, radius h), per-point rate of the fit: triangles
+9.8e5 -> 1.21e6 (unchanged master) / 8.6e5 -> 1.14e6 (moved), quadrilaterals 7.6e5 -> 8.9e5 /
+8.3e5 -> 8.0e5 (one run each). ``search.json`` (one full run of this round's code, load 2.5 on
+the two cores) is below these best figures: radius h, 1e6 triangles 8.2e5, quadrilaterals
+9.0e5 (self-contact and graded master: the same as before, checked side by side).
+
 The distance sweep of the third round showed where the time went: at a given distance the
 cost is flat in the radius (within the timing noise, e.g. 1e5 triangles at 1 h: 1.2e5
 points/s at radii 2 h, 10 h and infinity), but it falls with the distance (1e5 triangles:

@@ -50,7 +50,8 @@ int morton_order(int g, i64 n, const double *x, i64 *order);
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
               const void *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
-              double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
+              double *dist, i64 *edge, unsigned char *vertex, i64 *point, i64 *written,
+              const i64 *index, i64 *facet,
               double *oxi, double *y, double *normal, double *gap, double *distance,
               double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
               const i64 *fnodes, const double *axis);

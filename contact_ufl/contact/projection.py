@@ -627,17 +627,20 @@ class _Hierarchy:
         rule: tuple | None = None,
         out: Projection | None = None,
         index: IntArray | None = None,
-    ) -> tuple[IntArray, IntArray, _Pairs]:
+    ) -> tuple[IntArray, IntArray, IntArray, _Pairs]:
         """The pairs of each point ``x`` (C-contiguous) within the tie reach of its closest
-        facet (at most ``cap`` a point): their number per point, their facets ``(npts,
-        cap)`` and their projections ``(npts, cap)``; ``rule``: the arrays of a self-contact
-        search (point nodes, point normals, facet nodes, facet centre normals). ``out``: a
-        :class:`Projection` (C-contiguous fields) in which each point with one pair gets its
-        closest point, at its row of ``index`` (its count set to 0 if it is beyond
-        ``radius``; its pair is then not written: its rows of the arrays returned are left
-        untouched, their memory pages never written)."""
+        facet (at most ``cap`` a point): their number per point (``npts``), and a row for
+        each point with pairs (``rows``, in the order the walks end): its point, its facets
+        ``(rows, cap)`` and their projections ``(rows, cap)``; ``rule``: the arrays of a
+        self-contact search (point nodes, point normals, facet nodes, facet centre normals).
+        ``out``: a :class:`Projection` (C-contiguous fields) in which each point with one
+        pair gets its closest point, at its row of ``index`` (its count set to 0 if it is
+        beyond ``radius``), and no row (the rows written are the first ones of arrays for
+        all the points: the memory pages of the others are never touched)."""
         npts, fdim = x.shape[0], self.gdim - 1
         count = np.zeros(npts, dtype=np.int64)
+        point = np.empty(npts, dtype=np.int64)
+        written = np.zeros(1, dtype=np.int64)
         f = np.empty((npts, cap), dtype=np.int64)
         xi = np.empty((npts, cap, fdim))
         dist = np.empty((npts, cap))
@@ -657,7 +660,7 @@ class _Hierarchy:
         status = self.lib.bvh_query(
             self.kind, self.gdim, self.nn, *p(self.leaf_nodes, self.perm), self.m,
             _ptr(self, self.tree), self.R_max, npts, _ptr(self, x), radius, cap,
-            *p(count, f, xi, dist, edge, vertex), *final, *contact,
+            *p(count, f, xi, dist, edge, vertex, point, written), *final, *contact,
         )  # fmt: skip
         if status == -1:
             raise MemoryError("the compiled closest-point search ran out of memory")
@@ -670,7 +673,9 @@ class _Hierarchy:
             raise ValueError(f"no compiled search for {self.nn}-node facets in {self.gdim}D")
         #: exact projections made by the last query (the work of its pruning)
         self.projections = int(status)
-        return count, f, _Pairs(xi=xi, dist=dist, edge=edge, vertex=vertex.view(bool))
+        r = int(written[0])
+        pairs = _Pairs(xi=xi[:r], dist=dist[:r], edge=edge[:r], vertex=vertex[:r].view(bool))
+        return count, point[:r], f[:r], pairs
 
 
 def _ptr(h: _Hierarchy, array: np.ndarray):
@@ -1439,7 +1444,9 @@ def closest_points(
     between its corners' heights along its centre normal) farther than ``r = min(d,
     radius)`` with ``d`` the smallest exact distance met so far (widened by ``1e-9 (r + 2
     R_max)``, beyond the tie tolerance): the work follows the point's distance to the
-    surface, not the radius.
+    surface, not the radius. On a surface four points are walked by turns, a step of each
+    (the memory loads of one under way while the others work; each walk, so its result, as
+    alone).
     The exact projections are those of the NumPy kernels, in the same operations. A point
     with one facet within that reach gets its closest point, normal, proximity and ``M``
     from C; the points with several go through the NumPy tie-break below. Self-contact:
@@ -1558,8 +1565,8 @@ def _search_compiled(
     if rule is not None and order is not None:
         rule = (rule[0][order], rule[1][order], rule[2], rule[3])
     # the points with one facet within the tie reach get their closest point in C
-    count, f, pairs = tree.query(x, radius, _CAP, rule, out, order)
-    rows, fid, pairs = _tied_pairs(tree, x, radius, rule, count, f, pairs)
+    count, point, f, pairs = tree.query(x, radius, _CAP, rule, out, order)
+    rows, fid, pairs = _tied_pairs(tree, x, radius, rule, count, point, f, pairs)
     if rows.size == 0:
         return
     pid = rows if order is None else order[rows]
@@ -1644,25 +1651,27 @@ def _tied_pairs(
     radius: float,
     rule: tuple | None,
     count: IntArray,
+    point: IntArray,
     f: IntArray,
     pairs: _Pairs,
 ) -> tuple[IntArray, IntArray, _Pairs]:
     """The pairs of the points ``x`` with several facets within the tie reach (``count``,
-    ``f``, ``pairs``: the query's result, at most ``_CAP`` a point; the points with more
-    queried again with room for all): point rows, facets and projections."""
+    ``point``, ``f``, ``pairs``: the query's result, at most ``_CAP`` a point; the points
+    with more queried again with room for all): point rows, facets and projections."""
     fields = ("xi", "dist", "edge", "vertex")
-    several = np.flatnonzero(count > 1)
-    kept = np.arange(_CAP) < count[several, None]
-    rows, fid = several[np.nonzero(kept)[0]], f[several][kept]
+    several = np.flatnonzero(count[point] > 1)
+    kept = np.arange(_CAP) < count[point[several], None]
+    rows, fid = point[several][np.nonzero(kept)[0]], f[several][kept]
     pairs = _Pairs(*(getattr(pairs, k)[several][kept] for k in fields))
     more = np.flatnonzero(count > _CAP)
     if more.size:
         cap = int(count[more].max())
         sub = None if rule is None else (rule[0][more], rule[1][more], rule[2], rule[3])
-        count_m, f_m, pairs_m = tree.query(np.ascontiguousarray(x[more]), radius, cap, sub)
-        kept_m = np.arange(cap) < count_m[:, None]
+        x_more = np.ascontiguousarray(x[more])
+        count_m, point_m, f_m, pairs_m = tree.query(x_more, radius, cap, sub)
+        kept_m = np.arange(cap) < count_m[point_m, None]
         keep = np.flatnonzero(count[rows] <= _CAP)
-        rows = np.concatenate([rows[keep], more[np.nonzero(kept_m)[0]]])
+        rows = np.concatenate([rows[keep], more[point_m[np.nonzero(kept_m)[0]]]])
         fid = np.concatenate([fid[keep], f_m[kept_m]])
         pairs = _concatenate(
             _Pairs(*(getattr(pairs, k)[keep] for k in fields)),

@@ -16,8 +16,14 @@
  * a leaf, that leaf; by coordinate, the four side by side for the compiler to vectorise), in
  * single precision rounded outwards (a box holding the exact one: the pruning is as safe,
  * the closest points are the same), and their codes (a row index, or -1 - (8 start + count)
- * for a leaf, EMPTY for an unused slot), so that two levels of the binary tree cost one row. The rows are in preorder; row m holds the root's box and code
- * as its first child.
+ * for a leaf, EMPTY for an unused slot), so that two levels of the binary tree cost one
+ * row. The rows are in preorder; row m holds the root's box and code as its first child.
+ *
+ * The query walks LANES points at a time on a surface, one step of each by turns (a row's
+ * children pushed, or a leaf's facets visited): the loads one walk has just started
+ * (prefetched) arrive while the others work, instead of stalling the one walk. Each walk is
+ * the same branch and bound as alone, so its facets, hence the results, are those of one
+ * point at a time.
  */
 #include <math.h>
 #include <stdint.h>
@@ -47,6 +53,9 @@ static node_t *rows(const void *buffer)
 #define NEWTON_ITERATIONS 25
 #define NEWTON_TOL 1e-13
 #define STACK 512
+#ifndef LANES
+#define LANES 4 /* points walked at a time (by turns) */
+#endif
 #define AHEAD 16 /* facets ahead whose nodes the refit prefetches */
 #define INLINE static inline __attribute__((always_inline))
 #if defined(__GNUC__) || defined(__clang__)
@@ -474,13 +483,14 @@ INLINE double clip01(double v) { return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v); }
 static double quad_newton(const double (*c)[3], const double *x, double *xi, int *conv, int *pd)
 {
     double s = xi[0], t = xi[1], a1[3], a2[3], r[3], rn[3];
+    int fresh = 0; /* whether r already holds the residual at (s, t): that of the step taken */
     *conv = 0;
     for (int it = 0; it < NEWTON_ITERATIONS; it++) {
         for (int k = 0; k < 3; k++) {
             a1[k] = c[1][k] + t * c[3][k];
             a2[k] = c[2][k] + s * c[3][k];
         }
-        quad_residual(c, x, s, t, r);
+        if (!fresh) quad_residual(c, x, s, t, r);
         double g1 = -dot3(r, a1), g2 = -dot3(r, a2);
         double h11 = dot3(a1, a1), h22 = dot3(a2, a2), h12gn = dot3(a1, a2);
         double h12 = h12gn - dot3(r, c[3]);
@@ -498,9 +508,13 @@ static double quad_newton(const double (*c)[3], const double *x, double *xi, int
         if (fix1 && fix2) step1 = step2 = 0.0;
         double f0 = dot3(r, r);
         double ns = clip01(s + step1), nt = clip01(t + step2);
+        fresh = 0;
         for (int h = 0; h < 3; h++) {
             quad_residual(c, x, ns, nt, rn);
-            if (!(dot3(rn, rn) > f0 * (1 + 1e-10))) break;
+            if (!(dot3(rn, rn) > f0 * (1 + 1e-10))) {
+                fresh = 1;
+                break;
+            }
             step1 *= 0.5;
             step2 *= 0.5;
             ns = clip01(s + step1);
@@ -510,6 +524,7 @@ static double quad_newton(const double (*c)[3], const double *x, double *xi, int
         int done = (ds > dt ? ds : dt) <= NEWTON_TOL;
         s = ns;
         t = nt;
+        if (fresh) memcpy(r, rn, sizeof r);
         if (done) {
             *conv = 1;
             break;
@@ -519,7 +534,7 @@ static double quad_newton(const double (*c)[3], const double *x, double *xi, int
         a1[k] = c[1][k] + t * c[3][k];
         a2[k] = c[2][k] + s * c[3][k];
     }
-    quad_residual(c, x, s, t, r);
+    if (!fresh) quad_residual(c, x, s, t, r);
     double h11 = dot3(a1, a1), h22 = dot3(a2, a2);
     double h12 = dot3(a1, a2) - dot3(r, c[3]);
     *pd = h11 > 0 && h11 * h22 - h12 * h12 > 0;
@@ -593,7 +608,40 @@ INLINE double box_distance2(int g, const double *B, const double *x)
 }
 
 /* The squared distances d (WIDE) from x to the children's boxes of row N (box_distance2 of
- * the single-precision boxes, their bounds exact in double), the children side by side. */
+ * the single-precision boxes, their bounds exact in double), the children side by side:
+ * with the GNU vector extensions (GCC, Clang) the four at once, the same operations in the
+ * same order per child. */
+#if defined(__GNUC__) || defined(__clang__)
+/* two lanes of doubles, two of 64-bit masks (SSE2, NEON): two children at a time */
+typedef double vd2 __attribute__((vector_size(2 * sizeof(double))));
+typedef long long vl2 __attribute__((vector_size(2 * sizeof(long long))));
+
+/* a > b ? a : b per lane */
+INLINE vd2 larger(vd2 a, vd2 b)
+{
+    vl2 m = a > b;
+    return (vd2)(((vl2)a & m) | ((vl2)b & ~m));
+}
+
+INLINE void row_distance2(int g, const node_t *N, const double *x, double *d)
+{
+    const vd2 zero = {0.0, 0.0};
+    vd2 s0 = zero, s1 = zero; /* children 0, 1 and 2, 3 */
+    for (int k = 0; k < g; k++) {
+        const float *lo = N->lo[k], *hi = N->hi[k];
+        vd2 xk = {x[k], x[k]};
+        vd2 lo0 = {lo[0], lo[1]}, lo1 = {lo[2], lo[3]}, hi0 = {hi[0], hi[1]}, hi1 = {hi[2], hi[3]};
+        vd2 e0 = larger(larger(lo0 - xk, xk - hi0), zero);
+        vd2 e1 = larger(larger(lo1 - xk, xk - hi1), zero);
+        s0 += e0 * e0;
+        s1 += e1 * e1;
+    }
+    d[0] = s0[0];
+    d[1] = s0[1];
+    d[2] = s1[0];
+    d[3] = s1[1];
+}
+#else
 INLINE void row_distance2(int g, const node_t *N, const double *x, double *d)
 {
     for (int c = 0; c < WIDE; c++) d[c] = 0.0;
@@ -605,6 +653,7 @@ INLINE void row_distance2(int g, const node_t *N, const double *x, double *d)
             d[c] += e * e;
         }
 }
+#endif
 
 /* Whether the surface facet X (kind 1 or 2) is certainly farther than bound from x: the
  * facet lies in a slab along its normal n at the centre (a triangle in its plane; a bilinear
@@ -768,181 +817,298 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
     return s < 0.0;
 }
 
-/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose
- * exact distance is within reach() of the smallest one, if that smallest one is within
- * reach(radius). count[p] is their number; up to cap of them are written at p * cap of f,
- * xi (fdim per pair), dist, edge, vertex (projection._Pairs), unless y is given and the count
- * is 1: where one facet is within that reach and y is not NULL, the fields of its closest
- * point are written instead at row index[p] (p if index is NULL) of facet, oxi, y, normal,
- * gap, distance and sliding (a projection.Projection; count set to 0 and the placeholders
- * written if it is beyond radius). Self-contact (pnodes not NULL): only the admissible
- * facets, with pnodes (npts, m) the node numbers of each point's facet, pnormal (npts, g) its
- * normal, fnodes (n, mf) the facets' node numbers, axis (n, g) their centre normals.
- * Returns the number of exact projections made, -1 when out of memory, -3 when the walk
- * overflows its stack (a tree far deeper than a balanced one); bvh_query -2 for an unknown
- * facet kind. */
-INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const void *tree, double rmax, i64 npts,
-              const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
-              double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
-              double *oxi, double *y, double *normal, double *gap, double *distance,
-              double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
-              const i64 *fnodes, const double *axis)
+/* The walk of one point: the facets met within the bound (hits, at leaf positions), the
+ * smallest distance met (best), the bound (reach of the best, at most reach of the radius;
+ * bound2 its square), and the exact projections made by the walks of the lane so far. */
+typedef struct {
+    hit_t *hits;
+    i64 nh, room, projected;
+    double best, bound, bound2, radius;
+} walk_t;
+
+/* The facet at leaf position j for the point x: skipped if its box or (a quadrilateral) its
+ * slab is beyond the bound or (self-contact: pn, the point's facet's nodes, not NULL) it is
+ * not admissible; else projected, and a hit if within the bound, which then tightens to the
+ * reach of the best distance. Returns 1 if projected, 0 if not, -1 when out of memory. */
+INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 j,
+                 const double *xp, double rmax, walk_t *W, int mp, const i64 *pn,
+                 const double *pnu, int mf, const i64 *fnodes, const double *axis)
 {
-    int fdim = g - 1;
-    const node_t *T = rows(tree);
-    i64 room = 64, projected = 0;
-    hit_t *hits = malloc(room * sizeof(hit_t));
-    if (!hits) return -1;
+    const double *X = leaf_nodes + j * nn * g;
+    { /* the facet's box before its exact projection */
+        double B[6];
+        for (int k = 0; k < g; k++) {
+            B[k] = B[g + k] = X[k];
+            for (int q = 1; q < nn; q++) {
+                double v = X[q * g + k];
+                if (v < B[k]) B[k] = v;
+                if (v > B[g + k]) B[g + k] = v;
+            }
+        }
+        if (box_distance2(g, B, xp) > W->bound2) return 0;
+    }
+    if (kind == 2 && beyond_slab(kind, X, xp, W->bound, rmax)) return 0;
+    if (pn && !admissible(g, mp, pn, pnu, mf, fnodes + perm[j] * mf, axis + perm[j] * g))
+        return 0;
+    pair_t q;
+    project(kind, X, xp, &q);
+    if (q.dist > W->bound) return 1;
+    if (W->nh == W->room) {
+        /* drop the hits beyond the bound, then grow */
+        i64 k = 0;
+        for (i64 h = 0; h < W->nh; h++)
+            if (W->hits[h].q.dist <= W->bound) W->hits[k++] = W->hits[h];
+        W->nh = k;
+        if (W->nh == W->room) {
+            hit_t *more = realloc(W->hits, 2 * W->room * sizeof(hit_t));
+            if (!more) return -1;
+            W->hits = more;
+            W->room *= 2;
+        }
+    }
+    W->hits[W->nh].j = j;
+    W->hits[W->nh].q = q;
+    W->nh++;
+    if (q.dist < W->best) {
+        W->best = q.dist;
+        double r = reach(q.dist < W->radius ? q.dist : W->radius, rmax);
+        if (r < W->bound) {
+            W->bound = r;
+            W->bound2 = r * r;
+        }
+    }
+    return 1;
+}
+
+/* What a query reads and writes (bvh_query's arguments). */
+typedef struct {
+    const double *leaf_nodes, *x;
+    const i64 *perm;
+    const node_t *T;
+    i64 m;
+    double rmax, radius;
+    int cap, mp, mf;
+    i64 *count, *f, *edge, *point, used;
+    double *xi, *dist;
+    unsigned char *vertex;
+    const i64 *index;
+    i64 *facet;
+    double *oxi, *y, *normal, *gap, *distance, *sliding;
+    const i64 *pnodes, *fnodes;
+    const double *pnormal, *axis;
+} query_t;
+
+/* The walk of point p in a lane (the lanes of a query walk their points by turns: one
+ * lane's loads are under way while the others work): its stack of rows and leaves (codes)
+ * with their squared box distances. */
+typedef struct {
+    walk_t W;
+    i64 p, top;
     i64 stack[STACK];
     double lower[STACK];
-    for (i64 p = 0; p < npts; p++) {
-        const double *xp = x + p * g;
-        double best = INFINITY;
-        double bound = reach(radius, rmax), bound2 = bound * bound;
-        i64 nh = 0, top = 0;
-        count[p] = 0;
-        if (m == 0) continue;
-        double root[WIDE];
-        row_distance2(g, T + m, xp, root);
-        double d0 = root[0];
-        if (d0 <= bound2) {
-            stack[0] = T[m].child[0];
-            lower[0] = d0;
-            top = 1;
+} lane_t;
+
+/* Start the walk of point p in lane L: its root pushed if within the bound. */
+INLINE void start(int g, const query_t *Q, lane_t *L, i64 p)
+{
+    walk_t *W = &L->W;
+    L->p = p;
+    L->top = 0;
+    W->nh = 0;
+    W->best = INFINITY;
+    W->bound = reach(Q->radius, Q->rmax);
+    W->bound2 = W->bound * W->bound;
+    Q->count[p] = 0;
+    if (Q->m == 0) return;
+    double root[WIDE];
+    row_distance2(g, Q->T + Q->m, Q->x + p * g, root);
+    if (!(root[0] <= W->bound2)) return;
+    L->stack[0] = Q->T[Q->m].child[0];
+    L->lower[0] = root[0];
+    L->top = 1;
+}
+
+/* One step of the walk of lane L (its stack not empty): the nearest entry popped, and
+ * either its children within the bound pushed, farthest first (their loads started), or
+ * its facets visited. Returns 0, -1 when out of memory, -3 when the stack is full (a tree
+ * far deeper than log4(m)). */
+INLINE int step(int kind, int g, int nn, const query_t *Q, lane_t *L)
+{
+    walk_t *W = &L->W;
+    const double *xp = Q->x + L->p * g;
+    i64 top = --L->top;
+    i64 code = L->stack[top];
+    if (L->lower[top] > W->bound2) return 0;
+    if (code >= 0) {
+        const node_t *N = Q->T + code;
+        double d[WIDE], ds[WIDE];
+        i64 c[WIDE];
+        int k = 0;
+        row_distance2(g, N, xp, ds);
+        for (int slot = 0; slot < WIDE; slot++) {
+            if (N->child[slot] == EMPTY || ds[slot] > W->bound2) continue;
+            int at = k++; /* insertion by decreasing distance */
+            while (at > 0 && d[at - 1] < ds[slot]) {
+                d[at] = d[at - 1];
+                c[at] = c[at - 1];
+                at--;
+            }
+            d[at] = ds[slot];
+            c[at] = N->child[slot];
         }
-        while (top > 0) {
-            top--;
-            i64 code = stack[top];
-            if (lower[top] > bound2) continue;
-            if (code >= 0) {
-                /* the children within the bound, pushed farthest first */
-                const node_t *N = T + code;
-                double d[WIDE], ds[WIDE];
-                i64 c[WIDE];
-                int k = 0;
-                row_distance2(g, N, xp, ds);
-                for (int slot = 0; slot < WIDE; slot++) {
-                    if (N->child[slot] == EMPTY || ds[slot] > bound2) continue;
-                    int at = k++; /* insertion by decreasing distance */
-                    while (at > 0 && d[at - 1] < ds[slot]) {
-                        d[at] = d[at - 1];
-                        c[at] = c[at - 1];
-                        at--;
-                    }
-                    d[at] = ds[slot];
-                    c[at] = N->child[slot];
-                }
-                if (top + k > STACK) {
-                    free(hits);
-                    return -3; /* the walk's stack is full: a tree far deeper than log4(m) */
-                }
-                for (int j = 0; j < k; j++) {
-                    stack[top] = c[j];
-                    lower[top++] = d[j];
-                    prefetch_child(T, leaf_nodes, nn * g, c[j]);
-                }
-                continue;
-            }
-            i64 start = (-code - 1) >> 3, end = start + ((-code - 1) & 7);
-            PREFETCH(perm + start);
-            for (i64 j = start; j < end; j++) {
-                const double *X = leaf_nodes + j * nn * g;
-                {  /* the facet's box before its exact projection */
-                    double B[6];
-                    for (int k = 0; k < g; k++) {
-                        B[k] = B[g + k] = X[k];
-                        for (int q = 1; q < nn; q++) {
-                            double v = X[q * g + k];
-                            if (v < B[k]) B[k] = v;
-                            if (v > B[g + k]) B[g + k] = v;
-                        }
-                    }
-                    if (box_distance2(g, B, xp) > bound2) continue;
-                }
-                if (kind == 2 && beyond_slab(kind, X, xp, bound, rmax)) continue;
-                if (pnodes && !admissible(g, mp, pnodes + p * mp, pnormal + p * g, mf,
-                                          fnodes + perm[j] * mf, axis + perm[j] * g))
-                    continue;
-                pair_t q;
-                project(kind, X, xp, &q);
-                projected++;
-                if (q.dist > bound) continue;
-                if (nh == room) {
-                    /* drop the hits beyond the bound, then grow */
-                    i64 k = 0;
-                    for (i64 h = 0; h < nh; h++)
-                        if (hits[h].q.dist <= bound) hits[k++] = hits[h];
-                    nh = k;
-                    if (nh == room) {
-                        hit_t *more = realloc(hits, 2 * room * sizeof(hit_t));
-                        if (!more) {
-                            free(hits);
-                            return -1;
-                        }
-                        hits = more;
-                        room *= 2;
-                    }
-                }
-                hits[nh].j = j;
-                hits[nh].q = q;
-                nh++;
-                if (q.dist < best) {
-                    best = q.dist;
-                    double r = reach(best < radius ? best : radius, rmax);
-                    if (r < bound) {
-                        bound = r;
-                        bound2 = r * r;
-                    }
-                }
-            }
+        if (top + k > STACK) return -3;
+        for (int j = 0; j < k; j++) {
+            L->stack[top] = c[j];
+            L->lower[top++] = d[j];
+            prefetch_child(Q->T, Q->leaf_nodes, nn * g, c[j]);
         }
-        i64 k = 0, last = 0;
-        for (i64 h = 0; h < nh; h++)
-            if (hits[h].q.dist <= bound) {
-                last = h;
-                k++;
-            }
-        count[p] = k;
-        /* the pairs, unless the point's one pair is finished below (their rows untouched) */
-        for (i64 h = 0, c = 0; h < nh && c < cap && (k > 1 || !y); h++) {
+        L->top = top;
+        return 0;
+    }
+    const i64 *pn = Q->pnodes ? Q->pnodes + L->p * Q->mp : NULL;
+    const double *pnu = Q->pnodes ? Q->pnormal + L->p * g : NULL;
+    i64 first = (-code - 1) >> 3, end = first + ((-code - 1) & 7);
+    for (i64 j = first; j < end; j++) {
+        int status = visit(kind, g, nn, Q->leaf_nodes, Q->perm, j, xp, Q->rmax, W, Q->mp, pn,
+                           pnu, Q->mf, Q->fnodes, Q->axis);
+        if (status < 0) return -1;
+        W->projected += status;
+    }
+    return 0;
+}
+
+/* The results of the point of lane L, its walk done: its count, and its pairs at the next
+ * row or its closest point (see bvh_query). */
+INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
+{
+    const int fdim = g - 1;
+    const walk_t *W = &L->W;
+    const hit_t *hits = W->hits;
+    const i64 p = L->p, nh = W->nh;
+    const double *xp = Q->x + p * g, bound = W->bound;
+    i64 k = 0, last = 0;
+    for (i64 h = 0; h < nh; h++)
+        if (hits[h].q.dist <= bound) {
+            last = h;
+            k++;
+        }
+    Q->count[p] = k;
+    if (k == 0) return;
+    if (k > 1 || !Q->y) {
+        /* the pairs, at the next row */
+        Q->point[Q->used] = p;
+        for (i64 h = 0, c = 0; h < nh && c < Q->cap; h++) {
             if (hits[h].q.dist > bound) continue;
-            i64 o = p * cap + c++;
-            f[o] = perm[hits[h].j];
-            for (int j = 0; j < fdim; j++) xi[o * fdim + j] = hits[h].q.xi[j];
-            dist[o] = hits[h].q.dist;
-            edge[o] = hits[h].q.edge;
-            vertex[o] = (unsigned char)hits[h].q.vertex;
+            i64 o = Q->used * Q->cap + c++;
+            Q->f[o] = Q->perm[hits[h].j];
+            for (int j = 0; j < fdim; j++) Q->xi[o * fdim + j] = hits[h].q.xi[j];
+            Q->dist[o] = hits[h].q.dist;
+            Q->edge[o] = hits[h].q.edge;
+            Q->vertex[o] = (unsigned char)hits[h].q.vertex;
         }
-        if (k == 1 && y) {
-            /* one facet within the tie reach: the closest point, no tie-break */
-            const pair_t *q = &hits[last].q;
-            const double *X = leaf_nodes + hits[last].j * nn * g;
-            i64 o = index ? index[p] : p;
-            if (finish(kind, g, nn, X, xp, q, radius, y + o * g, normal + o * g, gap + o,
-                       distance + o, sliding + o * fdim * fdim)) {
-                facet[o] = perm[hits[last].j];
-                for (int j = 0; j < fdim; j++) oxi[o * fdim + j] = q->xi[j];
-            } else {
-                count[p] = 0;
-                for (int c = 0; c < g; c++) {  /* the placeholders of an unpaired point */
-                    y[o * g + c] = xp[c];
-                    normal[o * g + c] = 0.0;
-                }
-                gap[o] = -INFINITY;
-                distance[o] = INFINITY;
-                for (int c = 0; c < fdim * fdim; c++) sliding[o * fdim * fdim + c] = 0.0;
+        Q->used++;
+        return;
+    }
+    /* one facet within the tie reach: the closest point, no tie-break */
+    const pair_t *q = &hits[last].q;
+    const double *X = Q->leaf_nodes + hits[last].j * nn * g;
+    i64 o = Q->index ? Q->index[p] : p;
+    double *y = Q->y + o * g, *normal = Q->normal + o * g, *M = Q->sliding + o * fdim * fdim;
+    if (finish(kind, g, nn, X, xp, q, Q->radius, y, normal, Q->gap + o, Q->distance + o, M)) {
+        Q->facet[o] = Q->perm[hits[last].j];
+        for (int j = 0; j < fdim; j++) Q->oxi[o * fdim + j] = q->xi[j];
+        return;
+    }
+    Q->count[p] = 0;
+    for (int c = 0; c < g; c++) { /* the placeholders of an unpaired point */
+        y[c] = xp[c];
+        normal[c] = 0.0;
+    }
+    Q->gap[o] = -INFINITY;
+    Q->distance[o] = INFINITY;
+    for (int c = 0; c < fdim * fdim; c++) M[c] = 0.0;
+}
+
+INLINE void free_lanes(lane_t *L, int lanes)
+{
+    for (int l = 0; l < lanes; l++) free(L[l].W.hits);
+    free(L);
+}
+
+/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose
+ * exact distance is within reach() of the smallest one, if that smallest one is within
+ * reach(radius). count[p] is their number; up to cap of them are written at row r (r cap
+ * to r cap + cap - 1) of f, xi (fdim per pair), dist, edge, vertex (projection._Pairs),
+ * point[r] = p, *written the number of rows (the arrays' first rows only: the pages of the
+ * others never touched), unless y is given and the count is 1: where one facet is within
+ * that reach and y is not NULL, the fields of its closest point are written instead at row
+ * index[p] (p if index is NULL) of facet, oxi, y, normal, gap, distance and sliding (a
+ * projection.Projection; count set to 0 and the placeholders written if it is beyond
+ * radius). Self-contact (pnodes not NULL): only the admissible facets, with pnodes (npts,
+ * m) the node numbers of each point's facet, pnormal (npts, g) its normal, fnodes (n, mf)
+ * the facets' node numbers, axis (n, g) their centre normals. The points are walked LANES
+ * at a time (surfaces; segments one at a time), a step of each by turns. Returns the number of exact projections made, -1 when
+ * out of memory, -3 when the walk overflows its stack (a tree far deeper than a balanced
+ * one); bvh_query -2 for an unknown facet kind. */
+INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
+                 const void *tree, double rmax, i64 npts, const double *x, double radius,
+                 int cap, i64 *count, i64 *f, double *xi, double *dist, i64 *edge,
+                 unsigned char *vertex, i64 *point, i64 *written, const i64 *index,
+                 i64 *facet, double *oxi, double *y, double *normal, double *gap,
+                 double *distance, double *sliding, int mp, const i64 *pnodes,
+                 const double *pnormal, int mf, const i64 *fnodes, const double *axis)
+{
+    query_t Q = {leaf_nodes, x, perm, rows(tree), m, rmax, radius, cap, mp, mf,
+                 count, f, edge, point, 0, xi, dist, vertex, index, facet, oxi, y, normal,
+                 gap, distance, sliding, pnodes, fnodes, pnormal, axis};
+    /* one lane for segments: their walks are short and their projections cheap, the turns
+     * cost more than they save */
+    const int lanes = kind == 0 ? 1 : LANES;
+    lane_t *L = malloc(lanes * sizeof(lane_t));
+    if (!L) return -1;
+    for (int l = 0; l < lanes; l++) {
+        walk_t W = {malloc(64 * sizeof(hit_t)), 0, 64, 0, INFINITY, 0.0, 0.0, radius};
+        L[l].W = W;
+        L[l].p = -1;
+        L[l].top = 0;
+    }
+    for (int l = 0; l < lanes; l++)
+        if (!L[l].W.hits) {
+            free_lanes(L, lanes);
+            return -1;
+        }
+    i64 next = 0;
+    for (int busy = 1; busy;) {
+        busy = 0;
+        for (int l = 0; l < lanes; l++) {
+            lane_t *A = L + l;
+            while (A->top == 0) { /* the lane's point done (or none yet): the next point */
+                if (A->p >= 0) conclude(kind, g, nn, &Q, A);
+                A->p = -1;
+                if (next == npts) break;
+                start(g, &Q, A, next++);
+            }
+            if (A->p < 0) continue;
+            busy = 1;
+            int status = step(kind, g, nn, &Q, A);
+            if (status < 0) {
+                free_lanes(L, lanes);
+                return status;
             }
         }
     }
-    free(hits);
+    i64 projected = 0;
+    for (int l = 0; l < lanes; l++) projected += L[l].W.projected;
+    free_lanes(L, lanes);
+    *written = Q.used;
     return projected;
 }
 
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
               const void *tree, double rmax, i64 npts,
               const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
-              double *dist, i64 *edge, unsigned char *vertex, const i64 *index, i64 *facet,
+              double *dist, i64 *edge, unsigned char *vertex, i64 *point, i64 *written,
+              const i64 *index, i64 *facet,
               double *oxi, double *y, double *normal, double *gap, double *distance,
               double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
               const i64 *fnodes, const double *axis)
@@ -950,16 +1116,16 @@ i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm
     /* one copy of the walk per facet kind, its dimensions constant */
     if (kind == 0)
         return query(0, 2, 2, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
-                     mp, pnodes, pnormal, mf, fnodes, axis);
+                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
+                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
     if (kind == 1)
         return query(1, 3, 3, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
-                     mp, pnodes, pnormal, mf, fnodes, axis);
+                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
+                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
     if (kind == 2)
         return query(2, 3, 4, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, index, facet, oxi, y, normal, gap, distance, sliding,
-                     mp, pnodes, pnormal, mf, fnodes, axis);
+                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
+                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
     (void)g;
     (void)nn;
     return -2;
