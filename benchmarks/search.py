@@ -112,11 +112,11 @@ quadrilaterals 1.30e6 -> 1.53e6, 1e5 1.07e6 -> 1.22e6, 1e6 7.9e5 -> 9.4e5; radiu
 triangles 4.8e5 -> 5.0e5, quadrilaterals 4.4e5 -> 4.7e5; 100 h and infinity unchanged within
 the noise. ``--sweeps points`` (1e6 facets, radius h), per-point rate of the fit: triangles
 9.8e5 -> 1.21e6 (unchanged master) / 8.6e5 -> 1.14e6 (moved), quadrilaterals 7.6e5 -> 8.9e5 /
-8.3e5 -> 8.0e5 (one run each). ``search.json`` was then re-run on the quiet machine (load below 1): radius h, 1e5
-triangles 1.43e6, quadrilaterals 1.24e6; 1e6 triangles 9.9e5, quadrilaterals 8.4e5; the
-points sweep's per-point rate on 1e6 facets (unchanged / moved master): triangles 1.14e6 /
-1.26e6, quadrilaterals 9.9e5 / 8.7e5 (self-contact and graded master: the same as before,
-checked side by side).
+8.3e5 -> 8.0e5 (one run each). ``search.json`` was then re-run on the quiet machine
+(load below 1): radius h, 1e5 triangles 1.43e6, quadrilaterals 1.24e6; 1e6 triangles
+9.9e5, quadrilaterals 8.4e5; the points sweep's per-point rate on 1e6 facets (unchanged /
+moved master): triangles 1.14e6 / 1.26e6, quadrilaterals 9.9e5 / 8.7e5 (self-contact and
+graded master: the same as before, checked side by side).
 
 The distance sweep of the third round showed where the time went: at a given distance the
 cost is flat in the radius (within the timing noise, e.g. 1e5 triangles at 1 h: 1.2e5
