@@ -90,8 +90,6 @@ BEAMS_FULL = [3, 4]
 BEAMS_QUICK = [3]
 HERTZ3D_FULL = [0.025, 0.0125]
 HERTZ3D_QUICK = [0.025]
-#: ``"scene"``: each scene's eps_N (E / h); ``"default"``: the package's (``--eps``)
-EPS = "scene"
 PARTS = ("search", "residual_assembly", "jacobian_assembly", "ptap", "linear_solve")
 
 
@@ -243,12 +241,19 @@ def save_tangent(problem: ContactProblem, path: str) -> None:
 
 
 def run(
-    make, size, contact: bool, options: dict | None = None, glue: int = 0, dump: str = ""
+    make,
+    size,
+    contact: bool,
+    options: dict | None = None,
+    glue: int = 0,
+    dump: str = "",
+    eps: str = "scene",
 ) -> dict:
     """Solve one scene and return its record (``glue``: with the glued baseline, its
-    factorisations repeated ``glue`` times; ``dump``: write the contact tangent there)."""
+    factorisations repeated ``glue`` times; ``dump``: write the contact tangent there;
+    ``eps``: ``"scene"``, each scene's eps_N (E / h), or ``"default"``, the package's)."""
     scene, steps, t_end = make(size, contact)
-    if EPS == "default":  # the package's default eps_N (E / L) instead of the scene's E / h
+    if eps == "default":  # the package's default eps_N (E / L) instead of the scene's E / h
         pairs = [dataclasses.replace(p, eps_N=None) for p in scene.contacts]
         scene = dataclasses.replace(scene, contacts=pairs)
     options = (options or {}) if contact else bulk_options(options or {})
@@ -284,7 +289,7 @@ def run(
         "ranks": problem.comm.size,
         "options": options,
         "partition": os.environ.get(PARTITION_VARIABLE, "bodies"),
-        "eps": EPS,
+        "eps": eps,
     }
     record["per_rank"] = _per_rank(problem, cpu, timings)
     if dump and contact:
@@ -425,9 +430,7 @@ def _by_ranks(args: argparse.Namespace) -> None:
 
 
 def main() -> None:
-    global EPS
     args = _arguments()
-    EPS = args.eps
     os.environ[PARTITION_VARIABLE] = args.partition  # read by every mesh made (and mpirun's)
     if args.ranks:
         _by_ranks(args)
@@ -456,8 +459,8 @@ def main() -> None:
             size = int(size) if make is beams else size
             runs = [
                 (
-                    run(make, size, False, options, glue),
-                    run(make, size, True, options, glue, args.dump),
+                    run(make, size, False, options, glue, eps=args.eps),
+                    run(make, size, True, options, glue, args.dump, args.eps),
                 )
                 for _ in range(args.repeat)
             ]

@@ -277,6 +277,7 @@ def surface_cells(
         One label per cell, the blocks in order: 0 none, ``k + 1`` for ``surfaces[k]`` (the
         first, for a cell on several).
     """
+    tables = [[np.sort(t, axis=1) for t in surface if len(t) > 0] for surface in surfaces]
     labels = []
     for cell_type, block in zip(cell_types, cells, strict=True):
         nv = dolfinx.cpp.mesh.cell_num_vertices(cell_type)
@@ -285,11 +286,10 @@ def surface_cells(
         label = np.zeros(len(vertices), dtype=np.int32)
         for local in basix.topology(basix.CellType[cell_type.name])[tdim - 1]:
             keys = np.sort(vertices[:, local], axis=1)
-            for k, surface in enumerate(surfaces):
+            for k, surface in enumerate(tables):
                 for table in surface:
-                    if table.shape[1] == len(local) and len(table) > 0:
-                        hit = _rows_in(keys, np.sort(table, axis=1))
-                        label[hit & (label == 0)] = k + 1
+                    if table.shape[1] == len(local):
+                        label[_rows_in(keys, table) & (label == 0)] = k + 1
         labels.append(label)
     return np.concatenate(labels) if labels else np.zeros(0, dtype=np.int32)
 

@@ -36,6 +36,13 @@ def dual_graph(mesh: dolfinx.mesh.Mesh) -> scipy.sparse.csr_array:
     return scipy.sparse.coo_array((ones, (np.r_[a, b], np.r_[b, a])), (n, n)).tocsr()
 
 
+def adjacency_list(graph: scipy.sparse.csr_array) -> dolfinx.cpp.graph.AdjacencyList_int64:
+    """The graph as the adjacency list a DOLFINx graph partitioner takes."""
+    return dolfinx.cpp.graph.AdjacencyList_int64(
+        graph.indices.astype(np.int64), graph.indptr.astype(np.int32)
+    )
+
+
 @pytest.mark.serial
 @pytest.mark.parametrize("nparts", [2, 3])
 def test_body_partitioner_splits_every_body(nparts):
@@ -44,9 +51,7 @@ def test_body_partitioner_splits_every_body(nparts):
     facet neighbours."""
     scene = patch(3, PRESSURE, quadrature_degree=2, subdivisions=1, cell="tetrahedron")
     graph = dual_graph(scene.mesh)
-    adjacency = dolfinx.cpp.graph.AdjacencyList_int64(
-        graph.indices.astype(np.int64), graph.indptr.astype(np.int32)
-    )
+    adjacency = adjacency_list(graph)
     dest = body_partitioner()(MPI.COMM_SELF, nparts, adjacency, True)
     offsets, data = np.asarray(dest.offsets), np.asarray(dest.array)
     owner = data[offsets[:-1]]
@@ -88,9 +93,7 @@ def test_contact_surfaces_are_split_evenly(nparts):
     of each contact surface."""
     scene = hertz_3d(h_contact=0.05).scene
     graph = dual_graph(scene.mesh)
-    adjacency = dolfinx.cpp.graph.AdjacencyList_int64(
-        graph.indices.astype(np.int64), graph.indptr.astype(np.int32)
-    )
+    adjacency = adjacency_list(graph)
     surfaces = contact_cells(scene)
     on_surface = np.zeros(graph.shape[0], dtype=bool)
     for cells in surfaces.values():
@@ -116,9 +119,7 @@ def test_each_contact_surface_of_a_body_is_split_evenly(nparts):
     marked as two, every part gets an equal share (within 10%) of each."""
     scene = hertz_3d(h_contact=0.05).scene
     graph = dual_graph(scene.mesh)
-    adjacency = dolfinx.cpp.graph.AdjacencyList_int64(
-        graph.indices.astype(np.int64), graph.indptr.astype(np.int32)
-    )
+    adjacency = adjacency_list(graph)
     f2c = scene.mesh.topology.connectivity(2, 3)
     faces = [
         f2c.array[f2c.offsets[scene.facet_tags.find(scene.tags[name])]]

@@ -303,8 +303,9 @@ class ContactInterface:
         derivatives of both are exactly zero, so their rows of the master's residual are zero
         and they would add only structural zeros to ``T^T K T``: couplings of the two bodies
         that cost fill in the factorisation, and pairing changes away from the contact that
-        cost analyses (3D Hertz P1 at 50,000 unknowns: 3.8 s against 5.8 s per Newton
-        iteration, the same iterations and force to 1e-15). The values of the gathered
+        cost analyses (3D Hertz P1 at 50,000 unknowns: 4.1 s against 6.2 s per Newton
+        iteration, the same iterations and force to 1e-15; README "Solvers for large
+        problems"). The values of the gathered
         fields stay those of the search (the last step's master nodes of a frictional point
         out of contact are not moved with the master: its slip is not used)."""
         proj = self.kinematics.projection
