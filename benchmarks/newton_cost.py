@@ -204,9 +204,16 @@ def glued(problem: ContactProblem, options: dict, repeat: int) -> tuple[dict, di
     return tangent, block
 
 
+def _nonzeros(A: PETSc.Mat | None) -> int:
+    """This rank's nonzeros of ``A`` (0 for none)."""
+    return 0 if A is None else int(A.getInfo(PETSc.Mat.InfoType.LOCAL)["nz_used"])
+
+
 def _per_rank(problem: ContactProblem, cpu: float, timings) -> list[dict]:
     """Each rank's parts (seconds per Newton iteration), CPU seconds of the solve, slave
-    points, and share of the rows and nonzeros of ``K`` and ``T``: where the work is."""
+    points, and share of the rows and nonzeros of ``K`` (the gathered blocks, through
+    ``T^T K T``), ``A`` (the unknowns' blocks, assembled straight) and ``T``: where the work
+    is."""
     solver = problem.solver
     local = PETSc.Mat.InfoType.LOCAL
     n = max(timings.iterations, 1)
@@ -217,8 +224,9 @@ def _per_rank(problem: ContactProblem, cpu: float, timings) -> list[dict]:
         "search_own_s": sum(c.search_time for c in problem.contacts) / n,
         "slave_points": int(sum(len(c.projection.facet) for c in problem.contacts)),
         "unknowns": problem.layout.local_size,
-        "K_rows": solver._K.getLocalSize()[0],
-        "K_nonzeros": int(solver._K.getInfo(local)["nz_used"]),
+        "K_rows": solver._K.getLocalSize()[0] if solver._K is not None else 0,
+        "K_nonzeros": _nonzeros(solver._K),
+        "A_nonzeros": _nonzeros(solver._A),
         "T_nonzeros": int(solver._T.getInfo(local)["nz_used"]),
         "J_nonzeros": int(solver._J.getInfo(local)["nz_used"]),
     }

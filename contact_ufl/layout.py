@@ -113,3 +113,73 @@ def chain_operator(
     )
     T.assemble()
     return T
+
+
+def split_tangent(
+    forms: Sequence[Sequence[object | None]], fields: Sequence, unknowns: Sequence
+) -> tuple[list[list], list[list] | None, list[int]]:
+    """The blocks of a tangent over the fields split by what the chain rule does to them.
+
+    ``T`` maps an unknown to its own field by the identity, so ``T^T K T`` holds the blocks
+    of ``K`` between two unknowns unchanged: they can be assembled straight into a matrix
+    over the unknowns. Only the blocks that touch a gathered field (the master node
+    positions ``xhat``) need the product, and only over the fields they couple.
+
+    Parameters
+    ----------
+    forms
+        The blocked tangent over ``fields`` (compiled forms or ``None``), rows and columns in
+        the order of ``fields``.
+    fields, unknowns
+        The assembled fields and the unknowns (a subsequence of the fields, in their order).
+
+    Returns
+    -------
+    unknown_forms
+        The blocks between two unknowns, over ``unknowns`` (the solver matrix's layout);
+        ``None`` where an unknown is no field or has no such block (a control's load factor,
+        gathered onto a field of its own): then every block goes through the product.
+    gathered_forms
+        The other blocks, over the coupled fields (``None`` where both are unknowns), or
+        ``None`` where no block touches a gathered field.
+    coupled
+        Indices (in ``fields``) of the fields that those blocks couple, in order.
+    """
+    own = {id(f) for f in unknowns}
+    kept = [i for i, f in enumerate(fields) if id(f) in own]
+    every = list(range(len(fields)))
+    if [id(fields[i]) for i in kept] != [id(f) for f in unknowns]:
+        return None, [list(row) for row in forms], every  # an unknown that is no field
+    is_kept = set(kept)
+    touching = [
+        (i, j)
+        for i in range(len(fields))
+        for j in range(len(fields))
+        if forms[i][j] is not None and not (i in is_kept and j in is_kept)
+    ]
+    coupled = sorted({i for pair in touching for i in pair})
+    if not coupled:
+        return [[forms[i][j] for j in kept] for i in kept], None, []
+    # a coupled unknown whose row (or column) touches no gathered field keeps its diagonal
+    # block in the product (a blocked matrix needs a form in every row and column)
+    moved = {
+        i
+        for i in coupled
+        if i in is_kept
+        and (
+            not any(forms[i][j] is not None and j not in is_kept for j in coupled)
+            or not any(forms[j][i] is not None and j not in is_kept for j in coupled)
+        )
+    }
+    unknown_forms = [[None if i == j and i in moved else forms[i][j] for j in kept] for i in kept]
+    columns = list(zip(*unknown_forms, strict=True))
+    if any(all(f is None for f in row) for row in [*unknown_forms, *columns]):
+        return None, [list(row) for row in forms], every  # an unknown without a block
+    gathered_forms = [
+        [
+            forms[i][j] if not (i in is_kept and j in is_kept) or (i == j and i in moved) else None
+            for j in coupled
+        ]
+        for i in coupled
+    ]
+    return unknown_forms, gathered_forms, coupled

@@ -4,11 +4,12 @@ The residual and Jacobian forms of :class:`~contact_ufl.problem.ContactProblem` 
 assembled over the fields ``[u, xhat_1, lambda_1, ...]``; the chain operator ``T`` of
 :mod:`contact_ufl.layout` (identity on the unknowns, the gathers ``xhat = Xhat + P u``)
 maps them onto the unknowns ``[u, lambda_1, ...]``: residual ``T^T r``, tangent
-``T^T K T``. The search runs at every new state; ``T`` and the tangent's sparsity pattern
-change only when the pairing does, and the solver matrix's pattern (that of the
-factorisation's symbolic analysis) only when a pairing leaves a superset of the pairings
-met (:attr:`NewtonSolver.pattern_superset`). The solver times its parts
-(:class:`NewtonTimings`).
+``T^T K T`` (the tangent's blocks between two unknowns, the bulk's among them, are assembled
+straight into the solver matrix: ``T`` maps them by the identity). The search runs at every
+new state; ``T`` and the tangent's sparsity pattern change only when the pairing does, and
+the solver matrix's pattern (that of the factorisation's symbolic analysis) only when a
+pairing leaves a superset of the pairings met (:attr:`NewtonSolver.pattern_superset`). The
+solver times its parts (:class:`NewtonTimings`).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from contact_ufl import free_bodies
-from contact_ufl.layout import chain_operator
+from contact_ufl.layout import StackedLayout, chain_operator, split_tangent
 
 if TYPE_CHECKING:
     from contact_ufl.problem import ContactProblem
@@ -60,10 +61,12 @@ class NewtonTimings:
         Assembly of the residual over the fields and its map ``T^T r`` to the unknowns, with
         the Dirichlet rows.
     jacobian_assembly
-        Assembly of the tangent ``K`` over the fields (bulk and contact forms together).
+        Assembly of the tangent: its blocks between unknowns straight into the solver's
+        matrix, the blocks of the gathered fields (``K``) over the fields they couple.
     ptap
-        ``T^T K T``, the copy into the solver's matrix (whose pattern grows, with a reset
-        factorisation, where a new pairing leaves it) and the Dirichlet rows.
+        ``T^T K T`` of the gathered blocks, its sum into the solver's matrix (whose pattern
+        grows, with a reset factorisation, where a new pairing leaves it) and the Dirichlet
+        rows.
     newton
         Time inside ``SNES.solve``.
     callbacks
@@ -209,12 +212,29 @@ class NewtonSolver:
         spaces = [f.function_space for f in problem.fields]
         self._field_index = {id(f): k for k, f in enumerate(problem.fields)}
         self._r = fem_petsc.create_vector(spaces, kind="mpi")
-        self._K = fem_petsc.create_matrix(problem.jacobian_form, kind="mpi")
+        # the tangent's blocks between unknowns go straight into the solver matrix (T maps
+        # them by the identity; A: their pattern and the local-to-global maps of that
+        # assembly); only the blocks of the gathered fields go through T^T K T
+        self._unknown_forms, self._gathered_forms, self._coupled = split_tangent(
+            problem.jacobian_form, problem.fields, problem.unknowns
+        )
+        self._A = None
+        if self._unknown_forms is not None:
+            self._A = fem_petsc.create_matrix(self._unknown_forms, kind="mpi")
+            fem_petsc.assemble_matrix(self._A, self._unknown_forms)  # its pattern (any values)
+            self._A.assemble()
+        self._K = self._coupled_layout = None
+        if self._gathered_forms is not None:
+            self._K = fem_petsc.create_matrix(self._gathered_forms, kind="mpi")
+            self._coupled_layout = StackedLayout(
+                [problem.fields[i].function_space for i in self._coupled]
+            )
         self.x = fem_petsc.create_vector([f.function_space for f in problem.unknowns], kind="mpi")
         fem_petsc.assign(problem.unknowns, self.x)
         self._R = self.x.duplicate()
         self._J = None
-        self._T = None
+        self._T = None  # the chain operator onto every field (the residual's)
+        self._T_coupled = None  # its rows of the fields the gathered blocks couple
         self._JT = None
         self._pattern = None
         self._T_wide = None  # the superset operator of the solver matrix's pattern
@@ -327,6 +347,7 @@ class NewtonSolver:
         if changed:
             self._pattern = pattern
             self._T = self._chain_operator(gathers)
+            self._T_coupled = self._chain_operator(gathers, self._coupled)
             self._JT = None
             self._gathers = (parts, gathers)
             self._widen()
@@ -371,7 +392,7 @@ class NewtonSolver:
         # without the superset (3D) the pattern's operator is T itself: its product
         # T^T K T is then the tangent's, not a second PtAP
         same = all(w is g for w, g in zip(wide, gathers, strict=True))
-        self._T_wide = self._T if same else self._chain_operator(wide)
+        self._T_wide = self._T_coupled if same else self._chain_operator(wide, self._coupled)
         keys = self._gather_keys(wide)
         self._wide_current = keys
         self._wide_now = len(keys)
@@ -379,21 +400,26 @@ class NewtonSolver:
         self._wide_keys = keys if old is None else np.union1d(old, keys)
         self._grow = True
 
-    def _chain_operator(self, gathers: list[list]) -> PETSc.Mat:
-        """``T``: identity from each unknown to its assembled field, gathers for the others."""
+    def _chain_operator(self, gathers: list[list], rows: list[int] | None = None) -> PETSc.Mat:
+        """``T``: identity from each unknown to its assembled field, gathers for the others;
+        its rows of the fields ``rows`` (indices in the problem's fields; default: all).
+        ``None`` for no rows."""
         problem = self.problem
+        if rows is not None and not rows:
+            return None
+        fields = problem.fields
+        rows = range(len(fields)) if rows is None else rows
+        layout = problem.full_layout if len(rows) == len(fields) else self._coupled_layout
+        block = {id(fields[i]): k for k, i in enumerate(rows)}
         unknown_index = {id(f): k for k, f in enumerate(problem.unknowns)}
-        identity, gather_blocks, gather_cols = [], [], []
-        for row, f in enumerate(problem.fields):
-            if id(f) in unknown_index:
-                identity.append((row, unknown_index[id(f)]))
+        identity = [(block[k], unknown_index[k]) for k in block if k in unknown_index]
+        gather_blocks, gather_cols = [], []
         for g in gathers:
             for f, cols in g:
-                gather_blocks.append(self._field_index[id(f)])
-                gather_cols.append(cols)
-        return chain_operator(
-            problem.full_layout, problem.layout, identity, gather_blocks, gather_cols
-        )
+                if id(f) in block:
+                    gather_blocks.append(block[id(f)])
+                    gather_cols.append(cols)
+        return chain_operator(layout, problem.layout, identity, gather_blocks, gather_cols)
 
     def _block_slice(self, f: dolfinx.fem.Function) -> slice:
         """Local (owned) range of the assembled field ``f`` in the full layout."""
@@ -469,23 +495,38 @@ class NewtonSolver:
     def _assemble_jacobian_matrix(self, first: bool = False) -> PETSc.Mat:
         start = time.perf_counter()
         K = self._K
-        K.zeroEntries()
-        fem_petsc.assemble_matrix(K, self.problem.jacobian_form)
-        K.assemble()
+        if K is not None:
+            K.zeroEntries()
+            fem_petsc.assemble_matrix(K, self._gathered_forms)
+            K.assemble()
         assembled = time.perf_counter()
-        self.timings.jacobian_assembly += assembled - start
-        self.timings.jacobians += 1
-        if self._JT is None:
-            self._JT = K.PtAP(self._T)
+        if K is not None and self._JT is None:
+            self._JT = K.PtAP(self._T_coupled)
             self.timings.new_patterns += 1
-        else:
-            K.PtAP(self._T, result=self._JT)
+        elif K is not None:
+            K.PtAP(self._T_coupled, result=self._JT)
         J = self._grown_matrix(first)
-        J.zeroEntries()
-        J.axpy(1.0, self._JT, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        self._zero_dirichlet_rows(J)
-        self.timings.ptap += time.perf_counter() - assembled
+        multiplied = time.perf_counter()
+        self._assemble_unknown_blocks(J)
+        own = time.perf_counter()
+        self._add_gathered_blocks(J)
+        self.timings.jacobian_assembly += (assembled - start) + (own - multiplied)
+        self.timings.ptap += (multiplied - assembled) + (time.perf_counter() - own)
+        self.timings.jacobians += 1
         return J
+
+    def _assemble_unknown_blocks(self, J: PETSc.Mat) -> None:
+        """The tangent's blocks between unknowns, straight into ``J`` (its values zeroed)."""
+        J.zeroEntries()
+        if self._A is not None:
+            fem_petsc.assemble_matrix(J, self._unknown_forms)
+            J.assemble()
+
+    def _add_gathered_blocks(self, J: PETSc.Mat) -> None:
+        """Add ``T^T K T`` of the gathered blocks to ``J``, then the Dirichlet rows."""
+        if self._JT is not None:
+            J.axpy(1.0, self._JT, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        self._zero_dirichlet_rows(J)
 
     def _grown_matrix(self, new: bool = False) -> PETSc.Mat:
         """The solver matrix, its pattern grown by that of the superset operator where a
@@ -493,11 +534,13 @@ class NewtonSolver:
         ``T^T K T``'s: ``T`` is within the superset operator."""
         if not (self._grow or new):
             return self._J
-        tangent = self._T_wide is self._T and self._JT is not None
-        pattern = self._JT if tangent else self._K.PtAP(self._T_wide)
+        pattern = None  # the gathered blocks' T^T K T over the superset operator
+        tangent = self._T_wide is self._T_coupled and self._JT is not None
+        if self._K is not None:
+            pattern = self._JT if tangent else self._K.PtAP(self._T_wide)
         union, now = self.comm.allreduce(np.array([len(self._wide_keys), self._wide_now]))
         if new or union > (1.0 + self.pattern_slack) * now:  # on the current superset only
-            J = pattern.duplicate(copy=True) if tangent else pattern
+            J = self._new_matrix(pattern)
             self._wide_keys = self._wide_current
             if not new:  # the SNES's matrix from now on (the old one kept for its caller)
                 self._retired, self._J = self._J, J
@@ -505,14 +548,26 @@ class NewtonSolver:
         else:
             J = self._J
             J.zeroEntries()
-            J.axpy(1.0, pattern, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            if not tangent:
-                pattern.destroy()
+            if pattern is not None:
+                J.axpy(1.0, pattern, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        if pattern is not None and not tangent:
+            pattern.destroy()
+        if self._A is not None:  # the maps of the unknowns' blocks' assembly into J
+            J.setLGMap(*self._A.getLGMap())
         if not new:
             self._reset_pc()  # MUMPS fails on a changed pattern otherwise
         J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
         self._grow = False
         self.timings.analyses += 1
+        return J
+
+    def _new_matrix(self, pattern: PETSc.Mat | None) -> PETSc.Mat:
+        """A solver matrix on the pattern of the unknowns' blocks and ``pattern``."""
+        if self._A is None:
+            return pattern.duplicate()
+        J = self._A.duplicate()
+        if pattern is not None:
+            J.axpy(1.0, pattern, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return J
 
     def _shrink_pattern(self) -> None:
@@ -526,9 +581,8 @@ class NewtonSolver:
         self._wide_keys = self._wide_current = None
         self._widen()
         J = self._grown_matrix(new=True)
-        J.zeroEntries()
-        J.axpy(1.0, self._JT, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        self._zero_dirichlet_rows(J)
+        self._assemble_unknown_blocks(J)
+        self._add_gathered_blocks(J)
         self._J = J
         self.snes.setJacobian(weak_callback(self._jacobian), J)
         self._reset_pc()

@@ -294,3 +294,27 @@ def test_an_error_in_a_callback_is_raised_and_leaves_the_problem_usable(monkeypa
     monkeypatch.setattr(solver, "_update_contact", update)
     problem.solve(num_steps=1)
     assert problem.t == pytest.approx(1.0) and not problem.history.cutbacks
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.3])
+def test_unknown_blocks_assembled_straight_give_the_chain_rule_tangent(mu):
+    """The solver matrix holds the tangent's blocks between unknowns assembled straight and
+    the gathered blocks' ``T^T K T``: it equals ``T^T K T`` of the whole tangent over the
+    fields (the chain rule the solver used before the split), with and without friction."""
+    import dolfinx.fem.petsc as fem_petsc
+    from petsc4py import PETSc
+
+    problem = ContactProblem(
+        scenes.hertz_2d(h_contact=0.02, depth=0.01, mu=mu).scene, verbose=False
+    )
+    problem.solve(num_steps=1)
+    solver = problem.solver
+    assert solver._A is not None and solver._K is not None  # the split is in use
+    J = solver.evaluate_jacobian(solver.x)
+    K = fem_petsc.assemble_matrix(problem.jacobian_form, kind="mpi")
+    K.assemble()
+    whole = K.PtAP(solver._T)
+    solver._zero_dirichlet_rows(whole)
+    whole.axpy(-1.0, J, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    assert whole.norm() <= 1e-12 * J.norm()
+    assert J.norm() > 0.0
