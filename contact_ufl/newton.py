@@ -706,6 +706,10 @@ class NewtonSolver:
             increment = self.x.copy()
             increment.axpy(-1.0, start)
             self._increment = (t0, t, self.x.copy(), increment)
+        # PETSc objects of more than one rank dropped by Python (the operators and matrices
+        # of the pairings met) wait on their communicator until a collective clean-up:
+        # without it they stay in memory (the mesh's communicator, not PETSc's world one)
+        PETSc.garbage_cleanup(self.comm)
         names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
         return reason > 0, its, names.get(reason, str(reason))
 
