@@ -56,8 +56,9 @@ recorded beside the wall times, and the load average at the start of each run.
 Records: ``scene``, ``size`` (h_contact or divisions), ``case`` (``contact`` or ``bulk``),
 ``dofs``, ``newton_iterations``, ``new_patterns`` (Jacobians on a new pairing: a symbolic
 PtAP), ``analyses`` (symbolic analyses of the factorisation: the solver matrix's pattern was
-new or grew), ``wall_s``, ``cpu_s`` (process CPU time of the solve), ``load`` (1-minute load
-average at the start) and, per Newton iteration, ``total_s`` (SNES time), ``search_s``,
+new or grew), ``residuals`` (residual evaluations, line searches' included), ``wall_s``,
+``cpu_s`` (process CPU time of the solve), ``load`` (1-minute load average at the start)
+and, per Newton iteration, ``total_s`` (SNES time), ``search_s``,
 ``residual_assembly_s``, ``jacobian_assembly_s``, ``ptap_s``, ``linear_solve_s``,
 ``analysis_s`` and ``factorisation_s`` (PETSc's ``MatLUFactorSym`` and ``MatLUFactorNum``
 events: MUMPS's analysis and numeric factorisation, inside ``linear_solve_s``), ``cpu_per_it_s``
@@ -288,6 +289,7 @@ def run(
         "newton_iterations": timings.iterations,
         "new_patterns": timings.new_patterns,
         "analyses": timings.analyses,
+        "residuals": timings.residuals,
         "wall_s": wall,
         "cpu_s": cpu,
         "load": load,
