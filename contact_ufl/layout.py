@@ -137,49 +137,37 @@ def split_tangent(
     -------
     unknown_forms
         The blocks between two unknowns, over ``unknowns`` (the solver matrix's layout);
-        ``None`` where an unknown is no field or has no such block (a control's load factor,
-        gathered onto a field of its own): then every block goes through the product.
+        ``None`` where an unknown is no field (a control's load factor, gathered onto a field
+        of its own) or a row or column of either part would hold no block: then every block
+        goes through the product.
     gathered_forms
         The other blocks, over the coupled fields (``None`` where both are unknowns), or
         ``None`` where no block touches a gathered field.
     coupled
         Indices (in ``fields``) of the fields that those blocks couple, in order.
     """
+    n = len(fields)
+    whole = [list(row) for row in forms], list(range(n))  # every block through the product
     own = {id(f) for f in unknowns}
     kept = [i for i, f in enumerate(fields) if id(f) in own]
-    every = list(range(len(fields)))
     if [id(fields[i]) for i in kept] != [id(f) for f in unknowns]:
-        return None, [list(row) for row in forms], every  # an unknown that is no field
-    is_kept = set(kept)
-    touching = [
-        (i, j)
-        for i in range(len(fields))
-        for j in range(len(fields))
-        if forms[i][j] is not None and not (i in is_kept and j in is_kept)
+        return None, *whole  # an unknown that is no field
+    gathered = [
+        [forms[i][j] if i not in kept or j not in kept else None for j in range(n)]
+        for i in range(n)
     ]
-    coupled = sorted({i for pair in touching for i in pair})
+    touches = [
+        any(f is not None for f in gathered[i]) or any(row[i] is not None for row in gathered)
+        for i in range(n)
+    ]
+    coupled = [i for i in range(n) if touches[i]]
+    unknown_forms = [[forms[i][j] for j in kept] for i in kept]
     if not coupled:
-        return [[forms[i][j] for j in kept] for i in kept], None, []
-    # a coupled unknown whose row (or column) touches no gathered field keeps its diagonal
-    # block in the product (a blocked matrix needs a form in every row and column)
-    moved = {
-        i
-        for i in coupled
-        if i in is_kept
-        and (
-            not any(forms[i][j] is not None and j not in is_kept for j in coupled)
-            or not any(forms[j][i] is not None and j not in is_kept for j in coupled)
-        )
-    }
-    unknown_forms = [[None if i == j and i in moved else forms[i][j] for j in kept] for i in kept]
-    columns = list(zip(*unknown_forms, strict=True))
-    if any(all(f is None for f in row) for row in [*unknown_forms, *columns]):
-        return None, [list(row) for row in forms], every  # an unknown without a block
-    gathered_forms = [
-        [
-            forms[i][j] if not (i in is_kept and j in is_kept) or (i == j and i in moved) else None
-            for j in coupled
-        ]
-        for i in coupled
-    ]
+        return unknown_forms, None, []
+    gathered_forms = [[gathered[i][j] for j in coupled] for i in coupled]
+    # a blocked matrix needs a form in every row and column
+    blocks = [*unknown_forms, *zip(*unknown_forms, strict=True)]
+    blocks += [*gathered_forms, *zip(*gathered_forms, strict=True)]
+    if any(all(f is None for f in row) for row in blocks):
+        return None, *whole
     return unknown_forms, gathered_forms, coupled

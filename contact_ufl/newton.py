@@ -500,11 +500,12 @@ class NewtonSolver:
             fem_petsc.assemble_matrix(K, self._gathered_forms)
             K.assemble()
         assembled = time.perf_counter()
-        if K is not None and self._JT is None:
-            self._JT = K.PtAP(self._T_coupled)
-            self.timings.new_patterns += 1
-        elif K is not None:
-            K.PtAP(self._T_coupled, result=self._JT)
+        if K is not None:
+            if self._JT is None:
+                self._JT = K.PtAP(self._T_coupled)
+                self.timings.new_patterns += 1
+            else:
+                K.PtAP(self._T_coupled, result=self._JT)
         J = self._grown_matrix(first)
         multiplied = time.perf_counter()
         self._assemble_unknown_blocks(J)
