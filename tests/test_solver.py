@@ -253,6 +253,39 @@ def test_solver_matrix_rebuilt_inside_a_newton_solve():
     np.testing.assert_allclose(x_rebuilt, x_kept, rtol=0, atol=1e-10 * np.abs(x_kept).max())
 
 
+def test_a_pairing_within_the_solver_pattern_keeps_the_analysis(monkeypatch):
+    """3D: a pairing that leaves the last one's operator but whose product adds no nonzero
+    to the solver matrix keeps the matrix and its symbolic analysis: fewer analyses than
+    when every such pairing grows the matrix, the same iterations and solution, and at every
+    Jacobian the solver matrix holds every coupling of the tangent."""
+    from petsc4py import PETSc
+
+    def solve(grow_always: bool):
+        problem = ContactProblem(scenes.hertz_3d(h_contact=0.02).scene, verbose=False)
+        solver = problem.solver
+        if grow_always:
+            monkeypatch.setattr(solver, "_within_solver_pattern", lambda keys: False)
+        add, missing = solver._add_gathered_blocks, []
+
+        def add_checked(J):
+            union = J.duplicate(copy=False)
+            union.axpy(1.0, solver._JT, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            missing.append(union.getInfo()["nz_used"] - J.getInfo()["nz_used"])
+            union.destroy()
+            add(J)
+
+        monkeypatch.setattr(solver, "_add_gathered_blocks", add_checked)
+        solver.timings.reset()
+        problem.solve(num_steps=2)
+        return solver.timings, solver.x.array.copy(), missing
+
+    (kept, x_kept, missing), (grown, x_grown, _) = solve(False), solve(True)
+    assert kept.analyses < grown.analyses
+    assert kept.iterations == grown.iterations
+    assert len(missing) >= kept.iterations and not any(missing)
+    np.testing.assert_allclose(x_kept, x_grown, rtol=0, atol=1e-10 * np.abs(x_grown).max())
+
+
 def test_a_non_finite_iterate_is_a_failed_try():
     """A Newton update with a NaN (here put into the second line-search direction) makes a
     trial iterate that is not a number: its residual is NaN, with no search on it, and the
