@@ -702,6 +702,8 @@ class NewtonSolver:
         -------
         converged, Newton iterations (of all tries), SNES converged reason (name)
         """
+        if self.snes is None:
+            raise RuntimeError("this solver is closed (close()): make a new problem to solve")
         if self.predictor not in (None, "first", "retry"):
             raise ValueError(f"predictor must be 'retry', 'first' or None, got {self.predictor!r}")
         t0 = self.problem.t
@@ -749,6 +751,29 @@ class NewtonSolver:
         PETSc.garbage_cleanup(self.comm)
         names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if k.isupper()}
         return reason > 0, its, names.get(reason, str(reason))
+
+    def close(self) -> None:
+        """Free this solver's PETSc objects now (collective: call it on every rank).
+
+        On more than one rank PETSc frees an object that Python drops only at a collective
+        clean-up on its communicator, which for a dropped problem never comes: its SNES,
+        factorisation and matrices stay in memory (about 11 to 21 MB a problem of 3,900
+        unknowns on two ranks, far more with the factors of large problems). A script that
+        makes many problems closes each one when done with it
+        (:meth:`ContactProblem.close <contact_ufl.problem.ContactProblem.close>`). The
+        solver cannot solve afterwards."""
+        if self.snes is None:
+            return
+        objects = [self.snes, self._J, self._retired, self._A, self._K, self._JT]
+        objects += [self._T, self._T_coupled, self._T_wide, self._r, self.x, self._R]
+        if self._increment is not None:
+            objects += list(self._increment[2:])
+        for obj in objects:
+            if obj is not None:
+                obj.destroy()
+        self.snes = self._J = self._retired = self._A = self._K = self._JT = None
+        self._T = self._T_coupled = self._T_wide = self._increment = None
+        PETSc.garbage_cleanup(self.comm)
 
     def _predict(self, t0: float, t: float) -> bool:
         """Move :attr:`x`, the start of the step from ``t0`` to ``t``, to the predicted

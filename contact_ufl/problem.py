@@ -169,6 +169,7 @@ class ContactProblem:
         self._build_dirichlet()
         self._solver: NewtonSolver | None = None
         self._stepper: LoadStepper | None = None
+        self._closed = False
 
     def _interface(self, pair: ContactPair, parts: list) -> ContactInterface:
         """The contact interface of ``pair`` between the bulks that hold its surfaces."""
@@ -358,11 +359,29 @@ class ContactProblem:
         with :attr:`petsc_options` (the state it starts from is the converged state of step
         0), or the one made directly for it. One solver per problem: it owns the search
         state of the contacts and the chain operator T."""
+        if self._closed:
+            raise RuntimeError("this problem is closed (problem.close()): make a new one")
         if self._solver is None:
             from contact_ufl.newton import NewtonSolver
 
             self._solver = NewtonSolver(self, self.petsc_options, self.petsc_options_prefix)
         return self._solver
+
+    def close(self) -> None:
+        """Free the PETSc objects of this problem's solver (collective), for scripts that make
+        many problems on more than one rank (see :meth:`NewtonSolver.close
+        <contact_ufl.newton.NewtonSolver.close>`); the fields keep their values. A problem is
+        also a context manager that closes on leaving: ``with ContactProblem(scene) as
+        problem: ...``."""
+        if self._solver is not None:
+            self._solver.close()
+        self._closed = True
+
+    def __enter__(self) -> ContactProblem:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     @property
     def stepper(self) -> LoadStepper:

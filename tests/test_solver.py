@@ -286,6 +286,27 @@ def test_a_pairing_within_the_solver_pattern_keeps_the_analysis(monkeypatch):
     np.testing.assert_allclose(x_kept, x_grown, rtol=0, atol=1e-10 * np.abs(x_grown).max())
 
 
+def test_a_closed_problem_frees_its_solver_and_refuses_to_solve():
+    """``with ContactProblem(...) as problem``: on leaving, the solver's PETSc objects are
+    destroyed (on more than one rank a dropped problem's objects would wait in memory for a
+    collective clean-up that never comes); the fields keep their values, and the results read
+    from them; solving, or a result that needs the solver, then raises a clear error."""
+    with hertz_problem() as problem:
+        problem.solve(num_steps=1)
+        solver = problem.solver
+        held = [solver.snes, solver._J, solver._T, solver.x]
+        u, force = problem.u.x.array.copy(), problem.contact_force()
+    assert all(obj.handle == 0 for obj in held)
+    np.testing.assert_array_equal(problem.u.x.array, u)
+    assert len(problem.history.steps) == 1
+    with pytest.raises(RuntimeError, match="closed"):
+        problem.solve(num_steps=1, t_end=2.0)
+    with pytest.raises(RuntimeError, match="closed"):
+        problem.contact_residual()
+    np.testing.assert_array_equal(problem.contact_force(), force)  # from the fields
+    problem.close()  # closing again does nothing
+
+
 def test_a_non_finite_iterate_is_a_failed_try():
     """A Newton update with a NaN (here put into the second line-search direction) makes a
     trial iterate that is not a number: its residual is NaN, with no search on it, and the
