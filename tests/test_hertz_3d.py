@@ -133,10 +133,11 @@ def on_block_sequence():
     ]
 
 
-@pytest.mark.slow
 def test_on_block_within_2_percent(on_block_sequence):
     """Elastic on elastic, the finest mesh: a and p0 within 2% (-1.0% and +1.7% measured);
-    the errors of a, p0 and the pressure's L2 error fall from mesh to mesh."""
+    the errors of a, p0 and the pressure's L2 error fall from mesh to mesh (in the default
+    suite since the compiled search and the fewer analyses: 17 s on one rank, 13 s on
+    two)."""
     errors = np.array(
         [[abs(e["a_error"]), abs(e["p0_error"]), e["pressure_l2_error"]] for e in on_block_sequence]
     )
