@@ -48,11 +48,14 @@ def cattaneo_mindlin_run(
     shift: float = 0.0015,
     steps: int = 4,
     refine_radius: float = 0.3,
+    pair: dict | None = None,
 ):
     """Hertz loading, then ``steps`` tangential steps; one record per tangential level.
 
     ``h`` is the element size within ``refine_radius`` of the first point of contact (the
-    contact half-width is about 0.05 here; see :func:`scenes.hertz_2d`).
+    contact half-width is about 0.05 here; see :func:`scenes.hertz_2d`). ``pair``: fields
+    of the contact pair to replace (e.g. ``{"eps_N": None, "eps_T": 0.1}``: the default
+    ``eps_N``, a given ``eps_T``; by default the scene's ``eps_N = E / h``).
 
     Returns the records (Q / (mu P), stick-zone half-width measured and exact, its relative
     error, the RMS shear-traction error in |x| < 0.8 a relative to mu p0, Newton
@@ -61,6 +64,8 @@ def cattaneo_mindlin_run(
     hertz = scenes.hertz_2d(
         h_contact=h, depth=depth, mu=mu, shift=shift, refine_radius=refine_radius
     )
+    if pair:
+        hertz.scene.contacts[0] = dataclasses.replace(hertz.scene.contacts[0], **pair)
     problem = ContactProblem(hertz.scene, verbose=False)
     problem.solve(num_steps=4, t_end=1.0)
     levels = []
