@@ -286,6 +286,25 @@ def test_patch_quadratic_2d(cell):
     assert abs(problem.contact_force()[1] / PRESSURE - 1.0) < 1e-12
 
 
+@pytest.mark.slow  # 10 s (a minute to compile the Q2 hexahedron's forms)
+@pytest.mark.parametrize(
+    "multiplier_degree, low, high",
+    [
+        (1, 2e-3, 5e-3),  # measured 3.1e-3 (P2 tetrahedra: 7.0e-3)
+        (2, 2e-2, 1e-1),  # measured 4.2e-2: the P2 multipliers oscillate (tetrahedra: 5.0e-2)
+    ],
+)
+def test_patch_quadratic_hexahedra(multiplier_degree, low, high):
+    """Q2 hexahedra (9-node quadrilateral facets), the 3D composite rule of degree 4 x 2:
+    P1 multipliers give the pressure uniform to 3.1e-3, P2 multipliers 13 times less
+    uniform, as on P2 tetrahedra; the force exact with either. Both bounds are asserted,
+    so that a change shows."""
+    problem, deviation = solve_patch(3, multiplier_degree, 4, 2, "hexahedron")
+    assert problem.contacts[0].kinematics.nn == 9
+    assert low < deviation < high
+    assert abs(problem.contact_force()[2] / PRESSURE - 1.0) < 1e-12
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "dim, multiplier_degree, quadrature_degree, subdivisions, low, high",
