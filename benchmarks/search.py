@@ -32,6 +32,9 @@ Records (``sweep``):
   ``cpu_seconds`` (best repeated call, wall and CPU of this process: the KD-tree of the
   unchanged master is reused), ``first_call_s`` (CPU, the KD-trees built), ``second_call_s``
   (CPU, the KD-trees reused), ``points_per_s`` and ``cpu_points_per_s``;
+* ``"quadratic"``: the same records as ``"radius"`` at radius h for quadratic facets (3-node
+  segments, 6-node triangles with their midpoint nodes on the surface; searched in NumPy),
+  1e3 to 1e5 facets (``search_quadratic.json``);
 * ``"distance"`` (the largest master of each kind): all points at ``offset_over_h`` (0.1 to
   50) from the surface, radii 2 and 10 times that offset and infinity (all points paired):
   the cost against the points' distance and the radius;
@@ -281,13 +284,61 @@ def offset_points(gdim: int, npts: int, offset: float, rng: np.random.Generator)
     return np.stack([u[:, 0], u[:, 1], surface_3d(u[:, 0], u[:, 1]) + dz], axis=1)
 
 
-SWEEPS = ("graded", "self_contact", "radius", "distance", "points")
+SWEEPS = ("graded", "self_contact", "radius", "distance", "points", "quadratic")
 
 MAKERS = {
     "segment": lambda nf, rng: segments(nf),
     "triangle": triangles,
     "quadrilateral": quadrilaterals,
 }
+
+
+def quadratic_segments(nf: int, rng: np.random.Generator) -> tuple[np.ndarray, float]:
+    """``nf`` 3-node segments on the 2D curve (ends, then the midpoint node on the curve)."""
+    seg, h = segments(nf)
+    mid = 0.5 * (seg[:, 0] + seg[:, 1])
+    mid[:, 1] = surface_2d(mid[:, 0])
+    return np.concatenate([seg, mid[:, None]], axis=1), h
+
+
+def quadratic_triangles(nf: int, rng: np.random.Generator) -> tuple[np.ndarray, float]:
+    """About ``nf`` 6-node triangles (vertices, then the midpoint nodes of the edges 01, 12,
+    02 lifted onto the surface: curved facets)."""
+    tri, h = triangles(nf, rng)
+    mid = np.stack([0.5 * (tri[:, a] + tri[:, b]) for a, b in ((0, 1), (1, 2), (0, 2))], axis=1)
+    mid[..., 2] = surface_3d(mid[..., 0], mid[..., 1])
+    return np.concatenate([tri, mid], axis=1), h
+
+
+QUADRATIC_MAKERS = {"segment3": quadratic_segments, "triangle6": quadratic_triangles}
+
+
+def quadratic_sweep(sizes, npts) -> list[dict]:
+    """The quadratic facets (searched in NumPy), radius h: points per second against the
+    number of facets, the records of :func:`time_call` with ``sweep = "quadratic"``."""
+    records = []
+    print(f"{'facets':>8} {'kind':>13} {'paired':>7} {'cpu s':>8} {'points/s':>10}")
+    for kind, make in QUADRATIC_MAKERS.items():
+        for nf in sizes:
+            rng = np.random.default_rng(nf)
+            nodes, h = make(nf, rng)
+            points = slave_points(nodes.shape[2], npts, h, rng)
+            record = {
+                "sweep": "quadratic",
+                "kind": kind,
+                "gdim": int(nodes.shape[2]),
+                "facets": int(nodes.shape[0]),
+                "points": npts,
+                "radius_over_h": 1.0,
+                **time_call(points, nodes, h),
+            }
+            records.append(record)
+            print(
+                f"{record['facets']:8d} {kind:>13} {record['paired_fraction']:7.2f} "
+                f"{record['cpu_seconds']:8.4f} {record['cpu_points_per_s']:10.3g}",
+                flush=True,
+            )
+    return records
 
 
 def radius_sweep(sizes, npts, factors) -> list[dict]:
@@ -546,6 +597,7 @@ def main() -> None:
             100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
         ),
         "points": lambda: points_sweep(largest, counts),
+        "quadratic": lambda: quadratic_sweep(sizes[:3], npts),
     }
     records = [r for name in args.sweeps for r in run[name]()]
     with open(args.json, "w") as f:
