@@ -503,7 +503,9 @@ def self_contact_sweep(n: int) -> list[dict]:
 
 def _searcher(points, masters: list, radius: float, trees, moved: bool) -> Callable:
     """A search of ``points`` on ``masters[0]``; each call first swaps the two masters if
-    ``moved`` (so that every call meets a moved master)."""
+    ``moved`` (so that every call meets a moved master: ``masters[0]`` must be the master of
+    the last search before the first call; with the other first, the first call met an
+    unchanged master and, the fastest of all, was what the sweep kept)."""
 
     def call():
         if moved:
@@ -532,7 +534,7 @@ def points_sweep(nf: int, counts) -> list[dict]:
                 points = slave_points(nodes.shape[2], n, h, rng)
                 trees = projection.TreeCache()
                 closest_points(points, nodes, h, trees=trees)
-                _, cpu, _ = best_of(_searcher(points, [shifted, nodes], h, trees, moved))
+                _, cpu, _ = best_of(_searcher(points, [nodes, shifted], h, trees, moved))
                 times.append(cpu)
                 records.append(
                     {
