@@ -32,7 +32,7 @@ Records (``sweep``):
   ``cpu_seconds`` (best repeated call, wall and CPU of this process: the KD-tree of the
   unchanged master is reused), ``first_call_s`` (CPU, the KD-trees built), ``second_call_s``
   (CPU, the KD-trees reused), ``points_per_s`` and ``cpu_points_per_s``;
-* ``"quadratic"``: the same records as ``"radius"`` at radius h for quadratic facets (3-node
+* ``"quadratic"``: the records of ``"radius"`` at radius h for quadratic facets (3-node
   segments, 6-node triangles with their midpoint nodes on the surface; searched in NumPy),
   1e3 to 1e5 facets (``search_quadratic.json``);
 * ``"distance"`` (the largest master of each kind): all points at ``offset_over_h`` (0.1 to
@@ -313,49 +313,23 @@ def quadratic_triangles(nf: int, rng: np.random.Generator) -> tuple[np.ndarray, 
 QUADRATIC_MAKERS = {"segment3": quadratic_segments, "triangle6": quadratic_triangles}
 
 
-def quadratic_sweep(sizes, npts) -> list[dict]:
-    """The quadratic facets (searched in NumPy), radius h: points per second against the
-    number of facets, the records of :func:`time_call` with ``sweep = "quadratic"``."""
-    records = []
-    print(f"{'facets':>8} {'kind':>13} {'paired':>7} {'cpu s':>8} {'points/s':>10}")
-    for kind, make in QUADRATIC_MAKERS.items():
-        for nf in sizes:
-            rng = np.random.default_rng(nf)
-            nodes, h = make(nf, rng)
-            points = slave_points(nodes.shape[2], npts, h, rng)
-            record = {
-                "sweep": "quadratic",
-                "kind": kind,
-                "gdim": int(nodes.shape[2]),
-                "facets": int(nodes.shape[0]),
-                "points": npts,
-                "radius_over_h": 1.0,
-                **time_call(points, nodes, h),
-            }
-            records.append(record)
-            print(
-                f"{record['facets']:8d} {kind:>13} {record['paired_fraction']:7.2f} "
-                f"{record['cpu_seconds']:8.4f} {record['cpu_points_per_s']:10.3g}",
-                flush=True,
-            )
-    return records
-
-
-def radius_sweep(sizes, npts, factors) -> list[dict]:
-    """The records of the radius sweep (the slave points of :func:`slave_points`)."""
+def radius_sweep(sizes, npts, factors, makers=MAKERS, sweep: str = "radius") -> list[dict]:
+    """The records of the radius sweep (the slave points of :func:`slave_points`) over the
+    facet kinds of ``makers``, named ``sweep``; the flat kinds' (``"radius"``) with the
+    stages of the NumPy search."""
     records = []
     print(
         f"{'facets':>8} {'kind':>13} {'radius/h':>8} {'paired':>7} {'cpu s':>8} {'points/s':>10}"
         f" {'first s':>8}"
     )
-    for kind, make in MAKERS.items():
+    for kind, make in makers.items():
         for nf in sizes:
             rng = np.random.default_rng(nf)
             nodes, h = make(nf, rng)
             points = slave_points(nodes.shape[2], npts, h, rng)
             for factor in factors:
                 record = {
-                    "sweep": "radius",
+                    "sweep": sweep,
                     "kind": kind,
                     "gdim": int(nodes.shape[2]),
                     "facets": int(nodes.shape[0]),
@@ -370,6 +344,8 @@ def radius_sweep(sizes, npts, factors) -> list[dict]:
                     f"{record['cpu_points_per_s']:10.3g} {record['first_call_s']:8.4f}",
                     flush=True,
                 )
+            if sweep != "radius":
+                continue
             record = {
                 "sweep": "stages",
                 "kind": kind,
@@ -599,7 +575,7 @@ def main() -> None:
             100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
         ),
         "points": lambda: points_sweep(largest, counts),
-        "quadratic": lambda: quadratic_sweep(sizes[:3], npts),
+        "quadratic": lambda: radius_sweep(sizes[:3], npts, (1.0,), QUADRATIC_MAKERS, "quadratic"),
     }
     records = [r for name in args.sweeps for r in run[name]()]
     with open(args.json, "w") as f:

@@ -595,9 +595,7 @@ class NewtonSolver:
         """Whether the nonzeros ``keys`` (:func:`_nonzero_keys`) of a product over the
         superset are all among those added to the solver matrix since it was made, on every
         rank (collective)."""
-        inside = self._product_keys is not None and (
-            len(keys) == 0 or bool(np.all(np.isin(keys, self._product_keys, assume_unique=True)))
-        )
+        inside = bool(np.isin(keys, self._product_keys, assume_unique=True).all())
         return bool(self.comm.allreduce(inside, MPI.LAND))
 
     def _new_matrix(self, pattern: PETSc.Mat | None) -> PETSc.Mat:
@@ -767,14 +765,14 @@ class NewtonSolver:
         if self.snes is None:
             return
         objects = [self.snes, self._J, self._retired, self._A, self._K, self._JT]
-        objects += [self._T, self._T_coupled, self._T_wide, self._r, self.x, self._R]
+        objects += [self._T, self._T_coupled, self._T_wide, self._r, self.x, self._R, self._state]
         if self._increment is not None:
             objects += list(self._increment[2:])
         for obj in objects:
             if obj is not None:
                 obj.destroy()
         self.snes = self._J = self._retired = self._A = self._K = self._JT = None
-        self._T = self._T_coupled = self._T_wide = self._increment = None
+        self._T = self._T_coupled = self._T_wide = self._increment = self._state = None
         PETSc.garbage_cleanup(self.comm)
 
     def _predict(self, t0: float, t: float) -> bool:
