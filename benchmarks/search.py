@@ -32,9 +32,9 @@ Records (``sweep``):
   ``cpu_seconds`` (best repeated call, wall and CPU of this process: the KD-tree of the
   unchanged master is reused), ``first_call_s`` (CPU, the KD-trees built), ``second_call_s``
   (CPU, the KD-trees reused), ``points_per_s`` and ``cpu_points_per_s``;
-* ``"quadratic"``: the records of ``"radius"`` at radius h for quadratic facets (3-node
-  segments, 6-node triangles with their midpoint nodes on the surface; searched in NumPy),
-  1e3 to 1e5 facets (``search_quadratic.json``);
+* ``"quadratic"``: the records of ``"radius"`` at radius h and infinity for quadratic
+  facets (3-node segments, 6-node triangles and 9-node quadrilaterals with their midpoint
+  nodes on the surface), 1e3 to 1e5 facets (``search_quadratic.json``);
 * ``"distance"`` (the largest master of each kind): all points at ``offset_over_h`` (0.1 to
   50) from the surface, radii 2 and 10 times that offset and infinity (all points paired):
   the cost against the points' distance and the radius;
@@ -310,7 +310,23 @@ def quadratic_triangles(nf: int, rng: np.random.Generator) -> tuple[np.ndarray, 
     return np.concatenate([tri, mid], axis=1), h
 
 
-QUADRATIC_MAKERS = {"segment3": quadratic_segments, "triangle6": quadratic_triangles}
+def quadratic_quadrilaterals(nf: int, rng: np.random.Generator) -> tuple[np.ndarray, float]:
+    """About ``nf`` 9-node quadrilaterals (basix vertices, the midpoint nodes of the edges 01,
+    13, 23, 02, then the centre node, lifted onto the surface from the means of their edge's
+    or cell's vertices: curved facets), and their size."""
+    quads, h = quadrilaterals(nf, rng)
+    edges = ((0, 1), (1, 3), (2, 3), (0, 2))
+    mid = [0.5 * (quads[:, a] + quads[:, b]) for a, b in edges] + [quads.mean(axis=1)]
+    mid = np.stack(mid, axis=1)
+    mid[..., 2] = surface_3d(mid[..., 0], mid[..., 1])
+    return np.concatenate([quads, mid], axis=1), h
+
+
+QUADRATIC_MAKERS = {
+    "segment3": quadratic_segments,
+    "triangle6": quadratic_triangles,
+    "quadrilateral9": quadratic_quadrilaterals,
+}
 
 
 def radius_sweep(sizes, npts, factors, makers=MAKERS, sweep: str = "radius") -> list[dict]:
@@ -575,7 +591,9 @@ def main() -> None:
             100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
         ),
         "points": lambda: points_sweep(largest, counts),
-        "quadratic": lambda: radius_sweep(sizes[:3], npts, (1.0,), QUADRATIC_MAKERS, "quadratic"),
+        "quadratic": lambda: radius_sweep(
+            sizes[:3], npts, (1.0, np.inf), QUADRATIC_MAKERS, "quadratic"
+        ),
     }
     records = [r for name in args.sweeps for r in run[name]()]
     with open(args.json, "w") as f:

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_quads
+from test_quadratic import random_quadrilaterals, random_segments, random_triangles
 from test_search_exact import near_and_far
 
 from contact_ufl.contact import compiled, projection
@@ -22,15 +23,78 @@ from contact_ufl.verification import scenes
 FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
 
 
+def _wavy_lattice(rng: np.random.Generator, m: int) -> np.ndarray:
+    """The nodes (2m + 1, 2m + 1, 3) of a jittered lattice on a wavy surface: the vertices
+    and midpoint nodes of an m x m grid of quadratic cells."""
+    s = np.linspace(0.0, 1.0, 2 * m + 1)
+    X, Y = np.meshgrid(s, s, indexing="ij")
+    X[1:-1, 1:-1] += rng.uniform(-0.1, 0.1, (2 * m - 1, 2 * m - 1)) / m
+    Y[1:-1, 1:-1] += rng.uniform(-0.1, 0.1, (2 * m - 1, 2 * m - 1)) / m
+    return np.stack([X, Y, 0.15 * np.sin(3 * X) * np.cos(4 * Y)], axis=-1)
+
+
+def wavy_triangle6(rng: np.random.Generator, n: int) -> np.ndarray:
+    """About ``n`` curved 6-node triangles sharing their edges (each quadratic cell of a
+    wavy lattice split in two)."""
+    m = max(int(round(np.sqrt(n / 2))), 1)
+    V = _wavy_lattice(rng, m)
+    i, j = np.meshgrid(2 * np.arange(m), 2 * np.arange(m), indexing="ij")
+    i, j = i.ravel(), j.ravel()
+    # vertices, then the midpoints of the edges 01, 12, 02
+    lower = [V[i, j], V[i + 2, j], V[i, j + 2], V[i + 1, j], V[i + 1, j + 1], V[i, j + 1]]
+    upper = [V[i + 2, j], V[i + 2, j + 2], V[i, j + 2], V[i + 2, j + 1], V[i + 1, j + 2],
+             V[i + 1, j + 1]]  # fmt: skip
+    return np.concatenate([np.stack(lower, axis=1), np.stack(upper, axis=1)])
+
+
+def wavy_quadrilateral9(rng: np.random.Generator, n: int) -> np.ndarray:
+    """About ``n`` curved 9-node quadrilaterals sharing their edges (basix vertices, the
+    midpoints of the edges 01, 13, 23, 02, the centre) on a wavy lattice."""
+    m = max(int(round(np.sqrt(n))), 1)
+    V = _wavy_lattice(rng, m)
+    i, j = np.meshgrid(2 * np.arange(m), 2 * np.arange(m), indexing="ij")
+    i, j = i.ravel(), j.ravel()
+    nodes = [V[i, j], V[i + 2, j], V[i, j + 2], V[i + 2, j + 2], V[i + 1, j], V[i + 2, j + 1],
+             V[i + 1, j + 2], V[i, j + 1], V[i + 1, j + 1]]  # fmt: skip
+    return np.stack(nodes, axis=1)
+
+
 @pytest.mark.parametrize(
     ("make", "nf"),
-    [(segment_polyline, 300), (triangle_soup, 200), (warped_quads, 60), (wavy_quads, 400)],
-    ids=["segments", "triangles", "quadrilaterals", "quad-grid"],
+    [
+        (segment_polyline, 300),
+        (triangle_soup, 200),
+        (warped_quads, 60),
+        (wavy_quads, 400),
+        (random_segments, 300),
+        (random_triangles, 150),
+        (random_quadrilaterals, 60),
+        (wavy_triangle6, 400),
+        (wavy_quadrilateral9, 200),
+    ],
+    ids=[
+        "segments",
+        "triangles",
+        "quadrilaterals",
+        "quad-grid",
+        "segments3",
+        "triangles6",
+        "quadrilaterals9",
+        "triangle6-grid",
+        "quadrilateral9-grid",
+    ],
 )
 @pytest.mark.parametrize("radius", [np.inf, 0.05])
 def test_compiled_equals_numpy(make, nf, radius, monkeypatch):
     """The compiled search and the NumPy one (``CONTACT_UFL_SEARCH=numpy``) find the same
-    facets and, to round-off, the same closest points."""
+    facets and, to round-off, the same closest points.
+
+    The flat kinds repeat the NumPy operations (equal to the last bit but for the order of
+    a few sums). The quadratic kinds' Newton iterations evaluate the facet in monomial form
+    (NumPy: sums over the nodes), so ``xi`` agrees to round-off (1e-15) and ``M = A^-1``
+    to round-off times the condition of ``A = a_a . a_b - (x - y) . y_,ab``, which grows
+    for points far on the concave side of a curved facet (towards its centres of
+    curvature): ``M`` is compared relative to its size (there up to 5e-13 apart)."""
     rng = np.random.default_rng(nf + 11)
     nodes = make(rng, nf)
     points = near_and_far(rng, nodes, 400)
@@ -40,10 +104,14 @@ def test_compiled_equals_numpy(make, nf, radius, monkeypatch):
     np.testing.assert_array_equal(fast.facet, slow.facet)
     assert 0 < np.count_nonzero(fast.facet >= 0)
     paired = fast.facet >= 0
+    quadratic = projection.facet_kind(*nodes.shape[1:]) in projection.QUADRATIC
     for k in FIELDS:
-        np.testing.assert_allclose(
-            getattr(fast, k)[paired], getattr(slow, k)[paired], rtol=0, atol=1e-12
-        )
+        a, b = getattr(fast, k)[paired], getattr(slow, k)[paired]
+        if k == "sliding" and quadratic:  # per point, relative to its largest entry
+            size = np.abs(b).max(axis=(1, 2))
+            assert np.all(np.abs(a - b).max(axis=(1, 2)) <= 1e-10 * size + 1e-12)
+            continue
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
 
 
 def test_points_in_any_memory_layout():
@@ -59,8 +127,10 @@ def test_points_in_any_memory_layout():
         np.testing.assert_array_equal(got.y, expected.y)
 
 
-def test_work_does_not_grow_with_the_radius():
-    """On a flat grid of 20,000 triangles, points 0.01 to 3 facet sizes above it: the exact
+@pytest.mark.parametrize("quadratic", [False, True], ids=["triangles", "triangles6"])
+def test_work_does_not_grow_with_the_radius(quadratic):
+    """On a flat grid of 20,000 triangles (of 6-node triangles: their exact projections
+    deferred until the walk is done), points 0.01 to 3 facet sizes above it: the exact
     projections per point of an infinite radius are those of a radius of a few facets, and
     a few per point (the branch and bound prunes by the best distance met, not the radius)."""
     m = 100
@@ -70,6 +140,9 @@ def test_work_does_not_grow_with_the_radius():
     lower = np.stack([V[:-1, :-1], V[1:, :-1], V[:-1, 1:]], axis=2).reshape(-1, 3, 3)
     upper = np.stack([V[1:, :-1], V[1:, 1:], V[:-1, 1:]], axis=2).reshape(-1, 3, 3)
     nodes = np.concatenate([lower, upper])
+    if quadratic:  # the midpoints of the edges 01, 12, 02
+        mids = [0.5 * (nodes[:, a] + nodes[:, b]) for a, b in ((0, 1), (1, 2), (0, 2))]
+        nodes = np.concatenate([nodes, np.stack(mids, axis=1)], axis=1)
     rng = np.random.default_rng(5)
     h = 1.0 / m
     points = np.column_stack(
@@ -134,10 +207,10 @@ def test_a_build_error_is_raised_on_every_rank(monkeypatch):
 
 def test_numpy_search_on_request(monkeypatch):
     """``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search (no compiled kernel used)."""
-    assert projection._compiled(3, 3)
+    kinds = ((2, 2), (3, 3), (4, 3), (3, 2), (6, 3), (9, 3))  # flat and quadratic
+    assert all(projection._compiled(nn, gdim) for nn, gdim in kinds)
     monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
-    assert not projection._compiled(3, 3)
-    assert not projection._compiled(6, 3)  # quadratic facets: NumPy in any case
+    assert not any(projection._compiled(nn, gdim) for nn, gdim in kinds)
 
 
 @pytest.mark.parametrize("search", ["compiled", "numpy"])

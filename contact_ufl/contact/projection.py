@@ -1,11 +1,12 @@
 """Closest-point projection of many slave points onto a master surface made of facets.
 
-The flat facet kinds (segments, triangles, bilinear quadrilaterals) are searched by a
-compiled kernel (``search_kernel.c``, built on first use by :mod:`.compiled`): a
-bounding-volume hierarchy over the facets walked by branch and bound per point, with the
-exact projections of the NumPy kernels below in C; the tie-break between equidistant facets
-stays in NumPy (:func:`_select`). ``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search.
-The quadratic kinds are searched in NumPy (plus :class:`scipy.spatial.cKDTree` for the
+Every facet kind (segments, triangles, bilinear quadrilaterals, and the quadratic 3-node
+segments, 6-node triangles and 9-node quadrilaterals) is searched by a compiled kernel
+(``search_kernel.c``, built on first use by :mod:`.compiled`): a bounding-volume hierarchy
+over the facets walked by branch and bound per point, with the exact projections of the
+NumPy kernels below (and of :mod:`.curved`) in C; the tie-break between equidistant facets
+stays in NumPy (:func:`_select`). ``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search
+(plus :class:`scipy.spatial.cKDTree` for the
 candidates), vectorised over points and facets: the only Python loops run over a fixed small
 number of items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points,
 levels). The hot kernels work on coordinate columns (one 1D gather per node coordinate) rather
@@ -136,7 +137,14 @@ _DIRECTIONS = {2: 8, 3: 32}  # normal bins of a self-contact search, by dimensio
 _DIRECTIONS_MIN = 1 << 10  # facets above which a self-contact search goes by normal bins
 _FIELDS = ("facet", "xi", "y", "normal", "gap", "distance", "sliding")
 #: The facet kinds of the compiled search (kind numbers of ``search_kernel.c``).
-_COMPILED_KINDS = {"segment": 0, "triangle": 1, "quadrilateral": 2}
+_COMPILED_KINDS = {
+    "segment": 0,
+    "triangle": 1,
+    "quadrilateral": 2,
+    "segment3": 3,
+    "triangle6": 4,
+    "quadrilateral9": 5,
+}
 _CAP = 4  # pairs per point returned by the compiled query (more: that point is queried again)
 NON_FINITE = "{what} of the closest-point search hold non-finite values (NaN or infinity)"
 
@@ -535,8 +543,10 @@ class _Facets:
         self.nodes = nodes
         self.nf, self.nn, self.gdim = nodes.shape
         self.kind = facet_kind(self.nn, self.gdim)
+        # of a quadratic facet, the centroid and radius of its Bernstein control points
+        hull = bernstein_hull(self.kind, nodes) if self.kind in QUADRATIC else nodes
         X = [
-            [np.ascontiguousarray(nodes[:, a, k]) for k in range(self.gdim)] for a in range(self.nn)
+            [np.ascontiguousarray(hull[:, a, k]) for k in range(self.gdim)] for a in range(self.nn)
         ]
         c, _, self.size = _centroid_radius(X)
         self.centroid = np.stack(c, axis=1)
@@ -1434,9 +1444,9 @@ def closest_points(
 
     Notes
     -----
-    Flat facets (segments, triangles, bilinear quadrilaterals; unless
-    ``CONTACT_UFL_SEARCH=numpy``): a bounding-volume hierarchy of axis-aligned boxes over the
-    facets' nodes (median splits, 2 to 4 facets a leaf; built once per master shape and
+    Every facet kind (unless ``CONTACT_UFL_SEARCH=numpy``): a bounding-volume hierarchy of
+    axis-aligned boxes over the facets' nodes (of a quadratic facet, its Bernstein control
+    points; median splits, 2 to 4 facets a leaf; built once per master shape and
     kept in ``trees`` while no node has moved more than ``0.25 R_max``, its boxes refitted
     to the current nodes at every call where they changed; walked four children a step,
     their boxes in single precision rounded outwards) is walked per point in C, nearest
@@ -1447,12 +1457,16 @@ def closest_points(
     surface, not the radius. On a surface four points are walked by turns, a step of each
     (the memory loads of one under way while the others work; each walk, so its result, as
     alone).
-    The exact projections are those of the NumPy kernels, in the same operations. A point
-    with one facet within that reach gets its closest point, normal, proximity and ``M``
-    from C; the points with several go through the NumPy tie-break below. Self-contact:
-    the inadmissible facets are skipped in the walk (the same rule).
+    The exact projections are those of the NumPy kernels, in the same operations (of the
+    quadratic kinds, those of :mod:`.curved` to round-off). A quadratic facet is projected
+    when the walk is done, and only if the bounds of its distance from its chord facet (the
+    straight facet of its vertices, within a distance fixed by its midpoint nodes of it)
+    do not rule it out: by increasing lower bound, the bound tightened by the distances
+    found. A point with one facet within that reach gets its closest point, normal,
+    proximity and ``M`` from C; the points with several go through the NumPy tie-break
+    below. Self-contact: the inadmissible facets are skipped in the walk (the same rule).
 
-    Candidate search of the quadratic facets (and of all with ``CONTACT_UFL_SEARCH=numpy``):
+    Candidate search with ``CONTACT_UFL_SEARCH=numpy``:
     KD-trees of the facet centroids (the mean of the nodes; of a quadratic facet, of its
     Bernstein control points, whose convex hull holds it). Every facet point is
     within ``R_f`` (the largest node, or control point, distance from the centroid) of it.

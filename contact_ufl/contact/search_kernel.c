@@ -2,12 +2,17 @@
  * master facets and a branch-and-bound nearest-facet query per slave point.
  *
  * Compiled on first use by contact_ufl.contact.compiled (the system C compiler, loaded with
- * cffi) and called by contact_ufl.contact.projection for the flat facet kinds:
+ * cffi) and called by contact_ufl.contact.projection for every facet kind:
  *   kind 0: segment (2 nodes, 2D), 1: triangle (3 nodes, 3D), 2: bilinear quadrilateral
- *   (4 nodes, 3D, basix order).
- * The exact projections repeat the operations of the NumPy kernels of projection.py in the
- * same order (compile with -ffp-contract=off: no fused multiply-add), so that the distances
- * are those of the NumPy kernels to the last bit.
+ *   (4 nodes, 3D, basix order); the quadratic kinds 3: 3-node segment (2D), 4: 6-node
+ *   triangle, 5: 9-node quadrilateral (3D; node orders of contact_ufl.contact.curved).
+ * The exact projections of the flat kinds repeat the operations of the NumPy kernels of
+ * projection.py in the same order (compile with -ffp-contract=off: no fused multiply-add),
+ * so that the distances are those of the NumPy kernels to the last bit; those of the
+ * quadratic kinds are the kernels of curved.py, their Newton iterations on the facet in
+ * monomial form (the same points to round-off). The boxes of a quadratic facet are those
+ * of its Bernstein control points (which hold it), and its exact projection waits until
+ * the walk is done (DEFERRED, resolve).
  *
  * Tree layout: nodes in preorder; node i is a leaf when a[i] < 0 (its facets are
  * perm[-a[i] - 1 .. -a[i] - 1 + b[i]]), else its children are a[i] and b[i]. The query walks
@@ -142,7 +147,7 @@ INLINE float up(double v)
 }
 
 typedef struct {
-    int g, nn;
+    int kind, g, nn;
     i64 n;
     const double *nodes; /* (n, nn, g) as given */
     const i64 *perm, *a, *b;
@@ -152,8 +157,41 @@ typedef struct {
     double r2max, finite;
 } fit_t;
 
-/* The facets of a leaf copied in the order of perm, their box (lo, hi), and the largest
- * facet radius and finiteness so far updated. */
+/* The facet kind of nn nodes in g dimensions (projection._COMPILED_KINDS), -1 if none. */
+static int kind_of(int g, int nn)
+{
+    if (g == 2) return nn == 2 ? 0 : (nn == 3 ? 3 : -1);
+    if (g == 3) return nn == 3 ? 1 : (nn == 4 ? 2 : (nn == 6 ? 4 : (nn == 9 ? 5 : -1)));
+    return -1;
+}
+
+/* The points whose convex hull holds the facet X of kind: its nodes (X itself) for a flat
+ * facet; for a quadratic one its Bernstein control points, written to H (nn g values):
+ * the vertices, and for an edge ij of midpoint node m the point 2 x_m - (x_i + x_j) / 2
+ * (curved.bernstein_hull, the same operations). */
+static const int SEG3_EDGES[1][3] = {{0, 1, 2}};
+static const int TRI6_EDGES[3][3] = {{0, 1, 3}, {1, 2, 4}, {0, 2, 5}};
+static const int QUAD9_EDGES[4][3] = {{0, 1, 4}, {1, 3, 5}, {2, 3, 6}, {0, 2, 7}};
+
+INLINE const double *hull(int kind, int g, const double *X, double *H)
+{
+    if (kind < 3) return X;
+    const int nn = kind == 3 ? 3 : (kind == 4 ? 6 : 9), ne = kind == 3 ? 1 : (kind == 4 ? 3 : 4);
+    const int(*E)[3] = kind == 3 ? SEG3_EDGES : (kind == 4 ? TRI6_EDGES : QUAD9_EDGES);
+    memcpy(H, X, (size_t)(nn * g) * sizeof(double));
+    for (int e = 0; e < ne; e++)
+        for (int k = 0; k < g; k++)
+            H[E[e][2] * g + k] = 2.0 * X[E[e][2] * g + k] - 0.5 * (X[E[e][0] * g + k] + X[E[e][1] * g + k]);
+    if (kind == 5) /* the centre: along s at t = 1/2, then along t */
+        for (int k = 0; k < 3; k++) {
+            double along = 2.0 * X[24 + k] - 0.5 * (X[21 + k] + X[15 + k]);
+            H[24 + k] = 2.0 * along - 0.5 * (H[12 + k] + H[18 + k]);
+        }
+    return H;
+}
+
+/* The facets of a leaf copied in the order of perm, their box (lo, hi) (of their hull
+ * points), and the largest facet radius and finiteness so far updated. */
 INLINE void fit_leaf(fit_t *F, i64 i, double *box)
 {
     const int g = F->g, nn = F->nn, w = nn * g;
@@ -172,15 +210,17 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box)
             PREFETCH(next);
             PREFETCH(next + w - 1);
         }
+        double H[27];
+        const double *P = hull(F->kind, g, X, H);
         for (int k = 0; k < g; k++) {
-            double s = X[k];
-            for (int q = 1; q < nn; q++) s += X[q * g + k];
+            double s = P[k];
+            for (int q = 1; q < nn; q++) s += P[q * g + k];
             c[k] = s / nn;
         }
         for (int q = 0; q < nn; q++) {
             double d2 = 0.0;
             for (int k = 0; k < g; k++) {
-                double v = X[q * g + k], d = v - c[k];
+                double v = P[q * g + k], d = v - c[k];
                 d2 += d * d;
                 lo[k] = v < lo[k] ? v : lo[k];
                 hi[k] = v > hi[k] ? v : hi[k];
@@ -253,7 +293,7 @@ static i64 fit(fit_t *F, i64 i, double *box)
 INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
                     const i64 *a, const i64 *b, void *tree, double *leaf_nodes)
 {
-    fit_t F = {g, nn, n, nodes, perm, a, b, leaf_nodes, rows(tree), 0, 0.0, 0.0};
+    fit_t F = {kind_of(g, nn), g, nn, n, nodes, perm, a, b, leaf_nodes, rows(tree), 0, 0.0, 0.0};
     if (m > 0) {
         double B[6];
         i64 code = fit(&F, 0, B);
@@ -279,6 +319,9 @@ double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64
     if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaf_nodes);
     if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaf_nodes);
     if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    if (g == 2 && nn == 3) return refit(2, 3, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    if (g == 3 && nn == 6) return refit(3, 6, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    if (g == 3 && nn == 9) return refit(3, 9, n, nodes, perm, m, a, b, tree, leaf_nodes);
     return -1.0;
 }
 
@@ -580,6 +623,456 @@ static void quadrilateral(const double *X, const double *x, pair_t *out)
     }
 }
 
+/* -- quadratic facets (curved.py's kernels, for one pair) --------------------------------- */
+
+/* The shape functions N (nn), first derivatives dN[alpha][n] and second derivatives
+ * d2N[alpha][beta][n] of the quadratic facet kind (3: segment3, 4: triangle6, 5:
+ * quadrilateral9) at xi (curved.quadratic_shape_functions). */
+INLINE void quadratic_shape(int kind, const double *xi, double *N, double (*dN)[9],
+                            double (*d2N)[2][9])
+{
+    if (kind == 3) {
+        double u = xi[0];
+        N[0] = (1 - u) * (1 - 2 * u), N[1] = u * (2 * u - 1), N[2] = 4 * u * (1 - u);
+        dN[0][0] = 4 * u - 3, dN[0][1] = 4 * u - 1, dN[0][2] = 4 - 8 * u;
+        d2N[0][0][0] = 4.0, d2N[0][0][1] = 4.0, d2N[0][0][2] = -8.0;
+        return;
+    }
+    if (kind == 4) {
+        static const double dL[3][2] = {{-1.0, -1.0}, {1.0, 0.0}, {0.0, 1.0}};
+        const double L[3] = {1.0 - xi[0] - xi[1], xi[0], xi[1]};
+        for (int i = 0; i < 3; i++) {
+            N[i] = L[i] * (2 * L[i] - 1);
+            for (int a = 0; a < 2; a++) {
+                dN[a][i] = (4 * L[i] - 1) * dL[i][a];
+                for (int b = 0; b < 2; b++) d2N[a][b][i] = 4 * (dL[i][a] * dL[i][b]);
+            }
+        }
+        for (int e = 0; e < 3; e++) {
+            int i = TRI6_EDGES[e][0], j = TRI6_EDGES[e][1], n = TRI6_EDGES[e][2];
+            N[n] = 4 * L[i] * L[j];
+            for (int a = 0; a < 2; a++) {
+                dN[a][n] = 4 * (L[j] * dL[i][a] + L[i] * dL[j][a]);
+                for (int b = 0; b < 2; b++)
+                    d2N[a][b][n] = 4 * (dL[i][a] * dL[j][b] + dL[j][a] * dL[i][b]);
+            }
+        }
+        return;
+    }
+    /* the tensor product of the 1D functions (start, end, middle) */
+    static const int Q9[9][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0},
+                                 {1, 2}, {2, 1}, {0, 2}, {2, 2}};
+    double l[2][3], dl[2][3];
+    static const double d2l[3] = {4.0, 4.0, -8.0};
+    for (int a = 0; a < 2; a++) {
+        double u = xi[a];
+        l[a][0] = (1 - u) * (1 - 2 * u), l[a][1] = u * (2 * u - 1), l[a][2] = 4 * u * (1 - u);
+        dl[a][0] = 4 * u - 3, dl[a][1] = 4 * u - 1, dl[a][2] = 4 - 8 * u;
+    }
+    for (int n = 0; n < 9; n++) {
+        int i = Q9[n][0], j = Q9[n][1];
+        N[n] = l[0][i] * l[1][j];
+        dN[0][n] = dl[0][i] * l[1][j];
+        dN[1][n] = l[0][i] * dl[1][j];
+        d2N[0][0][n] = d2l[i] * l[1][j];
+        d2N[0][1][n] = d2N[1][0][n] = dl[0][i] * dl[1][j];
+        d2N[1][1][n] = l[0][i] * d2l[j];
+    }
+}
+
+/* sum_n w[n] X[n] (g) */
+INLINE void combine(int g, int nn, const double *w, const double *X, double *out)
+{
+    for (int k = 0; k < g; k++) {
+        double v = w[0] * X[k];
+        for (int n = 1; n < nn; n++) v += w[n] * X[n * g + k];
+        out[k] = v;
+    }
+}
+
+/* The distance of x from the straight segment AB (g coordinates). */
+INLINE double segment_distance(int g, const double *x, const double *A, const double *B)
+{
+    double e[3], r[3], w[3];
+    for (int k = 0; k < g; k++) {
+        e[k] = B[k] - A[k];
+        r[k] = x[k] - A[k];
+    }
+    double ee = sum_prod(g, e, e);
+    double u = clip01(sum_prod(g, r, e) / (ee > 0 ? ee : 1.0));
+    for (int k = 0; k < g; k++) w[k] = r[k] - u * e[k];
+    return sqrt(sum_prod(g, w, w));
+}
+
+/* curved.curve_closest for one point: the closest point of x on the quadratic curve through
+ * A (u = 0), C (u = 1/2) and B (u = 1); returns the distance, u in *u (exactly 0 or 1 at an
+ * end). */
+static double curve_closest(int g, const double *x, const double *A, const double *B,
+                            const double *C, double *u_out)
+{
+    double b1[3], b2[3], r0[3], chord[3], r[3], rn[3], dy[3];
+    for (int k = 0; k < g; k++) {
+        b1[k] = 4.0 * C[k] - 3.0 * A[k] - B[k];
+        b2[k] = 2.0 * A[k] + 2.0 * B[k] - 4.0 * C[k];
+        r0[k] = x[k] - A[k];
+        chord[k] = B[k] - A[k];
+    }
+    double cc = sum_prod(g, chord, chord);
+    double u = clip01(sum_prod(g, r0, chord) / (cc > 0 ? cc : 1.0));
+    for (int it = 0; it < NEWTON_ITERATIONS; it++) {
+        for (int k = 0; k < g; k++) {
+            r[k] = r0[k] - u * b1[k] - (u * u) * b2[k];
+            dy[k] = b1[k] + 2.0 * u * b2[k];
+        }
+        double gr = -sum_prod(g, r, dy), gn = sum_prod(g, dy, dy);
+        double h = gn - 2.0 * sum_prod(g, r, b2);
+        h = h > 1e-12 * gn ? h : gn;
+        double step = -gr / (h > 0 ? h : INFINITY);
+        if ((u <= 0.0 && gr > 0) || (u >= 1.0 && gr < 0)) step = 0.0;
+        double f0 = sum_prod(g, r, r), next = clip01(u + step);
+        for (int half = 0; half < 3; half++) {
+            for (int k = 0; k < g; k++) rn[k] = r0[k] - next * b1[k] - (next * next) * b2[k];
+            if (!(sum_prod(g, rn, rn) > f0 * (1 + 1e-10))) break;
+            step *= 0.5;
+            next = clip01(u + step);
+        }
+        int done = fabs(next - u) <= NEWTON_TOL;
+        u = next;
+        if (done) break;
+    }
+    for (int k = 0; k < g; k++) {
+        r[k] = r0[k] - u * b1[k] - (u * u) * b2[k];
+        rn[k] = x[k] - B[k];
+    }
+    double d_newton = sqrt(sum_prod(g, r, r)), d_start = sqrt(sum_prod(g, r0, r0));
+    double d_end = sqrt(sum_prod(g, rn, rn)), d = d_newton;
+    if (d_start < d) {
+        d = d_start;
+        u = 0.0;
+    }
+    if (d_end < d) {
+        d = d_end;
+        u = 1.0;
+    }
+    *u_out = u;
+    return d;
+}
+
+/* A quadratic facet of two reference dimensions in monomial form, y(s, t) = sum_pq
+ * C[p][q] s^p t^q (p, q <= 2; of a 6-node triangle p + q <= 2), made once per projection:
+ * the Newton iterations then evaluate y, its tangents and second derivatives in a few
+ * operations instead of the shape functions' sums over the nodes. */
+typedef struct {
+    double C[3][3][3]; /* C[p][q][k] */
+} patch_t;
+
+/* the monomial coefficients of the 1D quadratic Lagrange functions (start, end, middle) */
+static const double LAGRANGE_1D[3][3] = {{1.0, -3.0, 2.0}, {0.0, -1.0, 2.0}, {0.0, 4.0, -4.0}};
+
+static void make_patch(int kind, const double *X, patch_t *P)
+{
+    memset(P, 0, sizeof *P);
+    if (kind == 5) { /* node n = (i, j): l_i(s) l_j(t) */
+        static const int Q9[9][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0},
+                                     {1, 2}, {2, 1}, {0, 2}, {2, 2}};
+        for (int n = 0; n < 9; n++)
+            for (int p = 0; p < 3; p++)
+                for (int q = 0; q < 3; q++) {
+                    double w = LAGRANGE_1D[Q9[n][0]][p] * LAGRANGE_1D[Q9[n][1]][q];
+                    if (w != 0.0)
+                        for (int k = 0; k < 3; k++) P->C[p][q][k] += w * X[3 * n + k];
+                }
+        return;
+    }
+    /* a 6-node triangle: its value, tangents and (constant) second derivatives at 0 */
+    double N[9], dN[2][9], d2N[2][2][9], zero[2] = {0.0, 0.0}, c[3];
+    quadratic_shape(4, zero, N, dN, d2N);
+    combine(3, 6, N, X, P->C[0][0]);
+    combine(3, 6, dN[0], X, P->C[1][0]);
+    combine(3, 6, dN[1], X, P->C[0][1]);
+    combine(3, 6, d2N[0][1], X, P->C[1][1]);
+    combine(3, 6, d2N[0][0], X, c);
+    for (int k = 0; k < 3; k++) P->C[2][0][k] = 0.5 * c[k];
+    combine(3, 6, d2N[1][1], X, c);
+    for (int k = 0; k < 3; k++) P->C[0][2][k] = 0.5 * c[k];
+}
+
+/* x - y(xi) */
+INLINE void patch_residual(const patch_t *P, const double *x, const double *xi, double *r)
+{
+    const double s = xi[0], t = xi[1], S[3] = {1.0, s, s * s}, T[3] = {1.0, t, t * t};
+    for (int k = 0; k < 3; k++) {
+        double v = 0.0;
+        for (int p = 0; p < 3; p++)
+            v += S[p] * (P->C[p][0][k] + t * P->C[p][1][k] + T[2] * P->C[p][2][k]);
+        r[k] = x[k] - v;
+    }
+    (void)T;
+}
+
+/* x - y, the tangents a and the Hessian H of |x - y|^2 / 2 (and the metric gm) at xi
+ * (curved._state) */
+INLINE void patch_state(const patch_t *P, const double *x, const double *xi, double *r,
+                        double (*a)[3], double (*H)[2], double (*gm)[2])
+{
+    const double s = xi[0], t = xi[1];
+    const double S[3] = {1.0, s, s * s}, T[3] = {1.0, t, t * t};
+    const double dS[3] = {0.0, 1.0, 2.0 * s}, dT[3] = {0.0, 1.0, 2.0 * t};
+    const double d2[3] = {0.0, 0.0, 2.0};
+    double y2[2][2][3] = {{{0.0}}};
+    patch_residual(P, x, xi, r);
+    for (int k = 0; k < 3; k++) {
+        double a0 = 0.0, a1 = 0.0;
+        for (int p = 0; p < 3; p++)
+            for (int q = 0; q < 3; q++) {
+                double c = P->C[p][q][k];
+                a0 += dS[p] * T[q] * c;
+                a1 += S[p] * dT[q] * c;
+                y2[0][0][k] += d2[p] * T[q] * c;
+                y2[0][1][k] += dS[p] * dT[q] * c;
+                y2[1][1][k] += S[p] * d2[q] * c;
+            }
+        a[0][k] = a0;
+        a[1][k] = a1;
+    }
+    for (int al = 0; al < 2; al++)
+        for (int be = al; be < 2; be++) {
+            gm[al][be] = gm[be][al] = dot3(a[al], a[be]);
+            H[al][be] = H[be][al] = gm[al][be] - dot3(r, y2[al][be]);
+        }
+}
+
+/* curved._newton for one pair from xi (in/out): returns the distance; *good whether xi is a
+ * strict interior minimum (converged, inside, positive definite Hessian). */
+static double curved_newton(int kind, const patch_t *P, const double *x, double *xi, int *good)
+{
+    double r[3], a[2][3], H[2][2], gm[2][2], rn[3];
+    int conv = 0;
+    for (int it = 0; it < NEWTON_ITERATIONS; it++) {
+        patch_state(P, x, xi, r, a, H, gm);
+        double g0 = -dot3(r, a[0]), g1 = -dot3(r, a[1]);
+        double det = H[0][0] * H[1][1] - H[0][1] * H[1][0];
+        if (det <= 1e-12 * H[0][0] * H[1][1] || H[0][0] <= 0) memcpy(H, gm, sizeof H);
+        det = H[0][0] * H[1][1] - H[0][1] * H[1][0];
+        det = det > 0 ? det : INFINITY;
+        double step[2] = {-(H[1][1] * g0 - H[0][1] * g1) / det,
+                          -(H[0][0] * g1 - H[1][0] * g0) / det};
+        for (int j = 0; j < 2; j++) /* keep the iterate near the facet */
+            step[j] = step[j] < -0.5 ? -0.5 : (step[j] > 0.5 ? 0.5 : step[j]);
+        double f0 = dot3(r, r), next[2] = {xi[0] + step[0], xi[1] + step[1]};
+        for (int half = 0; half < 3; half++) {
+            patch_residual(P, x, next, rn);
+            if (!(dot3(rn, rn) > f0 * (1 + 1e-10))) break;
+            for (int j = 0; j < 2; j++) {
+                step[j] *= 0.5;
+                next[j] = xi[j] + step[j];
+            }
+        }
+        double d0 = fabs(next[0] - xi[0]), d1 = fabs(next[1] - xi[1]);
+        int done = (d0 > d1 ? d0 : d1) <= NEWTON_TOL;
+        xi[0] = next[0];
+        xi[1] = next[1];
+        if (done) {
+            conv = 1;
+            break;
+        }
+    }
+    patch_state(P, x, xi, r, a, H, gm);
+    int inside = xi[0] > 0.0 && xi[1] > 0.0
+                 && (kind == 4 ? xi[0] + xi[1] < 1.0 : xi[0] < 1.0 && xi[1] < 1.0);
+    int pd = H[0][0] > 0 && H[0][0] * H[1][1] - H[0][1] * H[1][0] > 0;
+    *good = conv && inside && pd;
+    return sqrt(dot3(r, r));
+}
+
+/* curved.triangle_interior for one pair: Newton from the projection on the plane of the
+ * vertices (clamped into the triangle), restarted from the centroid. */
+static double triangle6_interior(const double *X, const double *x, double *xi, int *good)
+{
+    double a1[3], a2[3], r[3];
+    for (int k = 0; k < 3; k++) {
+        a1[k] = X[3 + k] - X[k];
+        a2[k] = X[6 + k] - X[k];
+        r[k] = x[k] - X[k];
+    }
+    double G00 = dot3(a1, a1), G01 = dot3(a1, a2), G11 = dot3(a2, a2);
+    double b0 = dot3(r, a1), b1 = dot3(r, a2), det = G00 * G11 - G01 * G01;
+    xi[0] = xi[1] = 1.0 / 3.0;
+    if (det > 1e-14 * G00 * G11) {
+        xi[0] = (G11 * b0 - G01 * b1) / det;
+        xi[1] = (G00 * b1 - G01 * b0) / det;
+    }
+    xi[0] = clip01(xi[0]);
+    xi[1] = clip01(xi[1]);
+    double sum = xi[0] + xi[1];
+    if (sum > 1.0) {
+        xi[0] /= sum;
+        xi[1] /= sum;
+    }
+    patch_t P;
+    make_patch(4, X, &P);
+    double dist = curved_newton(4, &P, x, xi, good);
+    if (!*good) {
+        double xr[2] = {1.0 / 3.0, 1.0 / 3.0};
+        int good_r;
+        double dist_r = curved_newton(4, &P, x, xr, &good_r);
+        if (good_r) {
+            xi[0] = xr[0], xi[1] = xr[1], dist = dist_r, *good = 1;
+        }
+    }
+    return dist;
+}
+
+/* curved.quadrilateral_interior for one pair: Newton from the centre, restarted from four
+ * other points. */
+static double quadrilateral9_interior(const double *X, const double *x, double *xi, int *good)
+{
+    static const double starts[4][2] = {{0.25, 0.25}, {0.75, 0.25}, {0.25, 0.75}, {0.75, 0.75}};
+    patch_t P;
+    make_patch(5, X, &P);
+    xi[0] = xi[1] = 0.5;
+    double dist = curved_newton(5, &P, x, xi, good);
+    for (int j = 0; j < 4 && !*good; j++) {
+        double xr[2] = {starts[j][0], starts[j][1]};
+        int good_r;
+        double dist_r = curved_newton(5, &P, x, xr, &good_r);
+        if (good_r) {
+            xi[0] = xr[0], xi[1] = xr[1], dist = dist_r, *good = 1;
+        }
+    }
+    return dist;
+}
+
+/* projection._Master._project_quadratic for one pair: the closest point on the curved
+ * edges, replaced by an interior minimum where that is closer. */
+static void quadratic(int kind, const double *X, const double *x, pair_t *out)
+{
+    if (kind == 3) {
+        double u, d = curve_closest(2, x, X, X + 2, X + 4, &u);
+        out->xi[0] = u;
+        out->dist = d;
+        out->edge = -1;
+        out->vertex = u == 0.0 || u == 1.0;
+        return;
+    }
+    const int ne = kind == 4 ? 3 : 4;
+    const int(*E)[3] = kind == 4 ? TRI6_EDGES : QUAD9_EDGES;
+    const double(*XI)[2][2] = kind == 4 ? TRI_XI : QUAD_XI;
+    double xi[2];
+    int good;
+    double d_in = kind == 4 ? triangle6_interior(X, x, xi, &good)
+                            : quadrilateral9_interior(X, x, xi, &good);
+    /* The interior minimum wins unless an edge is at most as close (the order of
+     * _project_quadratic: the edges' best, replaced by the interior where strictly closer).
+     * An edge whose distance is certainly above d_in cannot change the result and is not
+     * projected: the curve y = chord + 4 u (1 - u) delta is within |delta| of its chord,
+     * so its distance is at least the chord's minus |delta| (margin far above round-off). */
+    double best_d = INFINITY, best_u = 0.0;
+    int best_k = -1;
+    for (int n = 0; n < ne; n++) {
+        const double *A = X + 3 * E[n][0], *B = X + 3 * E[n][1], *C = X + 3 * E[n][2];
+        if (good) {
+            double delta[3], chord[3];
+            for (int k = 0; k < 3; k++) {
+                delta[k] = C[k] - 0.5 * (A[k] + B[k]);
+                chord[k] = B[k] - A[k];
+            }
+            double lower = segment_distance(3, x, A, B) - sqrt(dot3(delta, delta));
+            if (lower > d_in + 1e-10 * (d_in + sqrt(dot3(chord, chord)))) continue;
+        }
+        double u, d = curve_closest(3, x, A, B, C, &u);
+        if (best_k < 0 || d < best_d) {
+            best_d = d;
+            best_u = u;
+            best_k = n;
+        }
+    }
+    if (good && (best_k < 0 || d_in < best_d)) {
+        out->xi[0] = xi[0];
+        out->xi[1] = xi[1];
+        out->dist = d_in;
+        out->edge = -1;
+        out->vertex = 0;
+        return;
+    }
+    for (int j = 0; j < 2; j++)
+        out->xi[j] = XI[best_k][0][j] + best_u * (XI[best_k][1][j] - XI[best_k][0][j]);
+    out->dist = best_d;
+    out->edge = best_k;
+    out->vertex = best_u == 0.0 || best_u == 1.0;
+}
+
+/* Bounds of the distance of x from a quadratic facet X (kind 3, 4 or 5) without its
+ * projection, from a chord facet of its vertices that is within dev of it point for point
+ * (at the same reference coordinates, both ways): its distance is within dev of the chord
+ * facet's (an exact projection, cheap).
+ * - 3-node segment: the chord AB, y = chord + 4 u (1 - u) delta, delta the midpoint node's
+ *   offset from the chord's midpoint: dev = |delta|.
+ * - 6-node triangle: the triangle of the vertices plus sum_e 4 L_i L_j delta_e (weights
+ *   summing to at most 4/3): dev = 4/3 max |delta_e|.
+ * - 9-node quadrilateral: the two triangles (v0, v1, v2), (v1, v3, v2) of its corners. The
+ *   facet minus the bilinear patch of the corners has the Bernstein control points H - P (P
+ *   those of the bilinear patch: the corners, the edges' chord midpoints, the corners'
+ *   mean), so it is within max |H - P|; the bilinear patch is within |c3| / 4 of the two
+ *   triangles (s t c3, (1 - s)(1 - t) c3 at most a quarter, c3 = x0 - x1 - x2 + x3). */
+INLINE void chord_bounds(int kind, const double *X, const double *x, double *lower,
+                         double *upper)
+{
+    double chord, dev;
+    if (kind == 3) {
+        double delta[2] = {X[4] - 0.5 * (X[0] + X[2]), X[5] - 0.5 * (X[1] + X[3])};
+        chord = segment_distance(2, x, X, X + 2);
+        dev = sqrt(sum_prod(2, delta, delta));
+    } else if (kind == 4) {
+        double dev2 = 0.0;
+        for (int e = 0; e < 3; e++) {
+            const int *E = TRI6_EDGES[e];
+            double delta[3];
+            for (int k = 0; k < 3; k++)
+                delta[k] = X[3 * E[2] + k] - 0.5 * (X[3 * E[0] + k] + X[3 * E[1] + k]);
+            double d2 = dot3(delta, delta);
+            dev2 = d2 > dev2 ? d2 : dev2;
+        }
+        pair_t q;
+        triangle(X, x, &q);
+        chord = q.dist;
+        dev = 4.0 / 3.0 * sqrt(dev2);
+    } else {
+        double H[27], T[9], c3[3], dev2 = 0.0;
+        hull(5, 3, X, H);
+        for (int e = 0; e < 4; e++) { /* the edges: H - chord midpoint */
+            const int *E = QUAD9_EDGES[e];
+            double d[3];
+            for (int k = 0; k < 3; k++)
+                d[k] = H[3 * E[2] + k] - 0.5 * (X[3 * E[0] + k] + X[3 * E[1] + k]);
+            double d2 = dot3(d, d);
+            dev2 = d2 > dev2 ? d2 : dev2;
+        }
+        { /* the centre: H - the corners' mean */
+            double d[3];
+            for (int k = 0; k < 3; k++) {
+                d[k] = H[24 + k] - 0.25 * (X[k] + X[3 + k] + X[6 + k] + X[9 + k]);
+                c3[k] = X[k] - X[3 + k] - X[6 + k] + X[9 + k];
+            }
+            double d2 = dot3(d, d);
+            dev2 = d2 > dev2 ? d2 : dev2;
+        }
+        pair_t q0, q1;
+        triangle(X, x, &q0);
+        for (int k = 0; k < 3; k++) { /* v1, v3, v2 */
+            T[k] = X[3 + k];
+            T[3 + k] = X[9 + k];
+            T[6 + k] = X[6 + k];
+        }
+        triangle(T, x, &q1);
+        chord = q0.dist < q1.dist ? q0.dist : q1.dist;
+        dev = sqrt(dev2) + 0.25 * sqrt(dot3(c3, c3));
+    }
+    /* widened by far more than the round-off of the distances */
+    *lower = chord - dev * (1 + 1e-12);
+    *upper = chord + dev * (1 + 1e-12);
+}
+
 INLINE void project(int kind, const double *X, const double *x, pair_t *out)
 {
     if (kind == 0) {
@@ -587,8 +1080,10 @@ INLINE void project(int kind, const double *X, const double *x, pair_t *out)
         out->edge = -1;
     } else if (kind == 1) {
         triangle(X, x, out);
-    } else {
+    } else if (kind == 2) {
         quadrilateral(X, x, out);
+    } else {
+        quadratic(kind, X, x, out);
     }
 }
 
@@ -711,6 +1206,7 @@ INLINE double reach(double v, double rmax) { return v + 1e-9 * (v + 2.0 * rmax);
 typedef struct {
     i64 j; /* position in the leaves */
     pair_t q;
+    double key; /* q.dist once projected; before, a lower bound of it (a deferred facet) */
 } hit_t;
 
 /* The closest point of x on the facet X at q.xi and what projection._select computes of it:
@@ -720,9 +1216,11 @@ INLINE int finish(int kind, int g, int nn, const double *X, const double *x, con
                   double radius, double *y, double *nu, double *gap, double *distance,
                   double *M)
 {
-    double N[4], dN[2][4], a[2][3] = {{0.0}}, r[3];
+    double N[9], dN[2][9], d2N[2][2][9], a[2][3] = {{0.0}}, r[3];
     int fdim = g - 1;
-    if (kind == 0) {
+    if (kind >= 3) {
+        quadratic_shape(kind, q->xi, N, dN, d2N);
+    } else if (kind == 0) {
         double u = q->xi[0];
         N[0] = 1.0 - u;
         N[1] = u;
@@ -770,12 +1268,22 @@ INLINE int finish(int kind, int g, int nn, const double *X, const double *x, con
     *distance = sqrt(rr);
     if (!(*distance <= radius)) return 0;
     *gap = -nr;
+    /* the curvature terms (x - y) . d2y/dxi_a dxi_b of a quadratic facet */
+    double curv[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
+    if (kind >= 3)
+        for (int al = 0; al < fdim; al++)
+            for (int be = 0; be < fdim; be++) {
+                double c[3];
+                combine(g, nn, d2N[al][be], X, c);
+                curv[al][be] = sum_prod(g, r, c);
+            }
     if (fdim == 1) {
-        double A11 = a[0][0] * a[0][0] + a[0][1] * a[0][1];
+        double A11 = a[0][0] * a[0][0] + a[0][1] * a[0][1] - curv[0][0];
         M[0] = !q->vertex && A11 != 0 ? 1.0 / A11 : 0.0;
         return 1;
     }
-    double A00 = dot3(a[0], a[0]), A11 = dot3(a[1], a[1]), A01 = dot3(a[0], a[1]);
+    double A00 = dot3(a[0], a[0]) - curv[0][0], A11 = dot3(a[1], a[1]) - curv[1][1];
+    double A01 = dot3(a[0], a[1]) - curv[0][1];
     if (kind == 2) {
         double c3[3];
         for (int k = 0; k < 3; k++) c3[k] = X[k] - X[3 + k] - X[6 + k] + X[9 + k];
@@ -793,7 +1301,7 @@ INLINE int finish(int kind, int g, int nn, const double *X, const double *x, con
         }
         return 1;
     }
-    const double(*XI)[2][2] = kind == 1 ? TRI_XI : QUAD_XI;
+    const double(*XI)[2][2] = kind == 1 || kind == 4 ? TRI_XI : QUAD_XI;
     double t0 = XI[q->edge][1][0] - XI[q->edge][0][0], t1 = XI[q->edge][1][1] - XI[q->edge][0][1];
     double tAt = t0 * (A00 * t0 + A01 * t1) + t1 * (A01 * t0 + A11 * t1);
     if (tAt != 0) {
@@ -817,6 +1325,13 @@ INLINE int admissible(int g, int m, const i64 *pnodes, const double *pnormal, in
     return s < 0.0;
 }
 
+/* Whether the exact projections of a facet kind wait until the walk is done: those of the
+ * quadratic facets (several Newton iterations each), whose distance
+ * bounds from their chord facets (chord_bounds) prune as the walk goes; then the facets are
+ * projected by increasing lower bound, each bound by the distances found (resolve): the
+ * same facets within the reach of the closest one, with far fewer projections. */
+#define DEFERRED(kind) ((kind) >= 3)
+
 /* The walk of one point: the facets met within the bound (hits, at leaf positions), the
  * smallest distance met (best), the bound (reach of the best, at most reach of the radius;
  * bound2 its square), and the exact projections made by the walks of the lane so far. */
@@ -835,12 +1350,13 @@ INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                  const double *pnu, int mf, const i64 *fnodes, const double *axis)
 {
     const double *X = leaf_nodes + j * nn * g;
-    { /* the facet's box before its exact projection */
-        double B[6];
+    { /* the facet's box (of its hull points) before its exact projection */
+        double B[6], H[27];
+        const double *P = hull(kind, g, X, H);
         for (int k = 0; k < g; k++) {
-            B[k] = B[g + k] = X[k];
+            B[k] = B[g + k] = P[k];
             for (int q = 1; q < nn; q++) {
-                double v = X[q * g + k];
+                double v = P[q * g + k];
                 if (v < B[k]) B[k] = v;
                 if (v > B[g + k]) B[g + k] = v;
             }
@@ -851,13 +1367,20 @@ INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
     if (pn && !admissible(g, mp, pn, pnu, mf, fnodes + perm[j] * mf, axis + perm[j] * g))
         return 0;
     pair_t q;
-    project(kind, X, xp, &q);
-    if (q.dist > W->bound) return 1;
+    double key, upper = INFINITY;
+    if (DEFERRED(kind)) { /* projected when the walk is done (resolve) */
+        chord_bounds(kind, X, xp, &key, &upper);
+        if (key > W->bound + 1e-10 * (W->bound + rmax)) return 0;
+    } else {
+        project(kind, X, xp, &q);
+        key = q.dist;
+        if (q.dist > W->bound) return 1;
+    }
     if (W->nh == W->room) {
         /* drop the hits beyond the bound, then grow */
         i64 k = 0;
         for (i64 h = 0; h < W->nh; h++)
-            if (W->hits[h].q.dist <= W->bound) W->hits[k++] = W->hits[h];
+            if (W->hits[h].key <= W->bound) W->hits[k++] = W->hits[h];
         W->nh = k;
         if (W->nh == W->room) {
             hit_t *more = realloc(W->hits, 2 * W->room * sizeof(hit_t));
@@ -867,8 +1390,19 @@ INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
         }
     }
     W->hits[W->nh].j = j;
-    W->hits[W->nh].q = q;
+    W->hits[W->nh].key = key;
     W->nh++;
+    if (DEFERRED(kind)) {
+        /* the bound from the upper bound of the distance (the closest facet is still
+         * within it, and within the reach of any bound it gives) */
+        double r = reach(upper < W->radius ? upper : W->radius, rmax);
+        if (r < W->bound) {
+            W->bound = r;
+            W->bound2 = r * r;
+        }
+        return 0;
+    }
+    W->hits[W->nh - 1].q = q;
     if (q.dist < W->best) {
         W->best = q.dist;
         double r = reach(q.dist < W->radius ? q.dist : W->radius, rmax);
@@ -977,6 +1511,43 @@ INLINE int step(int kind, int g, int nn, const query_t *Q, lane_t *L)
     return 0;
 }
 
+/* The deferred facets of the point of lane L (its walk done; DEFERRED kinds), projected by
+ * increasing lower bound while that is within the bound, which tightens to the reach of
+ * the smallest distance found: the closest facet (whose lower bound is at most its
+ * distance, so within every bound) is projected, and so is every facet within the reach
+ * of its distance. The others are left beyond the bound (distance infinite). */
+INLINE void resolve(int kind, int g, int nn, const query_t *Q, lane_t *L)
+{
+    walk_t *W = &L->W;
+    hit_t *hits = W->hits;
+    const double *xp = Q->x + L->p * g;
+    for (i64 h = 1; h < W->nh; h++) { /* insertion sort by lower bound: a few facets */
+        hit_t t = hits[h];
+        i64 i = h;
+        for (; i > 0 && hits[i - 1].key > t.key; i--) hits[i] = hits[i - 1];
+        hits[i] = t;
+    }
+    for (i64 h = 0; h < W->nh; h++) {
+        hit_t *H = hits + h;
+        if (H->key > W->bound + 1e-10 * (W->bound + Q->rmax)) {
+            H->q.dist = INFINITY;
+            H->key = INFINITY;
+            continue;
+        }
+        project(kind, Q->leaf_nodes + H->j * nn * g, xp, &H->q);
+        H->key = H->q.dist;
+        W->projected++;
+        if (H->q.dist < W->best) {
+            W->best = H->q.dist;
+            double r = reach(H->q.dist < W->radius ? H->q.dist : W->radius, Q->rmax);
+            if (r < W->bound) {
+                W->bound = r;
+                W->bound2 = r * r;
+            }
+        }
+    }
+}
+
 /* The results of the point of lane L, its walk done: its count, and its pairs at the next
  * row or its closest point (see bvh_query). */
 INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
@@ -1063,7 +1634,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
                  gap, distance, sliding, pnodes, fnodes, pnormal, axis};
     /* one lane for segments: their walks are short and their projections cheap, the turns
      * cost more than they save */
-    const int lanes = kind == 0 ? 1 : LANES;
+    const int lanes = g == 2 ? 1 : LANES;
     lane_t *L = malloc(lanes * sizeof(lane_t));
     if (!L) return -1;
     for (int l = 0; l < lanes; l++) {
@@ -1083,6 +1654,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
         for (int l = 0; l < lanes; l++) {
             lane_t *A = L + l;
             while (A->top == 0) { /* the lane's point done (or none yet): the next point */
+                if (A->p >= 0 && DEFERRED(kind)) resolve(kind, g, nn, &Q, A);
                 if (A->p >= 0) conclude(kind, g, nn, &Q, A);
                 A->p = -1;
                 if (next == npts) break;
@@ -1124,6 +1696,18 @@ i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm
                      gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
     if (kind == 2)
         return query(2, 3, 4, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
+                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
+    if (kind == 3)
+        return query(3, 2, 3, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
+                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
+    if (kind == 4)
+        return query(4, 3, 6, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
+                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
+                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
+    if (kind == 5)
+        return query(5, 3, 9, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
                      f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
                      gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
     (void)g;
