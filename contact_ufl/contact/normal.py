@@ -104,6 +104,12 @@ class NormalLaw:
         closing = float(self.closing.value) + margin
         return self._bracket_argument(proj) > -float(self.eps_N.value) * closing
 
+    def deepest_overlap(self, proj: Projection) -> float:
+        """The largest proximity ``g`` (overlap with the master) of this rank's paired
+        points (0 if none overlaps)."""
+        gap = proj.gap[proj.facet >= 0]
+        return float(max(gap.max(initial=0.0), 0.0))
+
     def nearest_open_gap(self, proj: Projection) -> float:
         """The smallest distance from the master surface of this rank's open points that have
         a master facet (``inf`` if none): how far the nearest open point is from touching."""
