@@ -484,11 +484,12 @@ INLINE double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-INLINE void triangle(const double *X, const double *x, pair_t *out)
+/* The reference coordinates xi of the projection of x on the plane of the triangle of the
+ * nodes X[0..2] (the operations of projection._triangle_interior), its tangents a1, a2 and
+ * r = x - X[0]; xi = 0 and 0 returned where the triangle is degenerate. */
+INLINE int plane_xi(const double *X, const double *x, double *xi, double *a1, double *a2,
+                    double *r)
 {
-    /* the projection on the plane where it is inside, else the closest point of the edges
-     * (projection._triangle_interior replaces the edges' result where it is inside) */
-    double a1[3], a2[3], r[3];
     for (int k = 0; k < 3; k++) {
         a1[k] = X[3 + k] - X[k];
         a2[k] = X[6 + k] - X[k];
@@ -501,7 +502,18 @@ INLINE void triangle(const double *X, const double *x, pair_t *out)
     double i11 = g22 * inv, i12 = -g12 * inv, i22 = g11 * inv;
     double b1 = r[0] * a1[0] + r[1] * a1[1] + r[2] * a1[2];
     double b2 = r[0] * a2[0] + r[1] * a2[1] + r[2] * a2[2];
-    double xi1 = i11 * b1 + i12 * b2, xi2 = i12 * b1 + i22 * b2;
+    xi[0] = i11 * b1 + i12 * b2;
+    xi[1] = i12 * b1 + i22 * b2;
+    return ok;
+}
+
+INLINE void triangle(const double *X, const double *x, pair_t *out)
+{
+    /* the projection on the plane where it is inside, else the closest point of the edges
+     * (projection._triangle_interior replaces the edges' result where it is inside) */
+    double a1[3], a2[3], r[3], xi[2];
+    plane_xi(X, x, xi, a1, a2, r);
+    double xi1 = xi[0], xi2 = xi[1];
     if (xi1 > 0.0 && xi2 > 0.0 && xi1 + xi2 < 1.0) {
         double w[3];
         for (int k = 0; k < 3; k++) w[k] = r[k] - xi1 * a1[k] - xi2 * a2[k];
@@ -890,18 +902,7 @@ static double curved_newton(int kind, const patch_t *P, const double *x, double 
 static double triangle6_interior(const double *X, const double *x, double *xi, int *good)
 {
     double a1[3], a2[3], r[3];
-    for (int k = 0; k < 3; k++) {
-        a1[k] = X[3 + k] - X[k];
-        a2[k] = X[6 + k] - X[k];
-        r[k] = x[k] - X[k];
-    }
-    double G00 = dot3(a1, a1), G01 = dot3(a1, a2), G11 = dot3(a2, a2);
-    double b0 = dot3(r, a1), b1 = dot3(r, a2), det = G00 * G11 - G01 * G01;
-    xi[0] = xi[1] = 1.0 / 3.0;
-    if (det > 1e-14 * G00 * G11) {
-        xi[0] = (G11 * b0 - G01 * b1) / det;
-        xi[1] = (G00 * b1 - G01 * b0) / det;
-    }
+    if (!plane_xi(X, x, xi, a1, a2, r)) xi[0] = xi[1] = 1.0 / 3.0;
     xi[0] = clip01(xi[0]);
     xi[1] = clip01(xi[1]);
     double sum = xi[0] + xi[1];
@@ -1015,6 +1016,21 @@ static void quadratic(int kind, const double *X, const double *x, pair_t *out)
  *   those of the bilinear patch: the corners, the edges' chord midpoints, the corners'
  *   mean), so it is within max |H - P|; the bilinear patch is within |c3| / 4 of the two
  *   triangles (s t c3, (1 - s)(1 - t) c3 at most a quarter, c3 = x0 - x1 - x2 + x3). */
+/* The largest squared distance of the points P[m] of the ne edges (i, j, m) of E from the
+ * midpoints of the chords X[i] X[j] (3D). */
+INLINE double largest_offset(int ne, const int (*E)[3], const double *P, const double *X)
+{
+    double largest = 0.0;
+    for (int e = 0; e < ne; e++) {
+        double d[3];
+        for (int k = 0; k < 3; k++)
+            d[k] = P[3 * E[e][2] + k] - 0.5 * (X[3 * E[e][0] + k] + X[3 * E[e][1] + k]);
+        double d2 = dot3(d, d);
+        largest = d2 > largest ? d2 : largest;
+    }
+    return largest;
+}
+
 INLINE void chord_bounds(int kind, const double *X, const double *x, double *lower,
                          double *upper)
 {
@@ -1024,30 +1040,14 @@ INLINE void chord_bounds(int kind, const double *X, const double *x, double *low
         chord = segment_distance(2, x, X, X + 2);
         dev = sqrt(sum_prod(2, delta, delta));
     } else if (kind == 4) {
-        double dev2 = 0.0;
-        for (int e = 0; e < 3; e++) {
-            const int *E = TRI6_EDGES[e];
-            double delta[3];
-            for (int k = 0; k < 3; k++)
-                delta[k] = X[3 * E[2] + k] - 0.5 * (X[3 * E[0] + k] + X[3 * E[1] + k]);
-            double d2 = dot3(delta, delta);
-            dev2 = d2 > dev2 ? d2 : dev2;
-        }
         pair_t q;
         triangle(X, x, &q);
         chord = q.dist;
-        dev = 4.0 / 3.0 * sqrt(dev2);
+        dev = 4.0 / 3.0 * sqrt(largest_offset(3, TRI6_EDGES, X, X));
     } else {
-        double H[27], T[9], c3[3], dev2 = 0.0;
+        double H[27], T[9], c3[3];
         hull(5, 3, X, H);
-        for (int e = 0; e < 4; e++) { /* the edges: H - chord midpoint */
-            const int *E = QUAD9_EDGES[e];
-            double d[3];
-            for (int k = 0; k < 3; k++)
-                d[k] = H[3 * E[2] + k] - 0.5 * (X[3 * E[0] + k] + X[3 * E[1] + k]);
-            double d2 = dot3(d, d);
-            dev2 = d2 > dev2 ? d2 : dev2;
-        }
+        double dev2 = largest_offset(4, QUAD9_EDGES, H, X); /* H - chord midpoints */
         { /* the centre: H - the corners' mean */
             double d[3];
             for (int k = 0; k < 3; k++) {
@@ -1686,30 +1686,19 @@ i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm
               const i64 *fnodes, const double *axis)
 {
     /* one copy of the walk per facet kind, its dimensions constant */
-    if (kind == 0)
-        return query(0, 2, 2, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
-                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
-    if (kind == 1)
-        return query(1, 3, 3, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
-                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
-    if (kind == 2)
-        return query(2, 3, 4, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
-                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
-    if (kind == 3)
-        return query(3, 2, 3, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
-                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
-    if (kind == 4)
-        return query(4, 3, 6, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
-                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
-    if (kind == 5)
-        return query(5, 3, 9, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count,
-                     f, xi, dist, edge, vertex, point, written, index, facet, oxi, y, normal,
-                     gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis);
+#define QUERY(K, G, NN)                                                                     \
+    query(K, G, NN, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count, f, xi,   \
+          dist, edge, vertex, point, written, index, facet, oxi, y, normal, gap, distance, \
+          sliding, mp, pnodes, pnormal, mf, fnodes, axis)
+    switch (kind) {
+    case 0: return QUERY(0, 2, 2);
+    case 1: return QUERY(1, 3, 3);
+    case 2: return QUERY(2, 3, 4);
+    case 3: return QUERY(3, 2, 3);
+    case 4: return QUERY(4, 3, 6);
+    case 5: return QUERY(5, 3, 9);
+    }
+#undef QUERY
     (void)g;
     (void)nn;
     return -2;
