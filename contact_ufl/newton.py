@@ -842,7 +842,7 @@ class NewtonSolver:
         rtol, atol, _, max_it = self.snes.getTolerances()
         self.snes.setTolerances(max_it=1)
         try:
-            reason, its = self._newton()
+            reason, its = self._newton(partial=True)
             if reason > 0:
                 return reason, its
             # the relative tolerance of the later solves refers to the step's start
@@ -876,7 +876,7 @@ class NewtonSolver:
         before = self.iterates[-1][0]  # the residual at x (the free iterate's last)
         free = self.x.copy()
         try:
-            self._newton()
+            self._newton(partial=True)
             for c in shifted:
                 c.normal.closing.value = c.normal.touching
             self._state = None
@@ -1050,9 +1050,13 @@ class NewtonSolver:
             "jumps (continuous normal from facet to facet)"
         )
 
-    def _newton(self) -> tuple[int, int]:
-        """One SNES solve from :attr:`x`: converged reason and iterations."""
-        self._state = None
+    def _newton(self, partial: bool = False) -> tuple[int, int]:
+        """One SNES solve from :attr:`x`: converged reason and iterations. ``partial``: a
+        solve cut short on purpose (``max_it`` set low, the first-contact iterates), whose
+        factorisation and contact state at :attr:`x` the next solve may keep (a failed
+        solve's factorisation is reset, and a solve's first residual searches anew)."""
+        if not partial:
+            self._state = None
         self.iterates = []
         self._not_finite = None  # inverted cells of an iterate whose residual is NaN/inf
         self._callback_error = None
@@ -1075,7 +1079,8 @@ class NewtonSolver:
             raise error
         self.timings.iterations += self.snes.getIterationNumber()
         if reason <= 0:
-            self._reset_pc()  # no stale factorisation in the next try
+            if not partial:
+                self._reset_pc()  # no stale factorisation in the next try
         return reason, self.snes.getIterationNumber()
 
     @property
