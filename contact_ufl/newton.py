@@ -196,6 +196,12 @@ class NewtonSolver:
     close_gaps
         Whether a failed step whose start has a contact pair with no point in contact is
         tried once more after a closing iterate (see :meth:`solve_step`).
+    first_contact_fraction
+        The first try of a step whose start has a contact pair with no point in contact
+        takes, after its first (free) iterate, a predictor iterate in which that pair's
+        points count as in contact only where they overlap the master by more than this
+        fraction (default 1/2) of its deepest overlap (see :meth:`solve_step`); ``None``:
+        no predictor iterate.
     timings
         Seconds spent in the parts of the Newton solves (:class:`NewtonTimings`).
     pattern_slack
