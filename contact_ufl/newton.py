@@ -842,8 +842,8 @@ class NewtonSolver:
         """Newton where ``pairs`` have no point in contact at the start: after the first
         (free) iterate, one iterate in which the points of each such pair count as in
         contact only where they overlap the master by more than
-        :attr:`first_contact_fraction` times
-        the pair's deepest overlap; then Newton. Converged reason and iterations (all
+        :attr:`first_contact_fraction` times the pair's deepest overlap
+        (:meth:`_predictor_iterate`); then Newton. Converged reason and iterations (all
         counted; at most the SNES's ``max_it`` in all, which is over 2)."""
         rtol, atol, _, max_it = self.snes.getTolerances()
         self.snes.setTolerances(max_it=1)
