@@ -46,6 +46,7 @@ import argparse
 import dataclasses
 import json
 import time
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from mpi4py import MPI
@@ -158,16 +159,27 @@ def run(dim: int, h: float, degree: int, case: str, eps_default: float | None) -
     }
 
 
+def compared_to_default(
+    solve: Callable[[str, float | None], dict], cases: Sequence[str], quantities: Sequence[str]
+) -> list[dict]:
+    """The records ``solve(case, eps_default)`` of ``cases`` on one mesh, the first the
+    default (``eps_default`` None; the others get its ``eps_N``), each with ``<q>_change``,
+    its quantity ``q`` relative to the default's, for each of ``quantities``."""
+    default = solve(cases[0], None)
+    records = [default] + [solve(case, default["eps_N"]) for case in cases[1:]]
+    for r in records:
+        for q in quantities:
+            r[f"{q}_change"] = r[q] / default[q] - 1.0
+    return records
+
+
 def mesh_records(dim: int, h: float, degree: int) -> list[dict]:
     """The runs of :data:`EPS_CASES` on one mesh, with the changes against the default."""
-    default = run(dim, h, degree, "default", None)
-    records = [default]
-    records += [run(dim, h, degree, case, default["eps_N"]) for case in EPS_CASES[1:]]
-    for r in records:
-        r["force_change"] = r["force"] / default["force"] - 1.0
-        r["p0_change"] = r["p0"] / default["p0"] - 1.0
-        r["peak_change"] = r["peak"] / default["peak"] - 1.0
-    return records
+
+    def solve(case: str, eps_default: float | None) -> dict:
+        return run(dim, h, degree, case, eps_default)
+
+    return compared_to_default(solve, EPS_CASES, ("force", "p0", "peak"))
 
 
 HEADER = (

@@ -30,6 +30,7 @@ import argparse
 import json
 import time
 
+from eps_default import compared_to_default
 from mpi4py import MPI
 
 from contact_ufl.verification.runs import cattaneo_mindlin_run
@@ -78,12 +79,11 @@ def run(h: float, case: str, eps_default: float | None) -> dict:
 
 def mesh_records(h: float) -> list[dict]:
     """The runs of :data:`CASES` on one mesh, with the changes against the default."""
-    default = run(h, "default", None)
-    records = [default] + [run(h, case, default["eps_N"]) for case in CASES[1:]]
-    for r in records:
-        r["Q_change"] = r["Q"] / default["Q"] - 1.0
-        r["c_change"] = r["c"] / default["c"] - 1.0
-    return records
+
+    def solve(case: str, eps_default: float | None) -> dict:
+        return run(h, case, eps_default)
+
+    return compared_to_default(solve, CASES, ("Q", "c"))
 
 
 HEADER = (

@@ -853,8 +853,7 @@ class NewtonSolver:
                 return reason, its
             # the relative tolerance of the later solves refers to the step's start
             self.snes.setTolerances(atol=max(atol, rtol * self.iterates[0][0]))
-            self._state = None
-            self._set_state(self.x)  # the search at the free iterate
+            self._set_state(self.x)  # the free iterate's search (its last residual's)
             shifted = []
             for c in pairs:
                 deepest = self.comm.allreduce(c.normal.deepest_overlap(c.projection), MPI.MAX)
@@ -893,7 +892,6 @@ class NewtonSolver:
                 free.copy(self.x)
         finally:
             free.destroy()
-            self._state = None
 
     def _closed_newton(self, pairs: list) -> tuple[int, int]:
         """A closing iterate on ``pairs``, then Newton: converged reason and iterations

@@ -107,8 +107,7 @@ class NormalLaw:
     def deepest_overlap(self, proj: Projection) -> float:
         """The largest proximity ``g`` (overlap with the master) of this rank's paired
         points (0 if none overlaps)."""
-        gap = proj.gap[proj.facet >= 0]
-        return float(max(gap.max(initial=0.0), 0.0))
+        return float(proj.gap[proj.facet >= 0].max(initial=0.0))
 
     def nearest_open_gap(self, proj: Projection) -> float:
         """The smallest distance from the master surface of this rank's open points that have

@@ -812,14 +812,13 @@ static void make_patch(int kind, const double *X, patch_t *P)
 /* x - y(xi) */
 INLINE void patch_residual(const patch_t *P, const double *x, const double *xi, double *r)
 {
-    const double s = xi[0], t = xi[1], S[3] = {1.0, s, s * s}, T[3] = {1.0, t, t * t};
+    const double s = xi[0], t = xi[1], t2 = t * t, S[3] = {1.0, s, s * s};
     for (int k = 0; k < 3; k++) {
         double v = 0.0;
         for (int p = 0; p < 3; p++)
-            v += S[p] * (P->C[p][0][k] + t * P->C[p][1][k] + T[2] * P->C[p][2][k]);
+            v += S[p] * (P->C[p][0][k] + t * P->C[p][1][k] + t2 * P->C[p][2][k]);
         r[k] = x[k] - v;
     }
-    (void)T;
 }
 
 /* x - y, the tangents a and the Hessian H of |x - y|^2 / 2 (and the metric gm) at xi
