@@ -17,6 +17,7 @@ from conftest import assert_taylor_slopes
 from mpi4py import MPI
 from test_self_contact import _slot_scene
 
+from contact_ufl.contact import curved
 from contact_ufl.contact.interface import ContactInterface
 from contact_ufl.contact.obstacles import RigidPlane
 from contact_ufl.contact.projection import closest_points, shape_functions
@@ -111,6 +112,37 @@ def test_closest_point_on_quadratic_facets(kind):
         N = shape_functions(nodes.shape[1], gdim, xis)[0]
         y = np.einsum("pn,pnd->pd", N, nodes[rows])
         assert np.allclose(y, np.array([p.y[0] for p in proj]), atol=1e-14)
+
+
+@pytest.mark.parametrize("search", ["compiled", "numpy"])
+def test_restart_finds_the_interior_minimum_the_first_newton_misses(search, monkeypatch):
+    """A point farther than a fifth of a saddle-shaped 9-node facet's radius of curvature:
+    Newton from the centre settles at a minimum of the facet's extension outside it, and a
+    restart finds the interior minimum, which is the closest point (brute force) and closer
+    than every edge."""
+    monkeypatch.setenv("CONTACT_UFL_SEARCH", search)
+    nodes = np.array(
+        [
+            [[0.052, 0.012, -0.095], [1.002, -0.03, 0.057], [-0.008, 0.997, 0.103]],
+            [[0.981, 0.971, -0.12], [0.495, -0.024, -0.089], [0.978, 0.523, -0.095]],
+            [[0.486, 1.023, 0.113], [0.038, 0.542, -0.026], [0.515, 0.459, -0.135]],
+        ]
+    ).reshape(1, 9, 3)
+    x = np.array([[0.914, 0.623, 0.671]])
+    kind = "quadrilateral9"
+    xi0, dist0, good0, settled0 = curved._newton(kind, x, nodes, np.full((1, 2), 0.5))
+    assert settled0[0] and not good0[0] and np.any(xi0 > 1.0)
+    assert dist0[0] * curved.curvature(kind, nodes)[0] > curved.RESTART_CURVATURE
+    edges = [
+        curved.curve_closest(x, *nodes[0, list(e)][:, None])[1][0]
+        for e in curved.QUADRILATERAL9_EDGES
+    ]
+    proj = closest_points(x, nodes)
+    assert np.all((proj.xi > 0.0) & (proj.xi < 1.0))
+    assert proj.distance[0] < min(edges) - 1e-3
+    s, t = np.meshgrid(np.linspace(0, 1, 401), np.linspace(0, 1, 401))
+    brute = sampled_distance(x, nodes, np.stack([s.ravel(), t.ravel()], axis=1))[0]
+    assert brute - 2.0 / 400 <= proj.distance[0] <= brute + 1e-12
 
 
 @pytest.mark.parametrize("kind", ["segment3", "triangle6", "quadrilateral9"])

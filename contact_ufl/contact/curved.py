@@ -13,9 +13,10 @@ them for the quadratic kinds:
   the chord, compared with the two end points;
 * :func:`triangle_interior`: an interior stationary point of ``|x - y(xi)|^2`` on a 6-node
   triangle (Newton from the projection on the plane of the vertices, restarted from the
-  centroid), to be compared with the closest points on the three curved edges;
-  :func:`quadrilateral_interior` likewise on a 9-node quadrilateral (the facet of a
-  quadratic hexahedron; Newton from the centre, restarted from four other points);
+  centroid where it may have missed an interior minimum: :func:`_restart`), to be compared
+  with the closest points on the three curved edges; :func:`quadrilateral_interior`
+  likewise on a 9-node quadrilateral (the facet of a quadratic hexahedron; Newton from the
+  centre, restarted from up to four other points);
 * :func:`bernstein_hull`: the Bernstein control points of a quadratic facet: the facet lies
   in their convex hull (the Bernstein weights are non-negative and sum to one), which is what
   the distance bounds of the candidate search need (a quadratic facet is *not* in the convex
@@ -35,6 +36,12 @@ FloatArray = npt.NDArray[np.float64]
 
 _ITERATIONS = 25
 _TOL = 1e-13  # on the reference-coordinate step
+
+#: Newton settled outside a facet is restarted from other points (an interior minimum may
+#: remain) only where the point is farther than this fraction of the facet's radius of
+#: curvature (:func:`curvature`): nearer, the facet would have to fold for the distance to
+#: have a second minimum on it.
+RESTART_CURVATURE = 0.2
 
 #: The edges of a 6-node triangle: start vertex, end vertex, midpoint node (node order
 #: ``v0, v1, v2, m01, m12, m02``), in the order of the straight triangle's edges.
@@ -190,16 +197,20 @@ def quadrilateral_interior(
 ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]:
     """Interior local minima of ``|x - y(xi)|^2`` on 9-node quadrilaterals ``nodes (P, 9,
     3)``, as :func:`triangle_interior`: Newton from the centre, restarted from four other
-    points where it does not converge inside."""
+    points in turn while the last one calls for it (:func:`_restart`)."""
     kind = "quadrilateral9"
-    xi, dist, good = _newton(kind, x, nodes, np.full((len(x), 2), 0.5))
+    xi, dist, good, settled = _newton(kind, x, nodes, np.full((len(x), 2), 0.5))
+    again = _restart(kind, nodes, dist, good, settled)
     for start in ((0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)):
-        redo = np.flatnonzero(~good)
+        redo = np.flatnonzero(again)
         if redo.size == 0:
             break
-        xi_r, dist_r, good_r = _newton(kind, x[redo], nodes[redo], np.tile(start, (redo.size, 1)))
+        xi_r, dist_r, good_r, settled_r = _newton(
+            kind, x[redo], nodes[redo], np.tile(start, (redo.size, 1))
+        )
         take = redo[good_r]
         xi[take], dist[take], good[take] = xi_r[good_r], dist_r[good_r], True
+        again[redo] = _restart(kind, nodes[redo], dist_r, good_r, settled_r)
     return xi, dist, good
 
 
@@ -209,7 +220,10 @@ def triangle_interior(
     """Interior local minima of ``|x - y(xi)|^2`` on 6-node triangles ``nodes (P, 6, 3)``.
 
     Newton on ``xi`` from the projection on the plane of the vertices (clamped into the
-    triangle), restarted from the centroid where it does not converge inside: the Hessian
+    triangle), restarted from the centroid where it does not settle at a strict local
+    minimum, or settles outside the triangle at a distance over :data:`RESTART_CURVATURE`
+    times its radius of curvature (nearer, the closest point is on an edge, which the
+    caller projects): the Hessian
     ``a_a . a_b - (x - y) . y_,ab`` (the metric where that is not positive definite), steps
     halved while the distance grows. Returns ``xi (P, 2)``, the distance, and whether ``xi``
     is a strict interior minimum (converged, inside, positive definite Hessian).
@@ -227,10 +241,10 @@ def triangle_interior(
         start[ok] = np.linalg.solve(G[ok], rhs[ok][:, :, None])[:, :, 0]
     start = np.clip(start, 0.0, 1.0)
     start /= np.maximum(start.sum(axis=1), 1.0)[:, None]
-    xi, dist, good = _newton("triangle6", x, nodes, start)
-    redo = np.flatnonzero(~good)
+    xi, dist, good, settled = _newton("triangle6", x, nodes, start)
+    redo = np.flatnonzero(_restart("triangle6", nodes, dist, good, settled))
     if redo.size:
-        xi_r, dist_r, good_r = _newton(
+        xi_r, dist_r, good_r, _ = _newton(
             "triangle6", x[redo], nodes[redo], np.full((redo.size, 2), 1.0 / 3.0)
         )
         take = redo[good_r]
@@ -238,9 +252,38 @@ def triangle_interior(
     return xi, dist, good
 
 
+def _restart(kind, nodes, dist, good, settled):
+    """Whether Newton's result calls for a restart: not an interior minimum, and either not
+    settled or settled at a distance over :data:`RESTART_CURVATURE` times the facet's radius
+    of curvature (:func:`curvature`)."""
+    far = dist * curvature(kind, nodes) > RESTART_CURVATURE
+    return ~good & (~settled | far)
+
+
+def curvature(kind: str, nodes: FloatArray) -> FloatArray:
+    """A curvature scale of quadratic facets ``nodes (P, nn, 3)`` of two reference
+    dimensions: ``8 |delta| / L^2`` (that of a parabola of height ``|delta|`` over a chord
+    ``L``), with ``delta`` the largest offset of a midpoint node from its chord's midpoint
+    (of the centre node of a 9-node quadrilateral from the centre of the 8-node one through
+    its other nodes) and ``L`` the shortest edge chord."""
+    edges = CURVED_EDGES[kind]
+    offset2 = np.max([_sq(nodes[:, m] - 0.5 * (nodes[:, i] + nodes[:, j])) for i, j, m in edges], 0)
+    if kind == "quadrilateral9":
+        serendipity = 0.5 * nodes[:, 4:8].sum(axis=1) - 0.25 * nodes[:, :4].sum(axis=1)
+        offset2 = np.maximum(offset2, _sq(nodes[:, 8] - serendipity))
+    chord2 = np.min([_sq(nodes[:, j] - nodes[:, i]) for i, j, _ in edges], axis=0)
+    return 8.0 * np.sqrt(offset2) / chord2
+
+
+def _sq(v: FloatArray) -> FloatArray:
+    return v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2]
+
+
 def _newton(kind, x, nodes, xi):
     """Newton iterations of :func:`triangle_interior` (:func:`quadrilateral_interior`)
-    from ``xi``."""
+    from ``xi``: ``xi``, the distance, whether ``xi`` is a strict interior local minimum and
+    whether it is a strict local minimum of the facet's extension (converged, positive
+    definite Hessian: *settled*, inside the facet or not)."""
     xi = xi.copy()
     conv = np.zeros(len(x), dtype=bool)
     act = np.arange(len(x))
@@ -285,7 +328,7 @@ def _newton(kind, x, nodes, xi):
     inside = (xi[:, 0] > 0.0) & (xi[:, 1] > 0.0)
     inside &= (xi.sum(axis=1) < 1.0) if kind == "triangle6" else np.all(xi < 1.0, axis=1)
     pd = (H[:, 0, 0] > 0) & (H[:, 0, 0] * H[:, 1, 1] - H[:, 0, 1] * H[:, 1, 0] > 0)
-    return xi, np.sqrt(_dot(r, r)), conv & inside & pd
+    return xi, np.sqrt(_dot(r, r)), conv & pd & inside, conv & pd
 
 
 def _state(kind, x, nodes, xi):

@@ -57,6 +57,7 @@ static node_t *rows(const void *buffer)
 #define LEAF 4
 #define NEWTON_ITERATIONS 25
 #define NEWTON_TOL 1e-13
+#define RESTART_CURVATURE 0.2 /* curved.RESTART_CURVATURE */
 #define STACK 512
 #ifndef LANES
 #define LANES 4 /* points walked at a time (by turns) */
@@ -853,9 +854,11 @@ INLINE void patch_state(const patch_t *P, const double *x, const double *xi, dou
         }
 }
 
-/* curved._newton for one pair from xi (in/out): returns the distance; *good whether xi is a
- * strict interior minimum (converged, inside, positive definite Hessian). */
-static double curved_newton(int kind, const patch_t *P, const double *x, double *xi, int *good)
+/* curved._newton for one pair from xi (in/out): returns the distance; *settled whether xi is
+ * a strict local minimum (converged, positive definite Hessian), *good whether it is one
+ * inside the facet. */
+static double curved_newton(int kind, const patch_t *P, const double *x, double *xi, int *good,
+                            int *settled)
 {
     double r[3], a[2][3], H[2][2], gm[2][2], rn[3];
     int conv = 0;
@@ -892,12 +895,58 @@ static double curved_newton(int kind, const patch_t *P, const double *x, double 
     int inside = xi[0] > 0.0 && xi[1] > 0.0
                  && (kind == 4 ? xi[0] + xi[1] < 1.0 : xi[0] < 1.0 && xi[1] < 1.0);
     int pd = H[0][0] > 0 && H[0][0] * H[1][1] - H[0][1] * H[1][0] > 0;
-    *good = conv && inside && pd;
+    *settled = conv && pd;
+    *good = *settled && inside;
     return sqrt(dot3(r, r));
 }
 
+/* The largest squared distance of the points P[m] of the ne edges (i, j, m) of E from the
+ * midpoints of the chords X[i] X[j] (3D). */
+INLINE double largest_offset(int ne, const int (*E)[3], const double *P, const double *X)
+{
+    double largest = 0.0;
+    for (int e = 0; e < ne; e++) {
+        double d[3];
+        for (int k = 0; k < 3; k++)
+            d[k] = P[3 * E[e][2] + k] - 0.5 * (X[3 * E[e][0] + k] + X[3 * E[e][1] + k]);
+        double d2 = dot3(d, d);
+        largest = d2 > largest ? d2 : largest;
+    }
+    return largest;
+}
+
+/* curved.curvature of the quadratic facet X (kind 4 or 5): 8 |delta| / L^2 */
+static double curvature(int kind, const double *X)
+{
+    const int ne = kind == 4 ? 3 : 4;
+    const int(*E)[3] = kind == 4 ? TRI6_EDGES : QUAD9_EDGES;
+    double offset2 = largest_offset(ne, E, X, X), chord2 = INFINITY;
+    for (int e = 0; e < ne; e++) {
+        double d[3];
+        for (int k = 0; k < 3; k++) d[k] = X[3 * E[e][1] + k] - X[3 * E[e][0] + k];
+        double d2 = dot3(d, d);
+        chord2 = d2 < chord2 ? d2 : chord2;
+    }
+    if (kind == 5) { /* the centre node from the 8-node quadrilateral's centre */
+        double d[3];
+        for (int k = 0; k < 3; k++)
+            d[k] = X[24 + k] - (0.5 * (X[12 + k] + X[15 + k] + X[18 + k] + X[21 + k])
+                                - 0.25 * (X[k] + X[3 + k] + X[6 + k] + X[9 + k]));
+        double d2 = dot3(d, d);
+        offset2 = d2 > offset2 ? d2 : offset2;
+    }
+    return 8.0 * sqrt(offset2) / chord2;
+}
+
+/* curved._restart: whether a Newton result (distance dist) calls for a restart */
+INLINE int restart(int kind, const double *X, double dist, int good, int settled)
+{
+    return !good && (!settled || dist * curvature(kind, X) > RESTART_CURVATURE);
+}
+
 /* curved.triangle_interior for one pair: Newton from the projection on the plane of the
- * vertices (clamped into the triangle), restarted from the centroid. */
+ * vertices (clamped into the triangle), restarted from the centroid where it may have
+ * missed an interior minimum (restart). */
 static double triangle6_interior(const double *X, const double *x, double *xi, int *good)
 {
     double a1[3], a2[3], r[3];
@@ -911,11 +960,12 @@ static double triangle6_interior(const double *X, const double *x, double *xi, i
     }
     patch_t P;
     make_patch(4, X, &P);
-    double dist = curved_newton(4, &P, x, xi, good);
-    if (!*good) {
+    int settled;
+    double dist = curved_newton(4, &P, x, xi, good, &settled);
+    if (restart(4, X, dist, *good, settled)) {
         double xr[2] = {1.0 / 3.0, 1.0 / 3.0};
         int good_r;
-        double dist_r = curved_newton(4, &P, x, xr, &good_r);
+        double dist_r = curved_newton(4, &P, x, xr, &good_r, &settled);
         if (good_r) {
             xi[0] = xr[0], xi[1] = xr[1], dist = dist_r, *good = 1;
         }
@@ -924,21 +974,24 @@ static double triangle6_interior(const double *X, const double *x, double *xi, i
 }
 
 /* curved.quadrilateral_interior for one pair: Newton from the centre, restarted from four
- * other points. */
+ * other points in turn while the last result calls for it (restart). */
 static double quadrilateral9_interior(const double *X, const double *x, double *xi, int *good)
 {
     static const double starts[4][2] = {{0.25, 0.25}, {0.75, 0.25}, {0.25, 0.75}, {0.75, 0.75}};
     patch_t P;
     make_patch(5, X, &P);
     xi[0] = xi[1] = 0.5;
-    double dist = curved_newton(5, &P, x, xi, good);
-    for (int j = 0; j < 4 && !*good; j++) {
+    int settled;
+    double dist = curved_newton(5, &P, x, xi, good, &settled);
+    int again = restart(5, X, dist, *good, settled);
+    for (int j = 0; j < 4 && again; j++) {
         double xr[2] = {starts[j][0], starts[j][1]};
         int good_r;
-        double dist_r = curved_newton(5, &P, x, xr, &good_r);
+        double dist_r = curved_newton(5, &P, x, xr, &good_r, &settled);
         if (good_r) {
             xi[0] = xr[0], xi[1] = xr[1], dist = dist_r, *good = 1;
         }
+        again = restart(5, X, dist_r, good_r, settled);
     }
     return dist;
 }
@@ -963,22 +1016,24 @@ static void quadratic(int kind, const double *X, const double *x, pair_t *out)
     double d_in = kind == 4 ? triangle6_interior(X, x, xi, &good)
                             : quadrilateral9_interior(X, x, xi, &good);
     /* The interior minimum wins unless an edge is at most as close (the order of
-     * _project_quadratic: the edges' best, replaced by the interior where strictly closer).
-     * An edge whose distance is certainly above d_in cannot change the result and is not
-     * projected: the curve y = chord + 4 u (1 - u) delta is within |delta| of its chord,
-     * so its distance is at least the chord's minus |delta| (margin far above round-off). */
+     * _project_quadratic: the edges' best in their order, ties to the first, replaced by the
+     * interior where strictly closer). An edge whose distance is certainly above d_in, or
+     * above the best edge so far, cannot change the result and is not projected: the curve
+     * y = chord + 4 u (1 - u) delta is within |delta| of its chord, so its distance is at
+     * least the chord's minus |delta| (margin far above round-off). */
     double best_d = INFINITY, best_u = 0.0;
     int best_k = -1;
     for (int n = 0; n < ne; n++) {
         const double *A = X + 3 * E[n][0], *B = X + 3 * E[n][1], *C = X + 3 * E[n][2];
-        if (good) {
+        if (good || best_k >= 0) {
             double delta[3], chord[3];
             for (int k = 0; k < 3; k++) {
                 delta[k] = C[k] - 0.5 * (A[k] + B[k]);
                 chord[k] = B[k] - A[k];
             }
             double lower = segment_distance(3, x, A, B) - sqrt(dot3(delta, delta));
-            if (lower > d_in + 1e-10 * (d_in + sqrt(dot3(chord, chord)))) continue;
+            double bar = good && d_in < best_d ? d_in : best_d;
+            if (lower > bar + 1e-10 * (bar + sqrt(dot3(chord, chord)))) continue;
         }
         double u, d = curve_closest(3, x, A, B, C, &u);
         if (best_k < 0 || d < best_d) {
@@ -1015,21 +1070,6 @@ static void quadratic(int kind, const double *X, const double *x, pair_t *out)
  *   those of the bilinear patch: the corners, the edges' chord midpoints, the corners'
  *   mean), so it is within max |H - P|; the bilinear patch is within |c3| / 4 of the two
  *   triangles (s t c3, (1 - s)(1 - t) c3 at most a quarter, c3 = x0 - x1 - x2 + x3). */
-/* The largest squared distance of the points P[m] of the ne edges (i, j, m) of E from the
- * midpoints of the chords X[i] X[j] (3D). */
-INLINE double largest_offset(int ne, const int (*E)[3], const double *P, const double *X)
-{
-    double largest = 0.0;
-    for (int e = 0; e < ne; e++) {
-        double d[3];
-        for (int k = 0; k < 3; k++)
-            d[k] = P[3 * E[e][2] + k] - 0.5 * (X[3 * E[e][0] + k] + X[3 * E[e][1] + k]);
-        double d2 = dot3(d, d);
-        largest = d2 > largest ? d2 : largest;
-    }
-    return largest;
-}
-
 INLINE void chord_bounds(int kind, const double *X, const double *x, double *lower,
                          double *upper)
 {
