@@ -265,7 +265,7 @@ def test_a_pairing_within_the_solver_pattern_keeps_the_analysis(monkeypatch):
         solver = problem.solver
         # Newton from the open state, its many pairings (the first contact's predictor
         # iterate starts from about the final zone and meets fewer)
-        solver.first_contact_fraction = None
+        solver.first_contact_level = None
         if grow_always:
             monkeypatch.setattr(solver, "_within_solver_pattern", lambda keys: False)
         add, missing = solver._add_gathered_blocks, []

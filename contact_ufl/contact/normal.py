@@ -109,6 +109,14 @@ class NormalLaw:
         points (0 if none overlaps)."""
         return float(proj.gap[proj.facet >= 0].max(initial=0.0))
 
+    def overlap_moments(self, proj: Projection, weights: np.ndarray) -> np.ndarray:
+        """``[sum w g, sum w]`` over this rank's paired points that overlap the master
+        (``g > 0``), ``weights`` their measures: the mean overlap is the first over the
+        second."""
+        g = np.where(proj.facet >= 0, proj.gap, 0.0)
+        over = g > 0.0
+        return np.array([np.dot(weights[over], g[over]), weights[over].sum()])
+
     def nearest_open_gap(self, proj: Projection) -> float:
         """The smallest distance from the master surface of this rank's open points that have
         a master facet (``inf`` if none): how far the nearest open point is from touching."""

@@ -291,6 +291,25 @@ class SlaveSurface:
         total, count = comm.allreduce(np.array([diameters.sum(), len(diameters)]), MPI.SUM)
         return float(total / count)
 
+    @functools.cached_property
+    def point_weights(self) -> np.ndarray:
+        """The reference measure of each owned slave point, ``(ncells * nq,)``: the rule's
+        weights times the measure of the straight cell through the vertices of the point's
+        facet over that of the reference cell (exact on flat facets)."""
+        gdim = self.V.mesh.geometry.dim
+        nodes = self.submesh.geometry.dofmaps[0][: self.num_cells]
+        x = self.submesh.geometry.x[nodes, :gdim]  # the vertices come first
+        if self.submesh.topology.dim == 1:
+            measure = np.linalg.norm(x[:, 1] - x[:, 0], axis=-1)
+        else:  # half the cross product of the edges (triangle) or diagonals (quadrilateral)
+            if self.submesh.basix_cell() == basix.CellType.quadrilateral:
+                a, b = x[:, 3] - x[:, 0], x[:, 2] - x[:, 1]
+            else:
+                a, b = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
+            measure = 0.5 * np.linalg.norm(np.cross(a, b), axis=-1)
+        reference = self.weights_ref.sum()  # the reference cell's measure
+        return (measure[:, None] * self.weights_ref[None, :] / reference).ravel()
+
     # -- data at the slave points: quadrature elements on the submesh -------------------
     def point_space(self, shape: tuple[int, ...]) -> dolfinx.fem.FunctionSpace:
         """A space of values of ``shape`` at the slave quadrature points (quadrature element)."""
