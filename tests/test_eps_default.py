@@ -54,7 +54,7 @@ def test_default_eps_gives_the_same_solution():
     assert np.isfinite(F1) and F1 > 0
 
 
-def linear_hertz(h_contact: float, eps_N: float | None = None):
+def linear_hertz_scene(h_contact: float, eps_N: float | None = None):
     """The 2D Hertz scene with a linear elastic bulk and ``eps_N`` (``None``: the default)."""
     scene = scenes.hertz_2d(h_contact=h_contact, depth=0.02).scene
     scene.bodies = [
@@ -62,7 +62,12 @@ def linear_hertz(h_contact: float, eps_N: float | None = None):
         for b in scene.bodies
     ]
     scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=eps_N)
-    return solved(scene)
+    return scene
+
+
+def linear_hertz(h_contact: float, eps_N: float | None = None):
+    """:func:`linear_hertz_scene` solved in one load step."""
+    return solved(linear_hertz_scene(h_contact, eps_N))
 
 
 @pytest.mark.serial
@@ -93,14 +98,10 @@ def first_contact(dim: int, h_contact: float, level) -> ContactProblem:
     """Hertz (linear elastic in 2D, the default eps, one load step) with the solver's
     ``first_contact_level`` (``None``: no predictor iterate)."""
     if dim == 2:
-        scene = scenes.hertz_2d(h_contact=h_contact, depth=0.02).scene
-        scene.bodies = [
-            dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
-            for b in scene.bodies
-        ]
+        scene = linear_hertz_scene(h_contact)
     else:
         scene = scenes.hertz_3d(h_contact=h_contact, depth=0.01).scene
-    scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=None)
+        scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=None)
     problem = ContactProblem(scene, verbose=False)
     problem.solver.first_contact_level = level
     problem.solve(num_steps=1)

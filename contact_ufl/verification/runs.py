@@ -276,17 +276,10 @@ def coulomb_ratio_3d(history: list[dict], window: tuple[float, float] = (1.5, 1.
 
 
 def slave_point_weights(problem, pair: int = 0) -> np.ndarray:
-    """Quadrature weights (reference area) of the slave points of all ranks, in the order of
-    :func:`~contact_ufl.results.contact_samples`: the reference rule's weights times twice
-    the area of each (flat, triangular) slave facet."""
-    slave = problem.contacts[pair].slave
-    nc = slave.num_cells
-    gdim = problem.V.mesh.geometry.dim
-    nodes = slave.submesh.geometry.dofmaps[0][:nc, :3]
-    v = slave.submesh.geometry.x[nodes, :gdim]  # (nc, 3, gdim)
-    area = 0.5 * np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=-1)
-    weights = (2.0 * area[:, None] * slave.weights_ref[None, :]).ravel()
-    return np.concatenate(problem.comm.allgather(weights))
+    """Quadrature weights (reference measure) of the slave points of all ranks, in the order
+    of :func:`~contact_ufl.results.contact_samples`: each rank's
+    :attr:`~contact_ufl.contact.slave.SlaveSurface.point_weights`."""
+    return np.concatenate(problem.comm.allgather(problem.contacts[pair].slave.point_weights))
 
 
 def hertz_3d_errors(problem, hertz: scenes.Hertz3DScene, pair: int = 0) -> dict:
