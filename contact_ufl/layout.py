@@ -116,8 +116,8 @@ def chain_operator(
 
 
 def split_tangent(
-    forms: Sequence[Sequence[object | None]], fields: Sequence, unknowns: Sequence
-) -> tuple[list[list], list[list] | None, list[int]]:
+    forms: Sequence[Sequence[list]], fields: Sequence, unknowns: Sequence
+) -> tuple[list[list] | None, list[list] | None, list[int]]:
     """The blocks of a tangent over the fields split by what the chain rule does to them.
 
     ``T`` maps an unknown to its own field by the identity, so ``T^T K T`` holds the blocks
@@ -128,8 +128,9 @@ def split_tangent(
     Parameters
     ----------
     forms
-        The blocked tangent over ``fields`` (compiled forms or ``None``), rows and columns in
-        the order of ``fields``.
+        The blocked tangent over ``fields``, each block a list of parts (compiled forms, see
+        :mod:`contact_ufl.assembly`; empty: no block), rows and columns in the order of
+        ``fields``.
     fields, unknowns
         The assembled fields and the unknowns (a subsequence of the fields, in their order).
 
@@ -141,7 +142,7 @@ def split_tangent(
         of its own) or a row or column of either part would hold no block: then every block
         goes through the product.
     gathered_forms
-        The other blocks, over the coupled fields (``None`` where both are unknowns), or
+        The other blocks, over the coupled fields (empty where both are unknowns), or
         ``None`` where no block touches a gathered field.
     coupled
         Indices (in ``fields``) of the fields that those blocks couple, in order.
@@ -153,13 +154,9 @@ def split_tangent(
     if [id(fields[i]) for i in kept] != [id(f) for f in unknowns]:
         return None, *whole  # an unknown that is no field
     gathered = [
-        [forms[i][j] if i not in kept or j not in kept else None for j in range(n)]
-        for i in range(n)
+        [forms[i][j] if i not in kept or j not in kept else [] for j in range(n)] for i in range(n)
     ]
-    touches = [
-        any(f is not None for f in gathered[i]) or any(row[i] is not None for row in gathered)
-        for i in range(n)
-    ]
+    touches = [any(gathered[i]) or any(row[i] for row in gathered) for i in range(n)]
     coupled = [i for i in range(n) if touches[i]]
     unknown_forms = [[forms[i][j] for j in kept] for i in kept]
     if not coupled:
@@ -168,6 +165,6 @@ def split_tangent(
     # a blocked matrix needs a form in every row and column
     blocks = [*unknown_forms, *zip(*unknown_forms, strict=True)]
     blocks += [*gathered_forms, *zip(*gathered_forms, strict=True)]
-    if any(all(f is None for f in row) for row in blocks):
+    if not all(any(row) for row in blocks):
         return None, *whole
     return unknown_forms, gathered_forms, coupled

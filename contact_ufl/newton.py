@@ -29,7 +29,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from contact_ufl import free_bodies
+from contact_ufl import assembly, free_bodies
 from contact_ufl.layout import StackedLayout, chain_operator, split_tangent
 
 if TYPE_CHECKING:
@@ -252,12 +252,12 @@ class NewtonSolver:
         )
         self._A = None
         if self._unknown_forms is not None:
-            self._A = fem_petsc.create_matrix(self._unknown_forms, kind="mpi")
-            fem_petsc.assemble_matrix(self._A, self._unknown_forms)  # its pattern (any values)
+            self._A = assembly.create_matrix(self._unknown_forms)
+            assembly.assemble_matrix(self._A, self._unknown_forms)  # its pattern (any values)
             self._A.assemble()
         self._K = self._coupled_layout = None
         if self._gathered_forms is not None:
-            self._K = fem_petsc.create_matrix(self._gathered_forms, kind="mpi")
+            self._K = assembly.create_matrix(self._gathered_forms)
             self._coupled_layout = StackedLayout(
                 [problem.fields[i].function_space for i in self._coupled]
             )
@@ -474,7 +474,8 @@ class NewtonSolver:
         Parameters
         ----------
         forms
-            Compiled blocked linear forms over the problem's fields.
+            A compiled blocked linear form over the problem's fields, each block a list of
+            parts (:mod:`contact_ufl.assembly`).
         out
             The result (default: a new vector of the unknowns).
         """
@@ -482,7 +483,7 @@ class NewtonSolver:
         r = self._r
         with r.localForm() as r_local:
             r_local.set(0.0)
-        fem_petsc.assemble_vector(r, forms)
+        assembly.assemble_vector(r, forms)
         r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         self._T.multTranspose(r, out)
         return out
@@ -535,7 +536,7 @@ class NewtonSolver:
         K = self._K
         if K is not None:
             K.zeroEntries()
-            fem_petsc.assemble_matrix(K, self._gathered_forms)
+            assembly.assemble_matrix(K, self._gathered_forms)
             K.assemble()
         assembled = time.perf_counter()
         if K is not None:
@@ -558,7 +559,7 @@ class NewtonSolver:
         """The tangent's blocks between unknowns, straight into ``J`` (its values zeroed)."""
         J.zeroEntries()
         if self._A is not None:
-            fem_petsc.assemble_matrix(J, self._unknown_forms)
+            assembly.assemble_matrix(J, self._unknown_forms)
             J.assemble()
 
     def _add_gathered_blocks(self, J: PETSc.Mat) -> None:

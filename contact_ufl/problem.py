@@ -12,6 +12,8 @@ convenience), and the results that need the chain rule (:meth:`ContactProblem.re
 
 from __future__ import annotations
 
+import functools
+import operator
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
@@ -61,15 +63,18 @@ def softer_modulus(parts: list[Domain], pair: ContactPair) -> float:
     return min(moduli) if moduli else float("nan")
 
 
-def _nonempty(form: ufl.Form) -> ufl.Form | None:
-    form = ufl.algorithms.expand_derivatives(form)
+def _derivative(form: ufl.Form, field: dolfinx.fem.Function) -> ufl.Form | None:
+    """The Gateaux derivative of ``form`` in the direction of a trial function of ``field``'s
+    space, ``None`` where it is empty."""
+    form = ufl.algorithms.expand_derivatives(
+        ufl.derivative(form, field, ufl.TrialFunction(field.function_space))
+    )
     return None if form.empty() else form
 
 
-def _zero_form(v: ufl.Argument, dx: ufl.Measure) -> ufl.Form:
-    """A zero linear form in ``v`` (an empty block of a blocked form)."""
-    component = v[0] if v.ufl_shape else v
-    return dolfinx.fem.Constant(v.ufl_function_space().mesh, 0.0) * component * dx
+def _summed(forms: list[ufl.Form]) -> list[ufl.Form]:
+    """The sum of ``forms`` as the one part of a block, or no part."""
+    return [functools.reduce(operator.add, forms)] if forms else []
 
 
 class ContactProblem:
@@ -120,7 +125,8 @@ class ContactProblem:
         Numbering of the unknowns and of the assembled fields.
     residual_form, jacobian_form
         The compiled blocked residual (rows: ``fields``) and Jacobian (``fields`` x
-        ``fields``).
+        ``fields``), each block a list of parts (:mod:`contact_ufl.assembly`): the bulk's,
+        then the contact terms.
     dirichlet_rows
         Local (owned) indices of the prescribed displacement dofs (unrolled) in a vector of
         the unknowns, then of the multipliers held at zero because the slave's displacement
@@ -235,50 +241,56 @@ class ContactProblem:
 
     # -- forms ------------------------------------------------------------------------
     def _build_forms(self) -> None:
+        # each block a list of parts compiled apart (contact_ufl.assembly): the bulk's, then
+        # the contact terms on the slave surfaces of its mesh
         tests = [ufl.TestFunction(b.V) for b in self.bulks]
-        residuals = [b.residual(v) for b, v in zip(self.bulks, tests, strict=True)]
-        # the contact terms alone (a zero form where a block has none: a blocked form needs
-        # every block)
-        contact_residuals = [_zero_form(v, b.dx) for b, v in zip(self.bulks, tests, strict=True)]
-        fields = [b.u for b in self.bulks]
-        unknowns = list(fields)
+        bulk = [b.residual(v) for b, v in zip(self.bulks, tests, strict=True)]
         for control in self.controls:
             k = self.bulks.index(control.bulk)
-            residuals[k] = residuals[k] - control.bulk_residual(tests[k])
-        tangent_extra = {}
+            bulk[k] = bulk[k] - control.bulk_residual(tests[k])
+        on_slave = [[] for _ in self.bulks]  # contact terms of each mesh's displacement rows
+        on_slave_tangent = [[] for _ in self.bulks]  # with the terms only the tangent sees
+        own, own_tangent = [], []  # residuals of the contact fields (and controls)
+        fields = [b.u for b in self.bulks]
+        unknowns = list(fields)
         for c in self.contacts:
             k = c.pair.slave_domain
-            Fu_c, F_fields = c.residuals(tests[k])
-            extra = c.tangent_residuals(tests[k])
-            if extra is not None:
-                tangent_extra[k] = tangent_extra.get(k, 0) + extra[0]
-                for j, form in enumerate(extra[1]):
-                    tangent_extra[len(residuals) + j] = form
-            residuals[k] = residuals[k] + Fu_c
-            contact_residuals[k] = contact_residuals[k] + Fu_c
-            residuals += F_fields
-            contact_residuals += F_fields
+            F_u, F_fields = c.residuals(tests[k])
+            # (ContactPair.geometric_traction: terms added for the tangent only)
+            extra_u, extra_fields = c.tangent_residuals(tests[k]) or (None, [])
+            on_slave[k].append(F_u)
+            on_slave_tangent[k].append(F_u if extra_u is None else F_u + extra_u)
+            own += F_fields
+            own_tangent += [F + e for F, e in zip(F_fields, extra_fields, strict=False)]
+            own_tangent += F_fields[len(extra_fields) :]
             fields += c.fields
             unknowns += c.unknowns
+        contact_rows = len(own)  # rows of the contact fields
         for control in self.controls:
-            residuals += control.residuals()
-            contact_residuals += [_zero_form(ufl.TestFunction(control.P), control.bulk.dx)]
+            F_control = control.residuals()
+            own += F_control
+            own_tangent += F_control
             fields += control.fields
             unknowns += control.unknowns
             control.block = len(unknowns) - 1
         self.fields, self.unknowns = fields, unknowns
-        # the residuals the tangent is taken from: with the terms only the tangent sees
-        # (ContactPair.geometric_traction)
-        tangent = [
-            r + tangent_extra[i] if i in tangent_extra else r for i, r in enumerate(residuals)
-        ]
+        residuals = [[F, *_summed(on)] for F, on in zip(bulk, on_slave, strict=True)]
+        residuals += [[F] for F in own]
+        tangent = [[F, *_summed(on)] for F, on in zip(bulk, on_slave_tangent, strict=True)]
+        tangent += [[F] for F in own_tangent]
         jacobian = [
-            [_nonempty(ufl.derivative(Fi, f, ufl.TrialFunction(f.function_space))) for f in fields]
-            for Fi in tangent
-        ]
+            [
+                [d for part in row if (d := _derivative(part, f)) is not None]
+                for f in fields
+            ]
+            for row in tangent
+        ]  # fmt: skip
         entity_maps = [c.slave.entity_map for c in self.contacts]
         self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
-        self._contact_residual_ufl = contact_residuals
+        # the contact terms alone
+        self._contact_residual_ufl = [_summed(on) for on in on_slave]
+        self._contact_residual_ufl += [[F] for F in own[:contact_rows]]
+        self._contact_residual_ufl += [[] for _ in own[contact_rows:]]
         self._contact_residual_form = None
         self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
         self.full_layout = StackedLayout([f.function_space for f in fields])

@@ -358,8 +358,9 @@ def test_unknown_blocks_assembled_straight_give_the_chain_rule_tangent(mu):
     """The solver matrix holds the tangent's blocks between unknowns assembled straight and
     the gathered blocks' ``T^T K T``: it equals ``T^T K T`` of the whole tangent over the
     fields (the chain rule the solver used before the split), with and without friction."""
-    import dolfinx.fem.petsc as fem_petsc
     from petsc4py import PETSc
+
+    from contact_ufl import assembly
 
     problem = ContactProblem(
         scenes.hertz_2d(h_contact=0.02, depth=0.01, mu=mu).scene, verbose=False
@@ -368,7 +369,8 @@ def test_unknown_blocks_assembled_straight_give_the_chain_rule_tangent(mu):
     solver = problem.solver
     assert solver._A is not None and solver._K is not None  # the split is in use
     J = solver.evaluate_jacobian(solver.x)
-    K = fem_petsc.assemble_matrix(problem.jacobian_form, kind="mpi")
+    K = assembly.create_matrix(problem.jacobian_form)
+    assembly.assemble_matrix(K, problem.jacobian_form)
     K.assemble()
     whole = K.PtAP(solver._T)
     solver._zero_dirichlet_rows(whole)

@@ -1,0 +1,104 @@
+"""Blocks as sums of forms compiled apart (``contact_ufl.assembly``): the same vectors and
+matrices as DOLFINx's blocked assembly of the summed forms, and no contact data packed on the
+bulk's cells."""
+
+import dolfinx
+import dolfinx.fem.petsc as fem_petsc
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from contact_ufl import assembly
+from contact_ufl.problem import ContactProblem
+from contact_ufl.verification import scenes
+
+
+@pytest.fixture(scope="module")
+def two_fields():
+    """A vector field on a mesh and a scalar field on its boundary, with a cell part and a
+    boundary part in the first block, coupled on the boundary (as displacements and a
+    multiplier on the slave submesh)."""
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 6, 5)
+    mesh.topology.create_connectivity(1, 2)
+    facets = dolfinx.mesh.exterior_facet_indices(mesh.topology)
+    submesh, entity_map = dolfinx.mesh.create_submesh(mesh, 1, facets)[:2]
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 2, (2,)))
+    Q = dolfinx.fem.functionspace(submesh, ("Lagrange", 1))
+    u, lam = dolfinx.fem.Function(V), dolfinx.fem.Function(Q)
+    u.interpolate(lambda x: np.stack([np.sin(3 * x[0]) * x[1], x[0] ** 2 + x[1]]))
+    lam.interpolate(lambda x: 1.0 + x[0] - 2 * x[1] ** 2)
+    v, q = ufl.TestFunction(V), ufl.TestFunction(Q)
+    tags = dolfinx.mesh.meshtags(mesh, 1, facets, np.full(len(facets), 3, dtype=np.int32))
+    ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags, subdomain_id=3)
+    x = ufl.SpatialCoordinate(mesh)
+    F_cell = ufl.inner(ufl.grad(u) + ufl.grad(u).T * (1 + u[0] ** 2), ufl.grad(v)) * ufl.dx
+    F_facet = lam * ufl.dot(u + x, v) * ds
+    G = (lam - ufl.dot(u, u)) * q * ds
+    fields = [u, lam]
+
+    def derivative(F, f):
+        return ufl.derivative(F, f, ufl.TrialFunction(f.function_space))
+
+    parts = [[F_cell, F_facet], [G]]
+    blocks = [[[derivative(P, f) for P in row] for f in fields] for row in parts]
+    blocks[1][1] = [derivative(G, lam)]
+    blocks[0][1] = [derivative(F_facet, lam)]
+    maps = [entity_map]
+    whole_residual = dolfinx.fem.form([F_cell + F_facet, G], entity_maps=maps)
+    whole_tangent = [[sum(b[1:], b[0]) for b in row] for row in blocks]
+    whole_tangent = dolfinx.fem.form(whole_tangent, entity_maps=maps)
+    return (
+        dolfinx.fem.form(parts, entity_maps=maps),
+        dolfinx.fem.form(blocks, entity_maps=maps),
+        whole_residual,
+        whole_tangent,
+        [V, Q],
+    )
+
+
+def test_parts_add_up_to_the_summed_blocks(two_fields):
+    parts, blocks, whole_residual, whole_tangent, spaces = two_fields
+    b = fem_petsc.create_vector(spaces, kind="mpi")
+    b.set(0.0)
+    assembly.assemble_vector(b, parts)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    reference = fem_petsc.assemble_vector(whole_residual, kind="mpi")
+    reference.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    assert reference.norm() > 1.0
+    assert np.allclose(b.array_r, reference.array_r, rtol=1e-13, atol=1e-13 * reference.norm())
+
+    A = assembly.create_matrix(blocks)
+    assembly.assemble_matrix(A, blocks)
+    A.assemble()
+    K = fem_petsc.assemble_matrix(whole_tangent, kind="mpi")
+    K.assemble()
+    assert K.norm() > 1.0
+    K.axpy(-1.0, A, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    assert K.norm() <= 1e-13 * A.norm()
+
+
+def test_a_part_outside_the_first_parts_cells_is_refused(two_fields):
+    """The sparsity of a block is its first part's: a later part over cells the first does
+    not cover is refused (DOLFINx's matrices would drop its values silently)."""
+    _, blocks, *_ = two_fields
+    swapped = [[list(reversed(blocks[0][0])), blocks[0][1]], [blocks[1][0], blocks[1][1]]]
+    with pytest.raises(ValueError, match=r"block \(0, 0\): a part integrates over cells"):
+        assembly.create_matrix(swapped)
+
+
+def test_the_bulk_cells_pack_no_contact_data():
+    """The cell integrals of the displacement rows pack the bulk's coefficients only, not
+    the contact's point data on the slave surface (zeros on every cell), and the contact
+    terms are a part of their own."""
+    hertz = scenes.hertz_2d(h_contact=0.05, depth=0.01)
+    problem = ContactProblem(hertz.scene, verbose=False)
+    bulk = problem.bulks[0]
+    alone = dolfinx.fem.form(bulk.residual(ufl.TestFunction(bulk.V)))
+    width = {k: c.shape[1] for k, c in dolfinx.fem.pack_coefficients(alone).items()}
+    first, *contact = problem.residual_form[0]
+    packed = dolfinx.fem.pack_coefficients(first)
+    assert {k: c.shape[1] for k, c in packed.items()} == width
+    assert len(contact) == 1
+    assert set(contact[0].integral_types) == {dolfinx.fem.IntegralType.exterior_facet}
