@@ -15,7 +15,7 @@ from __future__ import annotations
 import functools
 import operator
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import dolfinx
 import numpy as np
@@ -70,6 +70,15 @@ def _derivative(form: ufl.Form, field: dolfinx.fem.Function) -> ufl.Form | None:
         ufl.derivative(form, field, ufl.TrialFunction(field.function_space))
     )
     return None if form.empty() else form
+
+
+class _ContactTerms(NamedTuple):
+    """The contact terms of a problem's pairs (UFL forms)."""
+
+    on_slave: list[list[ufl.Form]]  #: on the displacement rows of each mesh
+    on_slave_tangent: list[list[ufl.Form]]  #: the same with the terms only the tangent sees
+    own: list[ufl.Form]  #: the residuals of the pairs' fields, in their order
+    own_tangent: list[ufl.Form]  #: the same with the terms only the tangent sees
 
 
 def _summed(forms: list[ufl.Form]) -> list[ufl.Form]:
@@ -248,53 +257,48 @@ class ContactProblem:
         for control in self.controls:
             k = self.bulks.index(control.bulk)
             bulk[k] = bulk[k] - control.bulk_residual(tests[k])
-        on_slave = [[] for _ in self.bulks]  # contact terms of each mesh's displacement rows
-        on_slave_tangent = [[] for _ in self.bulks]  # with the terms only the tangent sees
-        own, own_tangent = [], []  # residuals of the contact fields (and controls)
-        fields = [b.u for b in self.bulks]
-        unknowns = list(fields)
-        for c in self.contacts:
-            k = c.pair.slave_domain
-            F_u, F_fields = c.residuals(tests[k])
-            # (ContactPair.geometric_traction: terms added for the tangent only)
-            extra_u, extra_fields = c.tangent_residuals(tests[k]) or (None, [])
-            on_slave[k].append(F_u)
-            on_slave_tangent[k].append(F_u if extra_u is None else F_u + extra_u)
-            own += F_fields
-            own_tangent += [F + e for F, e in zip(F_fields, extra_fields, strict=False)]
-            own_tangent += F_fields[len(extra_fields) :]
-            fields += c.fields
-            unknowns += c.unknowns
-        contact_rows = len(own)  # rows of the contact fields
+        terms = self._contact_terms(tests)
+        controls = [F for control in self.controls for F in control.residuals()]
+        fields = [b.u for b in self.bulks] + [f for c in self.contacts for f in c.fields]
+        unknowns = [b.u for b in self.bulks] + [f for c in self.contacts for f in c.unknowns]
         for control in self.controls:
-            F_control = control.residuals()
-            own += F_control
-            own_tangent += F_control
             fields += control.fields
             unknowns += control.unknowns
             control.block = len(unknowns) - 1
         self.fields, self.unknowns = fields, unknowns
-        residuals = [[F, *_summed(on)] for F, on in zip(bulk, on_slave, strict=True)]
-        residuals += [[F] for F in own]
-        tangent = [[F, *_summed(on)] for F, on in zip(bulk, on_slave_tangent, strict=True)]
-        tangent += [[F] for F in own_tangent]
+        residuals = [[F, *_summed(on)] for F, on in zip(bulk, terms.on_slave, strict=True)]
+        residuals += [[F] for F in terms.own + controls]
+        tangent = [[F, *_summed(on)] for F, on in zip(bulk, terms.on_slave_tangent, strict=True)]
+        tangent += [[F] for F in terms.own_tangent + controls]
         jacobian = [
-            [
-                [d for part in row if (d := _derivative(part, f)) is not None]
-                for f in fields
-            ]
+            [[d for part in row if (d := _derivative(part, f)) is not None] for f in fields]
             for row in tangent
-        ]  # fmt: skip
+        ]
         entity_maps = [c.slave.entity_map for c in self.contacts]
         self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
         # the contact terms alone
-        self._contact_residual_ufl = [_summed(on) for on in on_slave]
-        self._contact_residual_ufl += [[F] for F in own[:contact_rows]]
-        self._contact_residual_ufl += [[] for _ in own[contact_rows:]]
+        self._contact_residual_ufl = [_summed(on) for on in terms.on_slave]
+        self._contact_residual_ufl += [[F] for F in terms.own] + [[] for _ in controls]
         self._contact_residual_form = None
         self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
         self.full_layout = StackedLayout([f.function_space for f in fields])
         self.layout = StackedLayout([f.function_space for f in unknowns])
+
+    def _contact_terms(self, tests: list[ufl.Argument]) -> _ContactTerms:
+        """The contact terms of the pairs: on the displacement rows of each mesh, and the
+        residuals of the pairs' fields, with the terms only the tangent sees
+        (:attr:`ContactPair.geometric_traction <contact_ufl.contact.pair.ContactPair>`)."""
+        terms = _ContactTerms([[] for _ in self.bulks], [[] for _ in self.bulks], [], [])
+        for c in self.contacts:
+            k = c.pair.slave_domain
+            F_u, F_fields = c.residuals(tests[k])
+            extra_u, extra_fields = c.tangent_residuals(tests[k]) or (None, [])
+            terms.on_slave[k].append(F_u)
+            terms.on_slave_tangent[k].append(F_u if extra_u is None else F_u + extra_u)
+            terms.own.extend(F_fields)
+            terms.own_tangent.extend(F + e for F, e in zip(F_fields, extra_fields, strict=False))
+            terms.own_tangent.extend(F_fields[len(extra_fields) :])
+        return terms
 
     def _build_dirichlet(self) -> None:
         # prescribed-displacement equations k (u - g) = 0 are scaled by a stiffness k = E L^(d-2)
