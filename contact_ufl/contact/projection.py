@@ -600,23 +600,26 @@ class _Hierarchy:
             self.lib.same_values(nodes.size, *p(nodes, self.fitted_nodes))
         )
 
-    def refit(self, nodes: FloatArray) -> None:
+    def refit(self, nodes: FloatArray) -> float:
         """The boxes, largest facet radius and leaf-ordered nodes of the current ``nodes``
-        (C-contiguous); a ``ValueError`` if a coordinate is not finite."""
+        (C-contiguous), in one pass with the copy of the nodes and their largest coordinate
+        change since the last refit, which it returns (meaningless after none); a
+        ``ValueError`` if a coordinate is not finite."""
         nf, nn, g = nodes.shape
         p = self._pointers
+        change = np.zeros(1)
         self.is_fitted = False
         R_max = float(
             self.lib.bvh_refit(
                 g, nn, nf, *p(nodes, self.perm), self.m,
-                *p(self.a, self.b, self.tree, self.leaf_nodes),
+                *p(self.a, self.b, self.tree, self.leaf_nodes, self.fitted_nodes, change),
             )
         )  # fmt: skip
         if R_max == -2.0:
             raise ValueError(non_finite("the master nodes", nodes))
         self.R_max = R_max
-        np.copyto(self.fitted_nodes, nodes)
         self.is_fitted = True
+        return float(change[0])
 
     def order(self, points: FloatArray) -> IntArray:
         """An order of the points along a Z-order (Morton) curve through the cells of a
@@ -1067,23 +1070,19 @@ class TreeCache:
         keeps the nodes of its last refit only)."""
         key = (*nodes.shape, "hierarchy")
         entry = self.entries.get(key)
-        tree = None
         if entry is not None:
             tree = entry[1]
             if tree.fitted(nodes):  # the master has not moved since the last search
                 self.entries.move_to_end(key)
                 return tree
             if tree.is_fitted:
-                tree.moved += tree.lib.largest_change(
-                    nodes.size, _ptr(tree, nodes), _ptr(tree, tree.fitted_nodes)
-                ) * np.sqrt(nodes.shape[2])
-            if tree.is_fitted and tree.moved <= _MOVE * tree.R_max:
-                self.entries.move_to_end(key)
-            else:
-                tree = None
-        if tree is None:
-            tree = _Hierarchy(nodes)
-            self._keep(key, None, tree)
+                R_max = tree.R_max
+                tree.moved += tree.refit(nodes) * np.sqrt(nodes.shape[2])
+                if tree.moved <= _MOVE * R_max:
+                    self.entries.move_to_end(key)
+                    return tree
+        tree = _Hierarchy(nodes)
+        self._keep(key, None, tree)
         tree.refit(nodes)
         return tree
 

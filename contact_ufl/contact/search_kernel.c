@@ -153,9 +153,10 @@ typedef struct {
     const double *nodes; /* (n, nn, g) as given */
     const i64 *perm, *a, *b;
     double *leaf_nodes; /* (n, nn, g) in the order of perm */
+    double *fitted;     /* (n, nn, g) as given: the nodes of the last refit, then these */
     node_t *T;
     i64 used; /* rows written */
-    double r2max, finite;
+    double r2max, finite, change;
 } fit_t;
 
 /* The facet kind of nn nodes in g dimensions (projection._COMPILED_KINDS), -1 if none. */
@@ -197,19 +198,24 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box)
 {
     const int g = F->g, nn = F->nn, w = nn * g;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double r2max = F->r2max, zero = 0.0;
+    double r2max = F->r2max, zero = 0.0, change = F->change;
     i64 start = -F->a[i] - 1;
     for (i64 j = start; j < start + F->b[i]; j++) {
         const double *X = F->nodes + F->perm[j] * w;
-        double *Y = F->leaf_nodes + j * w, c[3];
+        double *Y = F->leaf_nodes + j * w, *Z = F->fitted + F->perm[j] * w, c[3];
         for (int q = 0; q < w; q++) {
-            Y[q] = X[q];
+            double d = fabs(X[q] - Z[q]);
+            change = d > change ? d : change;
+            Z[q] = Y[q] = X[q];
             zero += 0.0 * X[q]; /* stays 0 unless a coordinate is NaN or infinite */
         }
         if (j + AHEAD < F->n) { /* the nodes of a facet a few leaves on: the gather's latency hidden */
             const double *next = F->nodes + F->perm[j + AHEAD] * w;
+            const double *last = F->fitted + F->perm[j + AHEAD] * w;
             PREFETCH(next);
             PREFETCH(next + w - 1);
+            PREFETCH(last);
+            PREFETCH(last + w - 1);
         }
         double H[27];
         const double *P = hull(F->kind, g, X, H);
@@ -230,6 +236,7 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box)
         }
     }
     F->r2max = r2max;
+    F->change = change;
     F->finite += zero;
     for (int k = 0; k < g; k++) {
         box[k] = lo[k];
@@ -292,9 +299,11 @@ static i64 fit(fit_t *F, i64 i, double *box)
 }
 
 INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                    const i64 *a, const i64 *b, void *tree, double *leaf_nodes)
+                    const i64 *a, const i64 *b, void *tree, double *leaf_nodes, double *fitted,
+                    double *change)
 {
-    fit_t F = {kind_of(g, nn), g, nn, n, nodes, perm, a, b, leaf_nodes, rows(tree), 0, 0.0, 0.0};
+    fit_t F = {kind_of(g, nn), g, nn, n, nodes, perm, a, b, leaf_nodes, fitted, rows(tree), 0,
+               0.0, 0.0, 0.0};
     if (m > 0) {
         double B[6];
         i64 code = fit(&F, 0, B);
@@ -306,23 +315,27 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
             R->child[c] = EMPTY;
         }
     }
+    *change = F.change;
     return F.finite == 0.0 ? sqrt(F.r2max) : -2.0;
 }
 
 /* The tree over the current nodes (n, nn, g) of the facets: tree (a buffer of (m + 1)
  * sizeof(node_t) + 128 bytes) gets the rows of the walk (every facet point lies in the box of
  * its nodes' convex hull); leaf_nodes (n, nn, g) the nodes in the order of perm (the facets
- * of a leaf contiguous). Returns the largest facet radius (node distance from the mean of
- * the nodes), -1 for an unknown facet kind, -2 if a coordinate is not finite. */
+ * of a leaf contiguous); fitted (n, nn, g), the nodes of the last refit, these nodes, and
+ * change the largest coordinate change from the one to the other (one pass over the nodes
+ * for all three). Returns the largest facet radius (node distance from the mean of the
+ * nodes), -1 for an unknown facet kind, -2 if a coordinate is not finite. */
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, void *tree, double *leaf_nodes)
+                 const i64 *a, const i64 *b, void *tree, double *leaf_nodes, double *fitted,
+                 double *change)
 {
-    if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaf_nodes);
-    if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaf_nodes);
-    if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaf_nodes);
-    if (g == 2 && nn == 3) return refit(2, 3, n, nodes, perm, m, a, b, tree, leaf_nodes);
-    if (g == 3 && nn == 6) return refit(3, 6, n, nodes, perm, m, a, b, tree, leaf_nodes);
-    if (g == 3 && nn == 9) return refit(3, 9, n, nodes, perm, m, a, b, tree, leaf_nodes);
+    if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
+    if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
+    if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
+    if (g == 2 && nn == 3) return refit(2, 3, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
+    if (g == 3 && nn == 6) return refit(3, 6, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
+    if (g == 3 && nn == 9) return refit(3, 9, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
     return -1.0;
 }
 
@@ -401,17 +414,6 @@ int morton_order(int g, i64 n, const double *x, i64 *order)
     free(key);
     free(other);
     return 0;
-}
-
-/* The largest coordinate change between two node arrays of len values. */
-double largest_change(i64 len, const double *p, const double *q)
-{
-    double m = 0.0;
-    for (i64 i = 0; i < len; i++) {
-        double d = fabs(p[i] - q[i]);
-        if (d > m) m = d;
-    }
-    return m;
 }
 
 /* -- exact projections (the NumPy kernels' operations, in their order) ------------------- */
