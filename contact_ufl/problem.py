@@ -259,8 +259,9 @@ class ContactProblem:
             bulk[k] = bulk[k] - control.bulk_residual(tests[k])
         terms = self._contact_terms(tests)
         controls = [F for control in self.controls for F in control.residuals()]
-        fields = [b.u for b in self.bulks] + [f for c in self.contacts for f in c.fields]
-        unknowns = [b.u for b in self.bulks] + [f for c in self.contacts for f in c.unknowns]
+        displacements = [b.u for b in self.bulks]
+        fields = displacements + [f for c in self.contacts for f in c.fields]
+        unknowns = displacements + [f for c in self.contacts for f in c.unknowns]
         for control in self.controls:
             fields += control.fields
             unknowns += control.unknowns

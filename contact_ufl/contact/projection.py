@@ -1067,7 +1067,8 @@ class TreeCache:
         exact once refitted, and stays good while the facets barely moved; not refitted if
         no node moved since the last call), else a new one. The movement since the build is
         bounded by the sum of the largest movements from one refit to the next (the hierarchy
-        keeps the nodes of its last refit only)."""
+        keeps the nodes of its last refit only), each measured by the refit itself: a tree
+        found to have moved too far is refitted once more, then replaced."""
         key = (*nodes.shape, "hierarchy")
         entry = self.entries.get(key)
         if entry is not None:
