@@ -17,6 +17,7 @@ from test_search_exact import near_and_far
 
 from contact_ufl.contact import compiled, projection
 from contact_ufl.contact.projection import TreeCache, closest_points
+from contact_ufl.contact.search import ClosestPointSearch
 from contact_ufl.problem import ContactProblem
 from contact_ufl.verification import scenes
 
@@ -254,6 +255,34 @@ def test_non_finite_points_raised_on_every_rank():
         points = np.full((1, search.gdim), np.inf)
     with pytest.raises(ValueError, match=r"slave points .* non-finite.*first row 0 \(on rank 0\)"):
         search.exchange(search.master.X_nodes, points)
+
+
+@pytest.mark.parametrize("make", [scenes.hertz_2d, scenes.hertz_3d])
+def test_a_search_that_reuses_its_order_and_fans_pairs_as_a_new_one(make):
+    """The candidates' order and fans kept from one search to the next (the same
+    candidates) give the pairing of a new search; candidates in another order get their
+    own order and fans."""
+    problem = ContactProblem(make(depth=0.01).scene, verbose=False)
+    contact = problem.contacts[0]
+    search, layout, u = contact.kinematics.search, problem.full_layout, contact.u
+    search.pair(u, layout)
+    u.x.array[:] = -0.005 * u.function_space.tabulate_dof_coordinates()[:, : search.gdim].ravel()
+    kept = search.pair(u, layout)
+    assert search._order is not None and search._fans is not None
+    fresh = ClosestPointSearch(search.slave, search.master, search.radius, search.touching)
+    new = fresh.pair(u, layout)
+    for field in ("points", "nodes", "columns", "neighbourhood"):
+        np.testing.assert_array_equal(getattr(kept, field), getattr(new, field))
+    for field in ("facet", "xi", "y", "gap"):
+        np.testing.assert_array_equal(
+            getattr(kept.projection, field), getattr(new.projection, field)
+        )
+    assert MPI.COMM_WORLD.allreduce(np.count_nonzero(kept.paired), MPI.SUM) > 0
+    keys = search._order[0]
+    shuffled = keys[::-1].copy()
+    np.testing.assert_array_equal(shuffled[search.order(shuffled)], keys[search.order(keys)])
+    columns = search._fans[0]
+    np.testing.assert_array_equal(search.fans(columns[::-1].copy()), search.fans(columns)[::-1])
 
 
 def test_stale_kernels_are_removed(tmp_path):

@@ -111,6 +111,8 @@ class ClosestPointSearch:
         self.time = 0.0
         #: search trees of the master facets, reused from one search to the next
         self.trees = TreeCache()
+        self._order: tuple[np.ndarray, np.ndarray] | None = None
+        self._fans: tuple[np.ndarray, np.ndarray] | None = None
         # the compiled kernel on every rank now: a rank with no slave points never builds
         # it, so a build error would otherwise be raised on the searching ranks only
         if self.comm.allreduce(_compiled(master.nn, self.gdim), MPI.LOR):
@@ -128,7 +130,7 @@ class ClosestPointSearch:
         n = len(master_nodes)
         payload = np.zeros((n, 0)) if payload is None else payload
         if n:
-            lo, hi = master_nodes.min(axis=1), master_nodes.max(axis=1)
+            lo, hi = _node_bounds(master_nodes)
         problem = _non_finite(points, lo if n else None, hi if n else None)
         problem = None if problem is None else f"{problem} (on rank {comm.rank})"
         gathered = comm.allgather((box, problem))
@@ -147,6 +149,28 @@ class ClosestPointSearch:
         nodes = np.concatenate([r[0] for r in received]).reshape(-1, *master_nodes.shape[1:])
         data = np.concatenate([r[1] for r in received]).reshape(len(nodes), *payload.shape[1:])
         return nodes, data
+
+    def order(self, keys: np.ndarray) -> np.ndarray:
+        """The order of the received candidate facets by their vertex ``keys`` (a
+        rank-independent order: ties between equidistant facets break the same way on any
+        number of ranks); that of the last search while the keys are the same."""
+        if self._order is not None and np.array_equal(self._order[0], keys):
+            return self._order[1]
+        order = np.lexsort(keys.T[::-1])
+        self._order = (keys.copy(), order)
+        return order
+
+    def fans(self, columns: np.ndarray) -> np.ndarray:
+        """The fan columns (:func:`fan_columns`) of every candidate facet of the gathered
+        ``columns``: those of the last search while its candidates are the same (the same
+        columns in the same order, as on one rank and whenever the exchange sends the same
+        facets), else anew."""
+        if self._fans is not None and np.array_equal(self._fans[0], columns):
+            return self._fans[1]
+        nn = self.master.nn
+        fans = fan_columns(columns, nn, np.arange(len(columns)))
+        self._fans = (columns.copy(), fans)
+        return fans
 
     def check_facing(self, description: str) -> None:
         """Raise (on every rank) if no slave point faces the master surface in the reference
@@ -208,11 +232,13 @@ class ClosestPointSearch:
         payload = np.hstack([mine.columns, mine.keys, mine.boundary.astype(np.int64), mine.flags])
         nodes, payload = self.exchange(mine.nodes, points, payload)
         # candidates in a rank-independent order: ties between facets break the same way
-        order = np.lexsort(payload[:, nx : nx + nk].T[::-1])
+        order = self.order(payload[:, nx : nx + nk])
         nodes, payload = nodes[order], payload[order]
         columns = payload[:, :nx]
         boundary = payload[:, nx + nk : nx + nk + ne].astype(bool)
-        rule = self._self_contact(payload[:, nx : nx + nk], self.slave.current_normals(u))
+        rule = None
+        if self.self_contact:  # the current normals only where the rule needs them
+            rule = self._self_contact(payload[:, nx : nx + nk], self.slave.current_normals(u))
         proj = closest_points(points, nodes[:, :nn], self.radius, self.trees, rule)
         if rule is not None:
             release_beside_own_facet(proj, points, rule, self.touching)
@@ -236,11 +262,22 @@ class ClosestPointSearch:
         gathered[paired] = nodes[proj.facet[paired]]
         gather = np.full((npts, nx, gdim), -1, dtype=np.int64)
         gather[paired] = columns[proj.facet[paired]][:, :, None] + np.arange(gdim)
-        fans = fan_columns(columns, nn, proj.facet[paired])
+        fans = self.fans(columns)[proj.facet[paired]]
+        fans = fans[:, : np.count_nonzero(fans >= 0, axis=1).max(initial=0)]  # -1 padded
         neighbourhood = np.full((npts, fans.shape[1]), -1, dtype=np.int64)
         neighbourhood[paired] = fans
         self.time += time.perf_counter() - start
         return Pairing(points, proj, gathered, gather, flags, neighbourhood)
+
+
+def _node_bounds(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The smallest and largest coordinates of each facet's ``nodes`` ``(n, nn, gdim)``, a
+    node at a time (NumPy's reduction over the middle axis is several times slower)."""
+    lo, hi = nodes[:, 0].copy(), nodes[:, 0].copy()
+    for a in range(1, nodes.shape[1]):
+        np.minimum(lo, nodes[:, a], out=lo)
+        np.maximum(hi, nodes[:, a], out=hi)
+    return lo, hi
 
 
 def _non_finite(points: np.ndarray, lo: np.ndarray | None, hi: np.ndarray | None) -> str | None:
@@ -310,17 +347,15 @@ def release_beyond_boundary(
     ``boundary``: boundary-edge flags per candidate.
     """
     paired = np.flatnonzero(proj.facet >= 0)
+    paired = paired[boundary[proj.facet[paired]].any(axis=1)]  # on a facet at the boundary
     if len(paired) == 0:
         return
-    facet = proj.facet[paired]
     on_edge = on_edges(boundary.shape[1], proj.xi[paired])  # as many edges as nodes
-    at_boundary = (on_edge & boundary[facet]).any(axis=1)
+    paired = paired[(on_edge & boundary[proj.facet[paired]]).any(axis=1)]
     d = points[paired] - proj.y[paired]
     normal_part = np.einsum("pd,pd->p", d, proj.normal[paired])
     off_normal = np.linalg.norm(d - normal_part[:, None] * proj.normal[paired], axis=1)
-    beyond = (
-        at_boundary & (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > tolerance)
-    )
+    beyond = (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > tolerance)
     released = paired[beyond]
     proj.facet[released] = -1
     proj.gap[released] = -np.inf

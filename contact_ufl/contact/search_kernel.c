@@ -134,17 +134,30 @@ i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b)
     return count;
 }
 
+/* The next float towards -infinity from a finite f (nextafterf(f, -INFINITY), inline). */
+INLINE float below(float f)
+{
+    union {
+        float f;
+        uint32_t u;
+    } b = {f};
+    if (f == 0.0f) return -0x1p-149f; /* the smallest subnormal, negative */
+    b.u += f > 0.0f ? (uint32_t)-1 : 1u; /* one unit in the last place down */
+    return b.f;
+}
+
 INLINE float down(double v)
 {
     /* the largest float not above v */
     float f = (float)v;
-    return (double)f > v ? nextafterf(f, -INFINITY) : f;
+    return (double)f > v ? below(f) : f;
 }
 
 INLINE float up(double v)
 {
+    /* the smallest float not below v */
     float f = (float)v;
-    return (double)f < v ? nextafterf(f, INFINITY) : f;
+    return (double)f < v ? -below(-f) : f;
 }
 
 typedef struct {
@@ -156,7 +169,8 @@ typedef struct {
     double *fitted;     /* (n, nn, g) as given: the nodes of the last refit, then these */
     node_t *T;
     i64 used; /* rows written */
-    double r2max, finite, change;
+    double r2max, change;
+    int finite;
 } fit_t;
 
 /* The facet kind of nn nodes in g dimensions (projection._COMPILED_KINDS), -1 if none. */
@@ -194,11 +208,12 @@ INLINE const double *hull(int kind, int g, const double *X, double *H)
 
 /* The facets of a leaf copied in the order of perm, their box (lo, hi) (of their hull
  * points), and the largest facet radius and finiteness so far updated. */
-INLINE void fit_leaf(fit_t *F, i64 i, double *box)
+INLINE void fit_leaf(fit_t *F, i64 i, double *box, const int kind, const int g, const int nn)
 {
-    const int g = F->g, nn = F->nn, w = nn * g;
+    const int w = nn * g;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double r2max = F->r2max, zero = 0.0, change = F->change;
+    double r2max = F->r2max, change = F->change;
+    int finite = 1;
     i64 start = -F->a[i] - 1;
     for (i64 j = start; j < start + F->b[i]; j++) {
         const double *X = F->nodes + F->perm[j] * w;
@@ -207,7 +222,6 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box)
             double d = fabs(X[q] - Z[q]);
             change = d > change ? d : change;
             Z[q] = Y[q] = X[q];
-            zero += 0.0 * X[q]; /* stays 0 unless a coordinate is NaN or infinite */
         }
         if (j + AHEAD < F->n) { /* the nodes of a facet a few leaves on: the gather's latency hidden */
             const double *next = F->nodes + F->perm[j + AHEAD] * w;
@@ -218,16 +232,17 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box)
             PREFETCH(last + w - 1);
         }
         double H[27];
-        const double *P = hull(F->kind, g, X, H);
-        for (int k = 0; k < g; k++) {
+        const double *P = hull(kind, g, X, H);
+        for (int k = 0; k < g; k++) { /* nn times the centroid: no division */
             double s = P[k];
             for (int q = 1; q < nn; q++) s += P[q * g + k];
-            c[k] = s / nn;
+            c[k] = s;
+            finite &= isfinite(s); /* a NaN or infinite coordinate makes its sum so */
         }
         for (int q = 0; q < nn; q++) {
-            double d2 = 0.0;
+            double d2 = 0.0; /* nn^2 times the squared distance from the centroid */
             for (int k = 0; k < g; k++) {
-                double v = P[q * g + k], d = v - c[k];
+                double v = P[q * g + k], d = nn * v - c[k];
                 d2 += d * d;
                 lo[k] = v < lo[k] ? v : lo[k];
                 hi[k] = v > hi[k] ? v : hi[k];
@@ -235,9 +250,9 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box)
             r2max = d2 > r2max ? d2 : r2max;
         }
     }
-    F->r2max = r2max;
+    F->r2max = r2max; /* nn^2 times the largest squared facet radius */
     F->change = change;
-    F->finite += zero;
+    F->finite &= finite;
     for (int k = 0; k < g; k++) {
         box[k] = lo[k];
         box[g + k] = hi[k];
@@ -260,7 +275,14 @@ static i64 fit(fit_t *F, i64 i, double *box)
 {
     const int g = F->g;
     if (F->a[i] < 0) {
-        fit_leaf(F, i, box);
+        switch (F->kind) { /* the loops of each kind unrolled */
+        case 0: fit_leaf(F, i, box, 0, 2, 2); break;
+        case 1: fit_leaf(F, i, box, 1, 3, 3); break;
+        case 2: fit_leaf(F, i, box, 2, 3, 4); break;
+        case 3: fit_leaf(F, i, box, 3, 2, 3); break;
+        case 4: fit_leaf(F, i, box, 4, 3, 6); break;
+        default: fit_leaf(F, i, box, 5, 3, 9); break;
+        }
         return leaf_code(F, i);
     }
     i64 row = F->used++, grand[WIDE];
@@ -303,7 +325,7 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
                     double *change)
 {
     fit_t F = {kind_of(g, nn), g, nn, n, nodes, perm, a, b, leaf_nodes, fitted, rows(tree), 0,
-               0.0, 0.0, 0.0};
+               0.0, 0.0, 1};
     if (m > 0) {
         double B[6];
         i64 code = fit(&F, 0, B);
@@ -316,7 +338,7 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
         }
     }
     *change = F.change;
-    return F.finite == 0.0 ? sqrt(F.r2max) : -2.0;
+    return F.finite ? sqrt(F.r2max) / nn : -2.0;
 }
 
 /* The tree over the current nodes (n, nn, g) of the facets: tree (a buffer of (m + 1)
