@@ -284,7 +284,7 @@ def offset_points(gdim: int, npts: int, offset: float, rng: np.random.Generator)
     return np.stack([u[:, 0], u[:, 1], surface_3d(u[:, 0], u[:, 1]) + dz], axis=1)
 
 
-SWEEPS = ("graded", "self_contact", "radius", "distance", "points", "quadratic")
+SWEEPS = ("graded", "self_contact", "radius", "distance", "points", "quadratic", "scenes")
 
 MAKERS = {
     "segment": lambda nf, rng: segments(nf),
@@ -565,6 +565,92 @@ def points_sweep(nf: int, counts) -> list[dict]:
     return records
 
 
+#: the scenes of the ``"scenes"`` sweep: name, scene maker, its keywords, displacement degree
+SCENES = [
+    ("hertz_2d", "hertz_2d", {"h_contact": 0.005}, 1),
+    ("hertz_2d", "hertz_2d", {"h_contact": 0.00125}, 1),
+    ("hertz_3d", "hertz_3d", {"h_contact": 0.0125}, 1),
+    ("hertz_3d", "hertz_3d", {"h_contact": 0.00625}, 1),
+    ("hertz_3d", "hertz_3d", {"h_contact": 0.0045}, 1),
+    ("hertz_3d", "hertz_3d", {"h_contact": 0.05, "order": 2}, 2),
+    ("hertz_3d", "hertz_3d", {"h_contact": 0.025, "h_edge": 0.01, "order": 2}, 2),
+]
+
+
+def _moved_pairing(search, u, layout, x: np.ndarray, rng, total: list) -> Callable:
+    """A pairing of ``search`` after moving the displacement ``u`` to ``x`` plus up to 1e-6
+    (a moved master), its CPU seconds added to ``total[0]``."""
+
+    def call():
+        u.x.array[:] = x + 1e-6 * rng.random(len(x))
+        start = time.process_time()
+        pairing = search.pair(u, layout)
+        total[0] += time.process_time() - start
+        return pairing
+
+    return call
+
+
+def scene_sweep(quick: bool) -> list[dict]:
+    """The whole search of a contact pair as a Newton iteration calls it
+    (:meth:`~contact_ufl.contact.search.ClosestPointSearch.pair`: slave points, candidate
+    exchange and order, closest points, release at the master's boundary, gathered nodes and
+    columns) on the verification scenes, each call after a small displacement of both
+    bodies (a moved master: the tree refitted), against the part of it in
+    :func:`closest_points` (the kernel the other sweeps time)."""
+    from contact_ufl.contact import search as search_module
+    from contact_ufl.problem import ContactProblem
+    from contact_ufl.verification import scenes
+
+    records = []
+    print(f"{'scene':>9} {'p':>2} {'dofs':>7} {'points':>7} {'facets':>7} {'ms/call':>8} "
+          f"{'points/s':>9} {'kernel':>7}")  # fmt: skip
+    kernel = [0.0]
+
+    def timed(*args, **kwargs):
+        start = time.process_time()
+        out = closest_points(*args, **kwargs)
+        kernel[0] += time.process_time() - start
+        return out
+
+    search_module.closest_points = timed
+    rng = np.random.default_rng(0)
+    for name, maker, options, degree in SCENES[:3] if quick else SCENES:
+        problem = ContactProblem(getattr(scenes, maker)(**options).scene, degree=degree,
+                                 verbose=False)  # fmt: skip
+        contact = problem.contacts[0]
+        search, layout, u = contact.kinematics.search, problem.full_layout, contact.u
+        x = u.x.array.copy()
+        search.pair(u, layout)
+
+        total = [0.0]
+        kernel[0] = 0.0
+        wall, cpu, pairing = best_of(_moved_pairing(search, u, layout, x, rng, total))
+        npts = len(pairing.points)
+        record = {
+            "sweep": "scenes",
+            "scene": name,
+            **{k: v for k, v in options.items()},
+            "degree": degree,
+            "dofs": problem.layout.global_size,
+            "points": npts,
+            "master_facets": int(len(search.master.keys)),
+            "paired": int(np.count_nonzero(pairing.paired)),
+            "seconds": wall,
+            "cpu_seconds": cpu,
+            "cpu_points_per_s": npts / cpu,
+            "kernel_fraction": kernel[0] / total[0],
+        }
+        records.append(record)
+        print(
+            f"{name:>9} {degree:2d} {record['dofs']:7d} {npts:7d} {record['master_facets']:7d} "
+            f"{cpu * 1e3:8.2f} {npts / cpu:9.3g} {record['kernel_fraction']:7.2f}",
+            flush=True,
+        )
+    search_module.closest_points = closest_points
+    return records
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--json", required=True)
@@ -591,6 +677,7 @@ def main() -> None:
             100_000 if not args.quick else 10_000, npts, (0.1, 1.0, 10.0, 50.0), (2.0, 10.0, np.inf)
         ),
         "points": lambda: points_sweep(largest, counts),
+        "scenes": lambda: scene_sweep(args.quick),
         "quadratic": lambda: radius_sweep(
             sizes[:3], npts, (1.0, np.inf), QUADRATIC_MAKERS, "quadratic"
         ),

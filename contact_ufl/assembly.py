@@ -25,6 +25,8 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from contact_ufl import keysets
+
 Parts = Sequence[dolfinx.fem.Form]
 
 
@@ -118,7 +120,7 @@ def _cells(form: dolfinx.fem.Form) -> np.ndarray:
                 # (cell, local index) pairs, two of them for an interior facet
                 entities = entities.reshape(len(entities), -1)[:, 0::2]
             cells.append(entities.ravel())
-    return np.unique(np.concatenate(cells))
+    return keysets.unique(np.concatenate(cells))
 
 
 def _index_sets(lines: Sequence[Sequence[Parts]], side: int) -> list[PETSc.IS]:

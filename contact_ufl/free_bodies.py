@@ -33,6 +33,8 @@ import dolfinx
 import numpy as np
 from mpi4py import MPI
 
+from contact_ufl import keysets
+
 if TYPE_CHECKING:
     from contact_ufl.bulk import Bulk
     from contact_ufl.problem import ContactProblem
@@ -146,7 +148,7 @@ def pieces(problem: ContactProblem) -> list[Piece]:
     out = []
     for k, bulk in enumerate(problem.bulks):
         dofs = bulk.V.dofmap.list
-        blocks = [np.unique(dofs[bulk.domain.cell_tags.find(b.tag)].ravel()) for b in bulk.bodies]
+        blocks = [keysets.unique(dofs[bulk.domain.cell_tags.find(b.tag)]) for b in bulk.bodies]
         for nodes in _merged(bulk.V.dofmap.index_map, blocks, problem.comm):
             held = bulk.prescribed_components[nodes].any(axis=0).astype(int)
             free = problem.comm.allreduce(held, MPI.SUM) == 0

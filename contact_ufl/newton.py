@@ -29,7 +29,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from contact_ufl import assembly, free_bodies
+from contact_ufl import assembly, free_bodies, keysets
 from contact_ufl.layout import StackedLayout, chain_operator, split_tangent
 
 if TYPE_CHECKING:
@@ -154,7 +154,9 @@ def _nonzero_keys(M: PETSc.Mat | None) -> np.ndarray:
     offsets, columns, _ = M.getValuesCSR()
     start = M.getOwnershipRange()[0]
     rows = np.repeat(np.arange(start, start + len(offsets) - 1, dtype=np.int64), np.diff(offsets))
-    return np.unique(rows * M.getSize()[1] + columns)
+    keys = rows * M.getSize()[1] + columns
+    # an AIJ row holds its columns sorted: the keys are a set already
+    return keys if keysets.is_strictly_increasing(keys) else keysets.unique(keys)
 
 
 class NewtonSolver:
@@ -406,7 +408,7 @@ class NewtonSolver:
                 cols = cols[:, None] if cols.ndim == 1 else cols
                 rows = start + np.arange(len(cols))[:, None]
                 keys.append((rows * n + cols)[cols >= 0])
-        return np.unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
+        return keysets.unique(np.concatenate(keys)) if keys else np.zeros(0, np.int64)
 
     def _widen(self) -> None:
         """Where the current pairing's ``T`` is not within the solver matrix's pattern (or
@@ -435,7 +437,7 @@ class NewtonSolver:
         self._wide_current = keys
         self._wide_now = len(keys)
         old = self._wide_keys
-        self._wide_keys = keys if old is None else np.union1d(old, keys)
+        self._wide_keys = keys if old is None else keysets.union(old, keys)
         self._grow = True
 
     def _chain_operator(self, gathers: list[list], rows: list[int] | None = None) -> PETSc.Mat:
@@ -600,7 +602,7 @@ class NewtonSolver:
             J.zeroEntries()
             if pattern is not None:
                 J.axpy(1.0, pattern, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            self._product_keys = np.union1d(self._product_keys, keys)
+            self._product_keys = keysets.union(self._product_keys, keys)
         if pattern is not None and not tangent:
             pattern.destroy()
         if self._A is not None:  # the maps of the unknowns' blocks' assembly into J

@@ -41,6 +41,7 @@ import scipy.sparse
 import scipy.sparse.csgraph
 from mpi4py import MPI
 
+from contact_ufl import keysets
 from contact_ufl.errors import collective_check
 
 __all__ = ["PARTITIONS", "body_partitioner", "cell_partitioner", "surface_cells"]
@@ -233,7 +234,7 @@ def _destinations(
     coo = adjacency.tocoo()
     rows, ranks = coo.row.astype(np.int64), owner[coo.col].astype(np.int64)
     other = ranks != owner[rows]
-    keys = np.unique(rows[other] * nparts + ranks[other])
+    keys = keysets.unique(rows[other] * nparts + ranks[other])
     ghost_rows, ghost_ranks = keys // nparts, keys % nparts
     counts = 1 + np.bincount(ghost_rows, minlength=n)
     offsets = np.concatenate([[0], np.cumsum(counts)])

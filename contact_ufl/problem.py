@@ -23,6 +23,7 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from contact_ufl import keysets
 from contact_ufl.bulk import Bulk
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
@@ -456,7 +457,7 @@ class ContactProblem:
         local = np.zeros(self.gdim)
         for k, blocks in nodes.items():
             values = R.array[self.block_rows(k)].reshape(-1, self.gdim)
-            local += values[np.unique(np.concatenate(blocks))].sum(axis=0)
+            local += values[keysets.unique(np.concatenate(blocks))].sum(axis=0)
         return self.comm.allreduce(local, MPI.SUM)
 
     def obstacle_reaction(self, obstacle: RigidObstacle) -> np.ndarray:

@@ -11,6 +11,8 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from contact_ufl import keysets
+
 
 @dataclass
 class ContactSamples:
@@ -107,7 +109,7 @@ def body_resultants(problem, vector) -> dict[int, np.ndarray]:
         for body in bulk.bodies:
             if body.tag in out:
                 raise ValueError(f"two bodies have the cell tag {body.tag} (on two meshes)")
-            blocks = np.unique(V.dofmap.list[bulk.domain.cell_tags.find(body.tag)])
+            blocks = keysets.unique(V.dofmap.list[bulk.domain.cell_tags.find(body.tag)])
             blocks = blocks[blocks < owned]
             local = values[blocks].sum(axis=0) if len(blocks) else np.zeros(problem.gdim)
             out[body.tag] = problem.comm.allreduce(local, MPI.SUM)

@@ -30,6 +30,7 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
+from contact_ufl import keysets
 from contact_ufl.contact.facets import (
     FACET_EDGES,
     basix_cell,
@@ -378,7 +379,7 @@ def node_fans(
     _, has_before = find_before(node * span + after)
     by_node = np.lexsort((after_key, has_before, node))
     start = by_node[np.searchsorted(node[by_node], fan_nodes)]
-    wanted = np.unique(global_nodes.astype(np.int64))
+    wanted = keysets.unique(global_nodes.astype(np.int64))
     index = np.searchsorted(fan_nodes, wanted)
     slots = np.repeat(wanted[:, None], K + 1, axis=1)
     if len(wanted):

@@ -66,6 +66,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
+from contact_ufl import keysets
 from contact_ufl.contact import compiled
 from contact_ufl.contact.curved import (
     CURVED_EDGES,
@@ -1586,7 +1587,7 @@ def _search_compiled(
     pid = rows if order is None else order[rows]
     # the selection over the facets met only (their data computed as _Master does)
     facets, local = np.unique(fid, return_inverse=True)
-    tied = np.unique(pid)
+    tied = keysets.unique(pid)
     part = Projection(*(getattr(out, k)[tied] for k in _FIELDS))
     _select(_Facets(nodes[facets]), points[tied], radius, part, np.searchsorted(tied, pid),
             local, pairs)  # fmt: skip

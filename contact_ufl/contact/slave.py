@@ -28,6 +28,7 @@ import ufl
 from mpi4py import MPI
 from scipy.spatial import cKDTree
 
+from contact_ufl import keysets
 from contact_ufl.contact.facets import (
     basix_cell,
     coordinate_element,
@@ -403,7 +404,7 @@ class SlaveSurface:
         owned = self.multiplier_space.dofmap.index_map.size_local
         gdim = self.V.mesh.geometry.dim
         nodes = self.multiplier_space.tabulate_dof_coordinates()[:owned, :gdim]
-        blocks = np.unique(self._cell_dofs)
+        blocks = keysets.unique(self._cell_dofs)
         coords = self.V.tabulate_dof_coordinates()[blocks, :gdim]
         scale = self.facet_size  # (collective)
         found = np.full(owned, -1, dtype=np.int64)
