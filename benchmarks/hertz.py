@@ -265,7 +265,7 @@ def main_3d(args) -> None:
     else:
         meshes = QUICK_3D_P2 if args.quick else FULL_3D_P2
     if args.h:
-        meshes = [(h, None) for h in args.h]
+        meshes = [(h, args.h_edge) for h in args.h]
     for h, h_edge in meshes:
         r = run_3d(
             h,
@@ -308,7 +308,10 @@ def main() -> None:
         "--order", type=int, choices=(1, 2), default=None, help="2D: of the geometry (= degree)"
     )
     parser.add_argument(
-        "--h", type=float, nargs="+", default=None, help="h_contact list (3D: no h_edge)"
+        "--h", type=float, nargs="+", default=None, help="h_contact list (3D: see --h-edge)"
+    )
+    parser.add_argument(
+        "--h-edge", type=float, default=None, help="3D with --h: the size at the contact edge"
     )
     parser.add_argument("--subdivisions", type=int, default=1, help="2D: contact quadrature")
     parser.add_argument(
