@@ -69,11 +69,20 @@ def create_matrix(blocks: Sequence[Sequence[Parts]]) -> PETSc.Mat:
     )
 
 
-def assemble_matrix(A: PETSc.Mat, blocks: Sequence[Sequence[Parts]]) -> PETSc.Mat:
+def assemble_matrix(
+    A: PETSc.Mat,
+    blocks: Sequence[Sequence[Parts]],
+    layout: Sequence[Sequence[Parts]] | None = None,
+) -> PETSc.Mat:
     """Add the parts of each block into its block of ``A`` (a matrix of
-    :func:`create_matrix`); not finally assembled (``A.assemble()``)."""
-    rows = _index_sets(blocks, 0)
-    columns = _index_sets([list(column) for column in zip(*blocks, strict=True)], 1)
+    :func:`create_matrix`); not finally assembled (``A.assemble()``).
+
+    ``layout``: the blocked form whose first parts give the spaces of ``A``'s rows and
+    columns (by default ``blocks``; needed where a row or column of ``blocks`` is empty).
+    """
+    layout = blocks if layout is None else layout
+    rows = _index_sets(layout, 0)
+    columns = _index_sets([list(column) for column in zip(*layout, strict=True)], 1)
     for i, row in enumerate(blocks):
         for j, parts in enumerate(row):
             if not parts:
@@ -90,6 +99,22 @@ def assemble_matrix(A: PETSc.Mat, blocks: Sequence[Sequence[Parts]]) -> PETSc.Ma
                 )
             A.restoreLocalSubMatrix(rows[i], columns[j], local)
     return A
+
+
+def split_constant(
+    blocks: Sequence[Sequence[Parts]],
+) -> tuple[list[list[Parts]], list[list[Parts]]]:
+    """The parts of a blocked bilinear form that depend on no coefficient and no constant
+    (their values are fixed by the mesh: a small-strain linear-elastic bulk's stiffness),
+    and the others, each in the blocks' layout (empty where none)."""
+
+    def constant(form: dolfinx.fem.Form) -> bool:
+        f = form._cpp_object
+        return not f.coefficients and not f.constants
+
+    fixed = [[[p for p in parts if constant(p)] for parts in row] for row in blocks]
+    varying = [[[p for p in parts if not constant(p)] for parts in row] for row in blocks]
+    return fixed, varying
 
 
 def _check_within_first(parts: Parts, block: tuple[int, int]) -> None:

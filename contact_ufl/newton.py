@@ -253,10 +253,18 @@ class NewtonSolver:
             problem.jacobian_form, problem.fields, problem.unknowns
         )
         self._A = None
+        # the parts of those blocks fixed by the mesh (a linear-elastic bulk's stiffness):
+        # assembled once a load step into B (A's pattern), added to every tangent of the step
+        self._B = self._varying_forms = self._fixed_forms = None
+        self._B_stale = True
         if self._unknown_forms is not None:
             self._A = assembly.create_matrix(self._unknown_forms)
             assembly.assemble_matrix(self._A, self._unknown_forms)  # its pattern (any values)
             self._A.assemble()
+            fixed, self._varying_forms = assembly.split_constant(self._unknown_forms)
+            if any(parts for row in fixed for parts in row):
+                self._B = self._A.duplicate()  # zero values
+                self._fixed_forms = fixed
         self._K = self._coupled_layout = None
         if self._gathered_forms is not None:
             self._K = assembly.create_matrix(self._gathered_forms)
@@ -558,11 +566,21 @@ class NewtonSolver:
         return J
 
     def _assemble_unknown_blocks(self, J: PETSc.Mat) -> None:
-        """The tangent's blocks between unknowns, straight into ``J`` (its values zeroed)."""
+        """The tangent's blocks between unknowns, straight into ``J`` (its values zeroed):
+        the fixed parts' ``B`` (assembled on the first tangent of a load step), then the
+        others."""
         J.zeroEntries()
-        if self._A is not None:
-            assembly.assemble_matrix(J, self._unknown_forms)
-            J.assemble()
+        if self._A is None:
+            return
+        if self._B is not None:
+            if self._B_stale:
+                self._B.zeroEntries()
+                assembly.assemble_matrix(self._B, self._fixed_forms, self._unknown_forms)
+                self._B.assemble()
+                self._B_stale = False
+            J.axpy(1.0, self._B, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        assembly.assemble_matrix(J, self._varying_forms, self._unknown_forms)
+        J.assemble()
 
     def _add_gathered_blocks(self, J: PETSc.Mat) -> None:
         """Add ``T^T K T`` of the gathered blocks to ``J``, then the Dirichlet rows."""
@@ -755,6 +773,7 @@ class NewtonSolver:
                 f"first_contact_level must be 'mean', a fraction in (0, 1) or None, got {level!r}"
             )
         t0 = self.problem.t
+        self._B_stale = True  # the fixed parts again on this step's first tangent
         self.problem.set_time(t)
         fem_petsc.assign(self.problem.unknowns, self.x)
         self._shrink_pattern()
@@ -817,14 +836,14 @@ class NewtonSolver:
         solver cannot solve afterwards."""
         if self.snes is None:
             return
-        objects = [self.snes, self._J, self._retired, self._A, self._K, self._JT]
+        objects = [self.snes, self._J, self._retired, self._A, self._B, self._K, self._JT]
         objects += [self._T, self._T_coupled, self._T_wide, self._r, self.x, self._R, self._state]
         if self._increment is not None:
             objects += list(self._increment[2:])
         for obj in objects:
             if obj is not None:
                 obj.destroy()
-        self.snes = self._J = self._retired = self._A = self._K = self._JT = None
+        self.snes = self._J = self._retired = self._A = self._B = self._K = self._JT = None
         self._T = self._T_coupled = self._T_wide = self._increment = self._state = None
         PETSc.garbage_cleanup(self.comm)
 

@@ -102,3 +102,41 @@ def test_the_bulk_cells_pack_no_contact_data():
     assert {k: c.shape[1] for k, c in packed.items()} == width
     assert len(contact) == 1
     assert set(contact[0].integral_types) == {dolfinx.fem.IntegralType.exterior_facet}
+
+
+@pytest.mark.parametrize("make, fixed", [(scenes.hertz_3d, 1), (scenes.hertz_2d, 0)])
+def test_a_fixed_bulk_stiffness_is_assembled_once_a_step(make, fixed):
+    """A part that depends on no coefficient or constant (the linear-elastic bulk of 3D
+    Hertz; not the Neo-Hookean one of 2D Hertz, nor a contact term) is kept in ``B`` and
+    added to every tangent of a load step: the tangent between the unknowns equals the one
+    assembled part by part, at a state that is not the one ``B`` was assembled at."""
+    problem = ContactProblem(make(depth=0.01).scene, verbose=False)
+    solver = problem.solver
+    constant, varying = assembly.split_constant(solver._unknown_forms)
+    assert sum(len(parts) for row in constant for parts in row) == fixed
+    assert (solver._B is not None) == bool(fixed)
+    assert all(
+        p._cpp_object.coefficients or p._cpp_object.constants
+        for row in varying
+        for parts in row
+        for p in parts
+    )
+    problem.solve(num_steps=1)  # B made on the step's first tangent, then reused
+    x = solver.x.copy()
+    x.array[:] += 1e-3 * np.sin(np.arange(len(x.array)))
+    solver._set_state(x)
+    J = solver._J.duplicate()
+    solver._assemble_unknown_blocks(J)
+    expected = solver._J.duplicate()
+    expected.zeroEntries()
+    assembly.assemble_matrix(expected, solver._unknown_forms)
+    expected.assemble()
+    (rows, columns, values), (rows_e, columns_e, values_e) = (
+        J.getValuesCSR(),
+        expected.getValuesCSR(),
+    )
+    np.testing.assert_array_equal(rows, rows_e)
+    np.testing.assert_array_equal(columns, columns_e)  # the same pattern: duplicates
+    scale = np.abs(values_e).max()
+    assert scale > 0
+    np.testing.assert_allclose(values, values_e, rtol=0, atol=1e-13 * scale)
