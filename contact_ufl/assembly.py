@@ -101,6 +101,51 @@ def assemble_matrix(
     return A
 
 
+def without_cross_point_couplings(
+    A: PETSc.Mat, spaces: Sequence[dolfinx.fem.FunctionSpace]
+) -> PETSc.Mat:
+    """A zero matrix on the pattern of the blocked matrix ``A`` (of :func:`create_matrix`
+    over ``spaces``, its forms assembled once: DOLFINx's matrix holds the entries set) less
+    the couplings between two different points within each diagonal block of a quadrature
+    space.
+
+    A quadrature function's basis functions are one at their point and zero at the others,
+    so a form couples two of them only at the same point, but DOLFINx's pattern couples
+    every dof of a cell with every other (the master nodes gathered at the six points of a
+    slave facet: a dense 54 x 54 block where six 9 x 9 blocks hold the values). The matrix
+    drops the zeros assembled outside its pattern (new nonzero locations are ignored);
+    a quadrature space's points are its blocks of ``index_map_bs`` dofs, owned with their
+    cell.
+    """
+    sizes = [V.dofmap.index_map.size_local * V.dofmap.index_map_bs for V in spaces]
+    starts = np.concatenate([[0], np.cumsum(sizes)])
+    offset = A.getOwnershipRange()[0]
+    indptr, columns, _ = A.getValuesCSR()
+    rows = np.repeat(np.arange(len(indptr) - 1), np.diff(indptr))
+    keep = np.ones(len(columns), dtype=bool)
+    for k, V in enumerate(spaces):
+        if not V.ufl_element().is_quadrature:
+            continue
+        bs, lo, hi = V.dofmap.index_map_bs, starts[k], starts[k + 1]
+        inside = (rows >= lo) & (rows < hi)
+        inside &= (columns >= offset + lo) & (columns < offset + hi)
+        keep[inside] = (rows[inside] - lo) // bs == (columns[inside] - offset - lo) // bs
+    kept = np.concatenate([[0], np.cumsum(keep)])[indptr]
+    B = PETSc.Mat().createAIJ(
+        A.getSizes(),
+        csr=(
+            kept.astype(PETSc.IntType),
+            columns[keep].astype(PETSc.IntType),
+            np.zeros(int(keep.sum()), dtype=PETSc.ScalarType),  # the pattern, as zeros
+        ),
+        comm=A.getComm(),
+    )
+    B.setLGMap(*A.getLGMap())
+    B.setOption(PETSc.Mat.Option.NEW_NONZERO_LOCATIONS, False)
+    B.assemble()
+    return B
+
+
 def split_constant(
     blocks: Sequence[Sequence[Parts]],
 ) -> tuple[list[list[Parts]], list[list[Parts]]]:

@@ -267,10 +267,16 @@ class NewtonSolver:
                 self._fixed_forms = fixed
         self._K = self._coupled_layout = None
         if self._gathered_forms is not None:
-            self._K = assembly.create_matrix(self._gathered_forms)
-            self._coupled_layout = StackedLayout(
-                [problem.fields[i].function_space for i in self._coupled]
-            )
+            coupled = [problem.fields[i].function_space for i in self._coupled]
+            # the gathered blocks couple the point data (the master nodes at each slave
+            # point) only point by point: K's pattern without the rest (fewer nonzeros to
+            # assemble and multiply)
+            full = assembly.create_matrix(self._gathered_forms)
+            assembly.assemble_matrix(full, self._gathered_forms)  # its pattern (any values)
+            full.assemble()
+            self._K = assembly.without_cross_point_couplings(full, coupled)
+            full.destroy()
+            self._coupled_layout = StackedLayout(coupled)
         self.x = fem_petsc.create_vector([f.function_space for f in problem.unknowns], kind="mpi")
         fem_petsc.assign(problem.unknowns, self.x)
         self._R = self.x.duplicate()
