@@ -8,6 +8,12 @@ the bulk needs 12, 31 ms of a 44 ms residual. So each block is a list of *parts*
 one by one (the bulk's cells and loads, then the contact terms) and added into the block one
 after the other.
 
+Two savings on the tangent: the parts that depend on no coefficient and no constant (a
+linear-elastic bulk's stiffness) can be told apart (:func:`split_constant`) and assembled
+once, and a matrix of point data (quadrature functions, which couple only at the same
+point) can drop the couplings between points that DOLFINx's cell-wise pattern holds
+(:func:`without_cross_point_couplings`).
+
 A block is a list of compiled forms (empty: no block); a blocked linear form is a list of
 blocks, a blocked bilinear form a list of rows of blocks. The vectors and matrices are
 DOLFINx's blocked ones (``kind="mpi"``: each process's owned entries block after block,
