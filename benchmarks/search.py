@@ -614,40 +614,42 @@ def scene_sweep(quick: bool) -> list[dict]:
         return out
 
     search_module.closest_points = timed
-    rng = np.random.default_rng(0)
-    for name, maker, options, degree in SCENES[:3] if quick else SCENES:
-        problem = ContactProblem(getattr(scenes, maker)(**options).scene, degree=degree,
-                                 verbose=False)  # fmt: skip
-        contact = problem.contacts[0]
-        search, layout, u = contact.kinematics.search, problem.full_layout, contact.u
-        x = u.x.array.copy()
-        search.pair(u, layout)
+    try:
+        rng = np.random.default_rng(0)
+        for name, maker, options, degree in SCENES[:3] if quick else SCENES:
+            problem = ContactProblem(getattr(scenes, maker)(**options).scene, degree=degree,
+                                     verbose=False)  # fmt: skip
+            contact = problem.contacts[0]
+            search, layout, u = contact.kinematics.search, problem.full_layout, contact.u
+            x = u.x.array.copy()
+            search.pair(u, layout)
 
-        total = [0.0]
-        kernel[0] = 0.0
-        wall, cpu, pairing = best_of(_moved_pairing(search, u, layout, x, rng, total))
-        npts = len(pairing.points)
-        record = {
-            "sweep": "scenes",
-            "scene": name,
-            **{k: v for k, v in options.items()},
-            "degree": degree,
-            "dofs": problem.layout.global_size,
-            "points": npts,
-            "master_facets": int(len(search.master.keys)),
-            "paired": int(np.count_nonzero(pairing.paired)),
-            "seconds": wall,
-            "cpu_seconds": cpu,
-            "cpu_points_per_s": npts / cpu,
-            "kernel_fraction": kernel[0] / total[0],
-        }
-        records.append(record)
-        print(
-            f"{name:>9} {degree:2d} {record['dofs']:7d} {npts:7d} {record['master_facets']:7d} "
-            f"{cpu * 1e3:8.2f} {npts / cpu:9.3g} {record['kernel_fraction']:7.2f}",
-            flush=True,
-        )
-    search_module.closest_points = closest_points
+            total = [0.0]
+            kernel[0] = 0.0
+            wall, cpu, pairing = best_of(_moved_pairing(search, u, layout, x, rng, total))
+            npts = len(pairing.points)
+            record = {
+                "sweep": "scenes",
+                "scene": name,
+                **options,
+                "degree": degree,
+                "dofs": problem.layout.global_size,
+                "points": npts,
+                "master_facets": int(len(search.master.keys)),
+                "paired": int(np.count_nonzero(pairing.paired)),
+                "seconds": wall,
+                "cpu_seconds": cpu,
+                "cpu_points_per_s": npts / cpu,
+                "kernel_fraction": kernel[0] / total[0],
+            }
+            records.append(record)
+            print(
+                f"{name:>9} {degree:2d} {record['dofs']:7d} {npts:7d} {record['master_facets']:7d} "
+                f"{cpu * 1e3:8.2f} {npts / cpu:9.3g} {record['kernel_fraction']:7.2f}",
+                flush=True,
+            )
+    finally:  # the kernel restored however the sweep ends
+        search_module.closest_points = closest_points
     return records
 
 

@@ -75,6 +75,15 @@ def create_matrix(blocks: Sequence[Sequence[Parts]]) -> PETSc.Mat:
     )
 
 
+def create_matrix_with_pattern(blocks: Sequence[Sequence[Parts]]) -> PETSc.Mat:
+    """A matrix of :func:`create_matrix` holding its pattern: DOLFINx's matrix stores no
+    entry until one is set, so the blocks are assembled into it once (any values)."""
+    A = create_matrix(blocks)
+    assemble_matrix(A, blocks)
+    A.assemble()
+    return A
+
+
 def assemble_matrix(
     A: PETSc.Mat,
     blocks: Sequence[Sequence[Parts]],
@@ -110,10 +119,9 @@ def assemble_matrix(
 def without_cross_point_couplings(
     A: PETSc.Mat, spaces: Sequence[dolfinx.fem.FunctionSpace]
 ) -> PETSc.Mat:
-    """A zero matrix on the pattern of the blocked matrix ``A`` (of :func:`create_matrix`
-    over ``spaces``, its forms assembled once: DOLFINx's matrix holds the entries set) less
-    the couplings between two different points within each diagonal block of a quadrature
-    space.
+    """A zero matrix on the pattern of the blocked matrix ``A`` (of
+    :func:`create_matrix_with_pattern` over ``spaces``) less the couplings between two
+    different points within each diagonal block of a quadrature space.
 
     A quadrature function's basis functions are one at their point and zero at the others,
     so a form couples two of them only at the same point, but DOLFINx's pattern couples
@@ -174,7 +182,8 @@ def _check_within_first(parts: Parts, block: tuple[int, int]) -> None:
     first = parts[0]
     cells = _cells(first)
     outside = sum(
-        len(np.setdiff1d(_cells(p), cells)) if p.mesh is first.mesh else 1 for p in parts[1:]
+        len(np.setdiff1d(_cells(p), cells, assume_unique=True)) if p.mesh is first.mesh else 1
+        for p in parts[1:]
     )
     if first.mesh.comm.allreduce(outside, MPI.SUM):
         raise ValueError(

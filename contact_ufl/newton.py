@@ -258,9 +258,7 @@ class NewtonSolver:
         self._B = self._varying_forms = self._fixed_forms = None
         self._B_stale = True
         if self._unknown_forms is not None:
-            self._A = assembly.create_matrix(self._unknown_forms)
-            assembly.assemble_matrix(self._A, self._unknown_forms)  # its pattern (any values)
-            self._A.assemble()
+            self._A = assembly.create_matrix_with_pattern(self._unknown_forms)
             fixed, self._varying_forms = assembly.split_constant(self._unknown_forms)
             if any(parts for row in fixed for parts in row):
                 self._B = self._A.duplicate()  # zero values
@@ -271,9 +269,7 @@ class NewtonSolver:
             # the gathered blocks couple the point data (the master nodes at each slave
             # point) only point by point: K's pattern without the rest (fewer nonzeros to
             # assemble and multiply)
-            full = assembly.create_matrix(self._gathered_forms)
-            assembly.assemble_matrix(full, self._gathered_forms)  # its pattern (any values)
-            full.assemble()
+            full = assembly.create_matrix_with_pattern(self._gathered_forms)
             self._K = assembly.without_cross_point_couplings(full, coupled)
             full.destroy()
             self._coupled_layout = StackedLayout(coupled)

@@ -105,6 +105,13 @@ def test_the_bulk_cells_pack_no_contact_data():
     assert set(contact[0].integral_types) == {dolfinx.fem.IntegralType.exterior_facet}
 
 
+def _move_off(solver) -> None:
+    """Set the solver's state to its unknowns moved by up to 1e-3 (another state)."""
+    x = solver.x.copy()
+    x.array[:] += 1e-3 * np.sin(np.arange(len(x.array)))
+    solver._set_state(x)
+
+
 @pytest.mark.parametrize("make, fixed", [(scenes.hertz_3d, 1), (scenes.hertz_2d, 0)])
 def test_a_fixed_bulk_stiffness_is_assembled_once_a_step(make, fixed):
     """A part that depends on no coefficient or constant (the linear-elastic bulk of 3D
@@ -123,9 +130,7 @@ def test_a_fixed_bulk_stiffness_is_assembled_once_a_step(make, fixed):
         for p in parts
     )
     problem.solve(num_steps=1)  # B made on the step's first tangent, then reused
-    x = solver.x.copy()
-    x.array[:] += 1e-3 * np.sin(np.arange(len(x.array)))
-    solver._set_state(x)
+    _move_off(solver)
     J = solver._J.duplicate()
     solver._assemble_unknown_blocks(J)
     expected = solver._J.duplicate()
@@ -148,11 +153,8 @@ def test_the_gathered_blocks_drop_only_zeros_between_points(make):
     """The gathered blocks' matrix ``K`` holds no coupling between two points of the
     master-node data (a quadrature space) and assembles to DOLFINx's full pattern's matrix
     exactly: what it drops is zero."""
-    problem = ContactProblem(make(depth=0.01).scene, verbose=False)
-    solver = problem.solver
-    x = solver.x.copy()
-    x.array[:] += 1e-3 * np.sin(np.arange(len(x.array)))
-    solver._set_state(x)
+    solver = ContactProblem(make(depth=0.01).scene, verbose=False).solver
+    _move_off(solver)
     full = assembly.create_matrix(solver._gathered_forms)
     matrices = []
     for K in (full, solver._K):
