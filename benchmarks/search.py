@@ -565,15 +565,15 @@ def points_sweep(nf: int, counts) -> list[dict]:
     return records
 
 
-#: the scenes of the ``"scenes"`` sweep: name, scene maker, its keywords, displacement degree
+#: the scenes of the ``"scenes"`` sweep: the scene maker, its keywords, displacement degree
 SCENES = [
-    ("hertz_2d", "hertz_2d", {"h_contact": 0.005}, 1),
-    ("hertz_2d", "hertz_2d", {"h_contact": 0.00125}, 1),
-    ("hertz_3d", "hertz_3d", {"h_contact": 0.0125}, 1),
-    ("hertz_3d", "hertz_3d", {"h_contact": 0.00625}, 1),
-    ("hertz_3d", "hertz_3d", {"h_contact": 0.0045}, 1),
-    ("hertz_3d", "hertz_3d", {"h_contact": 0.05, "order": 2}, 2),
-    ("hertz_3d", "hertz_3d", {"h_contact": 0.025, "h_edge": 0.01, "order": 2}, 2),
+    ("hertz_2d", {"h_contact": 0.005}, 1),
+    ("hertz_2d", {"h_contact": 0.00125}, 1),
+    ("hertz_3d", {"h_contact": 0.0125}, 1),
+    ("hertz_3d", {"h_contact": 0.00625}, 1),
+    ("hertz_3d", {"h_contact": 0.0045}, 1),
+    ("hertz_3d", {"h_contact": 0.05, "order": 2}, 2),
+    ("hertz_3d", {"h_contact": 0.025, "h_edge": 0.01, "order": 2}, 2),
 ]
 
 
@@ -616,8 +616,8 @@ def scene_sweep(quick: bool) -> list[dict]:
     search_module.closest_points = timed
     try:
         rng = np.random.default_rng(0)
-        for name, maker, options, degree in SCENES[:3] if quick else SCENES:
-            problem = ContactProblem(getattr(scenes, maker)(**options).scene, degree=degree,
+        for name, options, degree in SCENES[:3] if quick else SCENES:
+            problem = ContactProblem(getattr(scenes, name)(**options).scene, degree=degree,
                                      verbose=False)  # fmt: skip
             contact = problem.contacts[0]
             search, layout, u = contact.kinematics.search, problem.full_layout, contact.u
