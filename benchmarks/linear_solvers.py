@@ -117,6 +117,8 @@ def solve(A: PETSc.Mat, options: dict, repeat: int, splits=None) -> dict:
             "flops": F.getMumpsRinfog(3),
             "rank_flops": comm.allgather(F.getMumpsRinfo(3)),
             "factor_entries": F.getMumpsInfog(29),
+            "off_diagonal_pivots": F.getMumpsInfog(12),
+            "delayed_pivots": F.getMumpsInfog(13),
             "memory_MB": F.getMumpsInfog(22),
         }
     ksp.destroy()

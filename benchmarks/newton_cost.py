@@ -43,9 +43,10 @@ slave points and its share of the rows and nonzeros of ``K`` and ``T``: where th
 ``--partition graph`` distributes the meshes with DOLFINx's graph partition (whole bodies on
 ranks) instead of the default that splits every body over all ranks
 (:mod:`contact_ufl.partition`); the records say which (``partition``).
-``--option`` passes PETSc options to the solver (e.g. ``mat_mumps_icntl_7=3``; with ``pc_type
-fieldsplit`` the bulk case, which has no multipliers, takes the ``fieldsplit_u_pc_*`` options
-as its preconditioner: GAMG on the whole for README's field split); ``--dump
+``--option`` passes PETSc options to the solver (e.g. ``mat_mumps_icntl_7=3``);
+``--field-split`` solves with the package's
+:data:`~contact_ufl.newton.FIELD_SPLIT_PETSC_OPTIONS` (``--option`` on top of them; the bulk
+case, which has no multipliers, takes its ``u`` split's GAMG on the whole); ``--dump
 FILE`` writes the contact tangent at the end of the solve for ``benchmarks/linear_solvers.py``
 (orderings, MUMPS options, iterative solvers on it).
 
@@ -57,7 +58,9 @@ Records: ``scene``, ``size`` (h_contact or divisions), ``case`` (``contact`` or 
 ``dofs``, ``newton_iterations``, ``new_patterns`` (Jacobians on a new pairing: a symbolic
 PtAP), ``analyses`` (symbolic analyses of the factorisation: the solver matrix's pattern was
 new or grew), ``residuals`` (residual evaluations, line searches' included), ``wall_s``,
-``cpu_s`` (process CPU time of the solve), ``load`` (1-minute load average at the start)
+``cpu_s`` (process CPU time of the solve), ``load`` (1-minute load average at the start),
+``peak_rss_MB`` (each rank's largest resident memory so far: the cases run in order, bulk
+then contact, smaller sizes first)
 and, per Newton iteration, ``total_s`` (SNES time), ``search_s``,
 ``residual_assembly_s``, ``jacobian_assembly_s``, ``ptap_s``, ``linear_solve_s``,
 ``analysis_s`` and ``factorisation_s`` (PETSc's ``MatLUFactorSym`` and ``MatLUFactorNum``
@@ -72,6 +75,7 @@ import argparse
 import dataclasses
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -83,6 +87,7 @@ from petsc4py import PETSc
 
 from contact_ufl.gmshio import PARTITION_VARIABLE
 from contact_ufl.loads import Dirichlet
+from contact_ufl.newton import FIELD_SPLIT_PETSC_OPTIONS
 from contact_ufl.partition import PARTITIONS
 from contact_ufl.problem import ContactProblem
 from contact_ufl.verification import scenes
@@ -251,6 +256,11 @@ def save_tangent(problem: ContactProblem, path: str) -> None:
     viewer.destroy()
 
 
+def _peak_rss_mb() -> float:
+    """The largest resident memory of this process so far, in MB (Linux: KB units)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
 def run(
     make,
     size,
@@ -267,7 +277,7 @@ def run(
     if eps == "default":  # the package's default eps_N (E / L) instead of the scene's E / h
         pairs = [dataclasses.replace(p, eps_N=None) for p in scene.contacts]
         scene = dataclasses.replace(scene, contacts=pairs)
-    options = (options or {}) if contact else bulk_options(options or {})
+    options = options or {}  # a field split is the u split's preconditioner without contact
     problem = ContactProblem(scene, verbose=False, petsc_options=options)
     timings = problem.solver.timings
     timings.reset()
@@ -304,6 +314,7 @@ def run(
         "eps": eps,
         "solution_norm": problem.solver.x.norm(),  # the same answers on any number of ranks
         "contact_force": [float(f) for f in problem.contact_force()] if contact else None,
+        "peak_rss_MB": problem.comm.allgather(_peak_rss_mb()),
     }
     record["per_rank"] = _per_rank(problem, cpu, timings)
     if dump and contact:
@@ -314,20 +325,6 @@ def run(
         J = problem.solver.evaluate_jacobian(problem.solver.x)
         record["tangent"] = _factorise(J, options, glue)
     return record
-
-
-def bulk_options(options: dict) -> dict:
-    """The solver options of the bulk case: a ``fieldsplit`` (displacements ``u``, multipliers
-    ``lambda``) has one field without contact, so its ``u`` split's solver becomes the whole
-    preconditioner (e.g. GAMG); other options are kept."""
-    if options.get("pc_type") != "fieldsplit":
-        return options
-    kept = {k: v for k, v in options.items() if not k.startswith(("pc_", "fieldsplit_"))}
-    prefix = "fieldsplit_u_pc_"
-    return {
-        **kept,
-        **{k[len("fieldsplit_u_") :]: v for k, v in options.items() if k.startswith(prefix)},
-    }
 
 
 def fastest(records: list[dict]) -> dict:
@@ -402,6 +399,9 @@ def _arguments() -> argparse.Namespace:
     parser.add_argument("--glued", action="store_true", help="add the glued baseline")
     parser.add_argument("--ranks", nargs="+", type=int, help="run under mpirun -n k for each k")
     parser.add_argument("--option", nargs="*", default=[], help="PETSc options KEY=VALUE")
+    parser.add_argument(
+        "--field-split", action="store_true", help="the package's FIELD_SPLIT_PETSC_OPTIONS"
+    )
     parser.add_argument("--partition", choices=PARTITIONS, default="bodies", help="mesh partition")
     parser.add_argument("--eps", choices=("scene", "default"), default="scene", help="eps_N")
     parser.add_argument("--dump", default="", help="write the contact tangent (last size)")
@@ -450,6 +450,8 @@ def main() -> None:
         _by_ranks(args)
         return
     options = dict(o.split("=", 1) for o in args.option)
+    if args.field_split:
+        options = FIELD_SPLIT_PETSC_OPTIONS | options
     PETSc.Log.begin()
     sizes = {
         "hertz": HERTZ_QUICK if args.quick else HERTZ_FULL,

@@ -48,7 +48,7 @@ from contact_ufl.membranes import (
     MembraneNeoHookean,
     MembraneSVK,
 )
-from contact_ufl.newton import NewtonSolver, NewtonTimings
+from contact_ufl.newton import FIELD_SPLIT_PETSC_OPTIONS, NewtonSolver, NewtonTimings
 from contact_ufl.output import ResultWriter
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.problem import ContactProblem
@@ -59,6 +59,7 @@ from contact_ufl.taylor import taylor_test
 __version__ = "0.1.0"
 
 __all__ = [
+    "FIELD_SPLIT_PETSC_OPTIONS",
     "Body",
     "BodyForce",
     "ContactInputError",

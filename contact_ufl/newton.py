@@ -46,6 +46,39 @@ DEFAULT_PETSC_OPTIONS = {
     "pc_factor_mat_solver_type": "mumps",
 }
 
+#: Options of an iterative linear solve for large 3D problems (``petsc_options`` of
+#: :class:`~contact_ufl.problem.ContactProblem`): flexible GMRES on a Schur split of the
+#: unknowns (:meth:`NewtonSolver._split_fields`), algebraic multigrid (GAMG) on the
+#: displacements and LU on the multipliers' Schur approximation. MUMPS's work grows like n^2
+#: with the unknowns in 3D, this one's about like n: it pays from some 50,000 unknowns in 3D
+#: and gains more on two ranks (README, "Solvers for large problems"). Its linear solves end
+#: at a relative residual of 1e-8; Newton's iterations and answers are MUMPS's. A problem
+#: without multipliers (no contact pair) takes the multigrid on the whole.
+FIELD_SPLIT_PETSC_OPTIONS = {
+    "ksp_type": "fgmres",
+    "ksp_rtol": 1e-8,
+    "ksp_gmres_restart": 100,
+    "ksp_max_it": 500,
+    "pc_type": "fieldsplit",
+    "pc_fieldsplit_type": "schur",
+    "pc_fieldsplit_schur_fact_type": "full",
+    "pc_fieldsplit_schur_precondition": "selfp",
+    "fieldsplit_u_ksp_type": "preonly",
+    "fieldsplit_u_pc_type": "gamg",
+    "fieldsplit_u_pc_gamg_threshold": 0.01,
+    "fieldsplit_lambda_ksp_type": "preonly",
+    "fieldsplit_lambda_pc_type": "lu",
+}
+
+
+def one_field_options(options: dict) -> dict:
+    """The ``fieldsplit`` ``options`` of a problem with the displacements only (no
+    multipliers: one field, nothing to split): the ``u`` split's preconditioner (``pc_*``
+    of ``fieldsplit_u_pc_*``) on the whole; the other options kept."""
+    kept = {k: v for k, v in options.items() if not k.startswith(("pc_", "fieldsplit_"))}
+    prefix = "fieldsplit_u_pc_"
+    return kept | {k[len("fieldsplit_u_") :]: v for k, v in options.items() if k.startswith(prefix)}
+
 
 @dataclass
 class NewtonTimings:
@@ -322,6 +355,8 @@ class NewtonSolver:
         snes = PETSc.SNES().create(self.comm)
         snes.setOptionsPrefix(prefix)
         opts = PETSc.Options()
+        if options.get("pc_type") == "fieldsplit" and not self._has_other_unknowns():
+            options = one_field_options(options)
         for key, value in {
             **DEFAULT_PETSC_OPTIONS,
             "snes_atol": self._default_atol(),
@@ -346,6 +381,12 @@ class NewtonSolver:
         pc.reset()
         if pc.getType() == PETSc.PC.Type.FIELDSPLIT:
             self._split_fields(pc)
+
+    def _has_other_unknowns(self) -> bool:
+        """Whether the unknowns hold more than the displacements (multipliers, a control's
+        load factor) on some rank (collective)."""
+        meshes = len(self.problem.bulks)
+        return self.comm.allreduce(int(self.problem.layout.local_sizes[meshes:].sum()), MPI.SUM) > 0
 
     def _split_fields(self, pc: PETSc.PC) -> None:
         """The splits of a ``pc_type fieldsplit``: ``u``, the displacements of the meshes

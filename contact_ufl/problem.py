@@ -111,7 +111,9 @@ class ContactProblem:
         otherwise).
     petsc_options
         PETSc options (Newton, KSP, PC) of :attr:`solver`, overriding
-        :data:`contact_ufl.newton.DEFAULT_PETSC_OPTIONS`.
+        :data:`contact_ufl.newton.DEFAULT_PETSC_OPTIONS` (MUMPS's LU);
+        :data:`contact_ufl.newton.FIELD_SPLIT_PETSC_OPTIONS` for an iterative solve of a
+        large 3D problem.
     petsc_options_prefix
         Prefix of those options in the PETSc options database.
     verbose

@@ -1,5 +1,6 @@
 """Load stepping: cut-back of diverging steps, a clear error when cut-backs run out."""
 
+import dataclasses
 import gc
 import time
 import weakref
@@ -8,7 +9,8 @@ import numpy as np
 import pytest
 
 from contact_ufl.errors import ConvergenceError
-from contact_ufl.newton import NewtonSolver, NewtonTimings
+from contact_ufl.loads import Dirichlet
+from contact_ufl.newton import FIELD_SPLIT_PETSC_OPTIONS, NewtonSolver, NewtonTimings
 from contact_ufl.problem import ContactProblem
 from contact_ufl.stepping import LoadStepper
 from contact_ufl.verification import scenes
@@ -205,22 +207,10 @@ def test_an_unknown_predictor_is_refused():
 
 
 def test_field_split_solver_gives_the_same_solution():
-    """``pc_type fieldsplit`` gets the splits ``u`` (displacements) and ``lambda``
-    (multipliers) from the solver, also after the resets of a new pattern: GMRES with a
-    Schur split, GAMG on the displacements, gives the direct solver's solution."""
-    split = {
-        "ksp_type": "fgmres",
-        "ksp_rtol": 1e-12,
-        "ksp_max_it": 400,
-        "pc_type": "fieldsplit",
-        "pc_fieldsplit_type": "schur",
-        "pc_fieldsplit_schur_fact_type": "full",
-        "pc_fieldsplit_schur_precondition": "selfp",
-        "fieldsplit_u_ksp_type": "preonly",
-        "fieldsplit_u_pc_type": "gamg",
-        "fieldsplit_lambda_ksp_type": "preonly",
-        "fieldsplit_lambda_pc_type": "lu",
-    }
+    """The package's ``FIELD_SPLIT_PETSC_OPTIONS`` (a ``fieldsplit``: the solver gives it
+    the splits ``u`` and ``lambda``, also after the resets of a new pattern; GMRES with a
+    Schur split, GAMG on the displacements) gives the direct solver's solution."""
+    split = FIELD_SPLIT_PETSC_OPTIONS | {"ksp_rtol": 1e-12}
     results = []
     for options in ({}, split):
         problem = hertz_problem(**options)
@@ -234,6 +224,24 @@ def test_field_split_solver_gives_the_same_solution():
     assert iterative.timings.analyses >= 1  # the splits were kept through a reset
     assert iterative.snes.getKSP().getIterationNumber() > 1
     np.testing.assert_allclose(x_iterative, x_direct, rtol=0, atol=1e-8 * np.abs(x_direct).max())
+
+
+def test_field_split_options_without_multipliers_take_the_multigrid_on_the_whole():
+    """A problem without contact has the displacements only: nothing to split, so the field
+    split options give their ``u`` split's GAMG on the whole, with the direct solution."""
+    hertz = scenes.hertz_2d(h_contact=0.02, depth=0.01).scene
+    arc = Dirichlet(hertz.tags["cylinder_contact"], (0.0, -0.01))
+    scene = dataclasses.replace(hertz, contacts=[], dirichlet=[*hertz.dirichlet, arc])
+    solutions = []
+    for options in ({}, FIELD_SPLIT_PETSC_OPTIONS | {"ksp_rtol": 1e-12}):
+        problem = ContactProblem(scene, verbose=False, petsc_options=options)
+        problem.solve(num_steps=1)
+        solutions.append(problem.solver.x.array.copy())
+    ksp = problem.solver.snes.getKSP()
+    assert (ksp.getType(), ksp.getPC().getType()) == ("fgmres", "gamg")
+    assert ksp.getIterationNumber() > 1
+    direct, iterative = solutions
+    np.testing.assert_allclose(iterative, direct, rtol=0, atol=1e-8 * np.abs(direct).max())
 
 
 def test_solver_matrix_rebuilt_inside_a_newton_solve():

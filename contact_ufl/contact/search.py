@@ -34,6 +34,7 @@ from contact_ufl.contact.projection import (
 )
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
+from contact_ufl.keysets import unique
 from contact_ufl.layout import StackedLayout
 
 
@@ -404,7 +405,7 @@ def release_beside_own_facet(
     off = on_boundary & (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > tolerance)
     # vertex pairs of the same facet, over the facets of the search (the excluded facets
     # around a point's facet are among them: they are within a facet's size of the point)
-    pairs = np.unique(
+    pairs = unique(
         np.concatenate(
             [
                 _pair_codes(rule.facet_nodes[:, i], rule.facet_nodes[:, j])
