@@ -226,6 +226,24 @@ def test_field_split_solver_gives_the_same_solution():
     np.testing.assert_allclose(x_iterative, x_direct, rtol=0, atol=1e-8 * np.abs(x_direct).max())
 
 
+def test_field_split_solver_with_friction_gives_the_same_solution():
+    """Frictional contact (mu = 0.3, pressed then shifted into partial slip): the field
+    split's ``lambda`` holds the normal and tangential multipliers; its Newton iterations
+    and solution are the direct solver's."""
+    results = []
+    for options in ({}, FIELD_SPLIT_PETSC_OPTIONS | {"ksp_rtol": 1e-12}):
+        hertz = scenes.hertz_2d(h_contact=0.02, depth=0.01, mu=0.3, shift=0.002)
+        problem = ContactProblem(hertz.scene, verbose=False, petsc_options=options)
+        history = problem.solve(num_steps=4, t_end=2.0)
+        iterations = [r.newton_iterations for r in history.steps]
+        results.append((iterations, problem.contact_force(), problem.solver.x.array.copy()))
+    (its_direct, force_direct, x_direct), (its_split, force_split, x_split) = results
+    assert abs(force_direct[0]) > 0.1 * abs(force_direct[1])  # a tangential force
+    assert its_split == its_direct
+    np.testing.assert_allclose(force_split, force_direct, rtol=1e-9)
+    np.testing.assert_allclose(x_split, x_direct, rtol=0, atol=1e-8 * np.abs(x_direct).max())
+
+
 def test_field_split_options_without_multipliers_take_the_multigrid_on_the_whole():
     """A problem without contact has the displacements only: nothing to split, so the field
     split options give their ``u`` split's GAMG on the whole, with the direct solution."""
