@@ -128,23 +128,32 @@ class MeshMaster:
             self._ring_flags = np.zeros((len(fans), 0), dtype=bool)
         if smoothed:
             self.nx += int(self.V.mesh.comm.allreduce(self._ring.shape[1], MPI.MAX))
+        self._columns: tuple[StackedLayout, np.ndarray, np.ndarray] | None = None
 
     def candidates(self, layout: StackedLayout) -> MasterCandidates:
         """This rank's facets at the current displacement (collective with ``smoothed``)."""
         comm = self.V.mesh.comm
-        bs = self.V.dofmap.index_map_bs
         current = self.current_nodes()
-        global_nodes = self.global_nodes.astype(np.int64)
         flags = np.zeros((len(current), 0), dtype=np.int64)
         if self.smoothed:  # carry the neighbour nodes of every facet along
+            global_nodes = self.global_nodes.astype(np.int64)
             ring = gathered_node_positions(comm, global_nodes, current, self._ring)
             current = np.concatenate([current, ring], axis=1)
-            global_nodes = np.hstack([global_nodes, self._ring])
             flags = self._ring_flags.astype(np.int64)
-        columns = layout.from_block_global(self.block, global_nodes * bs)
-        return MasterCandidates(
-            current, columns, self.keys.astype(np.int64), self.boundary_edges, flags
-        )
+        columns, keys = self._columns_and_keys(layout)
+        return MasterCandidates(current, columns, keys, self.boundary_edges, flags)
+
+    def _columns_and_keys(self, layout: StackedLayout) -> tuple[np.ndarray, np.ndarray]:
+        """The columns of the facets' carried nodes in ``layout`` and their vertex keys
+        (``int64``): fixed by the mesh, made once per layout."""
+        if self._columns is None or self._columns[0] is not layout:
+            global_nodes = self.global_nodes.astype(np.int64)
+            if self.smoothed:
+                global_nodes = np.hstack([global_nodes, self._ring])
+            bs = self.V.dofmap.index_map_bs
+            columns = layout.from_block_global(self.block, global_nodes * bs)
+            self._columns = (layout, columns, self.keys.astype(np.int64))
+        return self._columns[1], self._columns[2]
 
     def _build(self) -> None:
         mesh = self.V.mesh

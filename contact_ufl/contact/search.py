@@ -122,7 +122,8 @@ class ClosestPointSearch:
     def exchange(self, master_nodes: np.ndarray, points: np.ndarray, payload=None):
         """Master facets of all ranks near this rank's ``points`` (bounding-box filter).
 
-        Returns the received facet nodes and their ``payload`` rows. Raises a
+        Returns the received facet nodes and their ``payload`` rows (on one rank with
+        every facet near: the arguments themselves). Raises a
         ``ValueError`` on every rank if a rank's points or master nodes are not all finite
         (the search would pair them silently).
         """
@@ -138,15 +139,19 @@ class ClosestPointSearch:
         problems = [p for _, p in gathered if p is not None]
         if problems:
             raise ValueError(problems[0])
-        boxes = [b for b, _ in gathered]
         sends = []
-        for b in boxes:
+        for box, _ in gathered:
             if n == 0:
                 sends.append((master_nodes, payload))
                 continue
-            near = np.all((lo <= b[1] + self.radius) & (hi >= b[0] - self.radius), axis=1)
-            sends.append((master_nodes[near], payload[near]))
-        received = comm.alltoall(sends) if comm.size > 1 else sends
+            near = _overlapping(lo, hi, box[0] - self.radius, box[1] + self.radius)
+            if near.all():
+                sends.append((master_nodes, payload))
+            else:
+                sends.append((master_nodes[near], payload[near]))
+        if comm.size == 1:
+            return sends[0]
+        received = comm.alltoall(sends)
         nodes = np.concatenate([r[0] for r in received]).reshape(-1, *master_nodes.shape[1:])
         data = np.concatenate([r[1] for r in received]).reshape(len(nodes), *payload.shape[1:])
         return nodes, data
@@ -161,17 +166,18 @@ class ClosestPointSearch:
         self._order = (keys.copy(), order)
         return order
 
-    def fans(self, columns: np.ndarray) -> np.ndarray:
+    def fans(self, columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The fan columns (:func:`fan_columns`) of every candidate facet of the gathered
-        ``columns``: those of the last search while its candidates are the same (the same
-        columns in the same order, as on one rank and whenever the exchange sends the same
-        facets), else anew."""
+        ``columns`` and their numbers (the rest of a row is ``-1``): those of the last
+        search while its candidates are the same (the same columns in the same order, as on
+        one rank and whenever the exchange sends the same facets), else anew."""
         if self._fans is not None and np.array_equal(self._fans[0], columns):
-            return self._fans[1]
+            return self._fans[1], self._fans[2]
         nn = self.master.nn
         fans = fan_columns(columns, nn, np.arange(len(columns)))
-        self._fans = (columns.copy(), fans)
-        return fans
+        counts = np.count_nonzero(fans >= 0, axis=1)
+        self._fans = (columns.copy(), fans, counts)
+        return fans, counts
 
     def check_facing(self, description: str) -> None:
         """Raise (on every rank) if no slave point faces the master surface in the reference
@@ -258,17 +264,33 @@ class ClosestPointSearch:
                 normal = smoothed_normals_3d(proj.xi[paired], facet_nodes, nn)
             proj.normal[paired] = normal
             proj.gap[paired] = -np.einsum("pd,pd->p", normal, points[paired] - proj.y[paired])
-        npts = len(points)
-        gathered = np.zeros((npts, nx, gdim))
-        gathered[paired] = nodes[proj.facet[paired]]
-        gather = np.full((npts, nx, gdim), -1, dtype=np.int64)
-        gather[paired] = columns[proj.facet[paired]][:, :, None] + np.arange(gdim)
-        fans = self.fans(columns)[proj.facet[paired]]
-        fans = fans[:, : np.count_nonzero(fans >= 0, axis=1).max(initial=0)]  # -1 padded
-        neighbourhood = np.full((npts, fans.shape[1]), -1, dtype=np.int64)
-        neighbourhood[paired] = fans
+        gathered = _at_points(nodes, proj.facet, paired, 0.0)
+        gather = _at_points(columns, proj.facet, paired, -1)[:, :, None] + np.arange(gdim)
+        gather[~paired] = -1
+        fans, counts = self.fans(columns)
+        width = counts[proj.facet[paired]].max(initial=0)  # the rest of the rows is -1
+        neighbourhood = _at_points(fans[:, :width], proj.facet, paired, -1)
         self.time += time.perf_counter() - start
         return Pairing(points, proj, gathered, gather, flags, neighbourhood)
+
+
+def _at_points(rows: np.ndarray, facet: np.ndarray, paired: np.ndarray, fill) -> np.ndarray:
+    """``rows[facet]`` at the ``paired`` points, ``fill`` at the others (an integer take:
+    faster than an assignment through the mask)."""
+    if len(rows) == 0:
+        return np.full((len(facet), *rows.shape[1:]), fill, dtype=rows.dtype)
+    out = rows[np.where(paired, facet, 0)]
+    out[~paired] = fill
+    return out
+
+
+def _overlapping(lo: np.ndarray, hi: np.ndarray, low: np.ndarray, high: np.ndarray):
+    """Which boxes ``[lo, hi]`` ``(n, gdim)`` meet the box ``[low, high]``, a coordinate at
+    a time."""
+    near = (lo[:, 0] <= high[0]) & (hi[:, 0] >= low[0])
+    for d in range(1, lo.shape[1]):
+        near &= (lo[:, d] <= high[d]) & (hi[:, d] >= low[d])
+    return near
 
 
 def _node_bounds(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -348,7 +370,7 @@ def release_beyond_boundary(
     ``boundary``: boundary-edge flags per candidate.
     """
     paired = np.flatnonzero(proj.facet >= 0)
-    paired = paired[boundary[proj.facet[paired]].any(axis=1)]  # on a facet at the boundary
+    paired = paired[boundary.any(axis=1)[proj.facet[paired]]]  # on a facet at the boundary
     if len(paired) == 0:
         return
     on_edge = on_edges(boundary.shape[1], proj.xi[paired])  # as many edges as nodes
