@@ -47,9 +47,9 @@ DEFAULT_PETSC_OPTIONS = {
 }
 
 #: Options of an iterative linear solve for large 3D problems (``petsc_options`` of
-#: :class:`~contact_ufl.problem.ContactProblem`): flexible GMRES on a Schur split of the
-#: unknowns (:meth:`NewtonSolver._split_fields`), algebraic multigrid (GAMG) on the
-#: displacements and LU on the multipliers' Schur approximation. MUMPS's work grows like n^2
+#: :class:`~contact_ufl.problem.ContactProblem`): flexible GMRES on an upper triangular Schur
+#: split of the unknowns (:meth:`NewtonSolver._split_fields`), algebraic multigrid (GAMG) on
+#: the displacements and LU on the multipliers' Schur approximation. MUMPS's work grows like n^2
 #: with the unknowns in 3D, this one's about like n: it pays from some 50,000 unknowns in 3D
 #: and gains more on two ranks (README, "Solvers for large problems"). Its linear solves end
 #: at a relative residual of 1e-8; Newton's iterations and answers are MUMPS's. A problem
@@ -61,7 +61,7 @@ FIELD_SPLIT_PETSC_OPTIONS = {
     "ksp_max_it": 500,
     "pc_type": "fieldsplit",
     "pc_fieldsplit_type": "schur",
-    "pc_fieldsplit_schur_fact_type": "full",
+    "pc_fieldsplit_schur_fact_type": "upper",  # one multigrid cycle an iteration, not two
     "pc_fieldsplit_schur_precondition": "selfp",
     "fieldsplit_u_ksp_type": "preonly",
     "fieldsplit_u_pc_type": "gamg",
