@@ -80,7 +80,8 @@ def test_force_driven_hertz_from_a_gap_with_the_field_split(force):
         scene = hertz_scene("force", force, gap=1e-3)
         problem = cu.ContactProblem(scene, verbose=False, petsc_options=options)
         history = problem.solve(num_steps=2)
-        results.append(([r.newton_iterations for r in history.steps], problem.solver.x.array.copy()))
+        iterations = [r.newton_iterations for r in history.steps]
+        results.append((iterations, problem.solver.x.array.copy()))
     (its_direct, x_direct), (its_split, x_split) = results
     assert its_split == its_direct
     np.testing.assert_allclose(x_split, x_direct, rtol=0, atol=1e-8 * np.abs(x_direct).max())
