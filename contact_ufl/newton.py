@@ -397,7 +397,7 @@ class NewtonSolver:
         blocks = [layout.owned(b, np.arange(n)) for b, n in enumerate(layout.local_sizes)]
         u = np.concatenate(blocks[:meshes]).astype(PETSc.IntType)
         rest = np.concatenate([np.zeros(0, np.int64), *blocks[meshes:]]).astype(PETSc.IntType)
-        if self.comm.allreduce(len(rest), MPI.SUM) == 0:
+        if not self._has_other_unknowns():
             return  # no multipliers: one field
         displacements = PETSc.IS().createGeneral(u, comm=self.comm)
         displacements.setBlockSize(self.problem.gdim)

@@ -265,8 +265,7 @@ class ClosestPointSearch:
             proj.normal[paired] = normal
             proj.gap[paired] = -np.einsum("pd,pd->p", normal, points[paired] - proj.y[paired])
         gathered = _at_points(nodes, proj.facet, paired, 0.0)
-        gather = _at_points(columns, proj.facet, paired, -1)[:, :, None] + np.arange(gdim)
-        gather[~paired] = -1
+        gather = _at_points(columns[:, :, None] + np.arange(gdim), proj.facet, paired, -1)
         fans, counts = self.fans(columns)
         width = counts[proj.facet[paired]].max(initial=0)  # the rest of the rows is -1
         neighbourhood = _at_points(fans[:, :width], proj.facet, paired, -1)
