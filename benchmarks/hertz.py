@@ -53,6 +53,7 @@ import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.materials import LinearElastic
+from contact_ufl.newton import FIELD_SPLIT_PETSC_OPTIONS
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import contact_samples
 from contact_ufl.verification import scenes
@@ -188,6 +189,8 @@ def plot_label(records: list[dict]) -> str:
     label = f"{dim} P{first.get('degree', 1)}"
     if first.get("refine_radius", 0.3) != 0.3:
         label += f", zone {first['refine_radius']:g} R"
+    if first.get("petsc_options", {}).get("pc_type") == "fieldsplit":
+        label += ", field split"
     return label
 
 
@@ -228,6 +231,7 @@ def run_3d(
     degree: int = 1,
     eps: str = "scene",
     multiplier_degree: int | str = 1,
+    petsc_options: dict | None = None,
 ) -> dict:
     """One 3D run; the record of :func:`hertz_3d_run` with the timings of the solver."""
     record, problem = hertz_3d_run(
@@ -236,6 +240,7 @@ def run_3d(
         degree=degree,
         default_eps=eps == "default",
         multiplier_degree=multiplier_degree,
+        petsc_options=petsc_options,
         depth=depth,
         h_edge=h_edge,
         flat=flat,
@@ -276,6 +281,7 @@ def main_3d(args) -> None:
             args.degree,
             args.eps,
             args.multiplier_degree,
+            FIELD_SPLIT_PETSC_OPTIONS if args.field_split else None,
         )
         records.append(r)
         if comm.rank == 0:
@@ -333,9 +339,14 @@ def main() -> None:
     parser.add_argument(
         "--repeat", type=int, default=1, help="2D: solves per mesh, the fastest kept"
     )
+    parser.add_argument(
+        "--field-split", action="store_true", help="3D: the package's iterative solver"
+    )
     args = parser.parse_args()
     if args.repeat < 1 or (args.repeat > 1 and args.dim == 3):
         parser.error("--repeat is a positive number of 2D solves per mesh")
+    if args.field_split and args.dim == 2:
+        parser.error("--field-split is for 3D (in 2D MUMPS is faster at every size measured)")
     if args.dim == 3:
         args.depth = 0.01 if args.depth is None else args.depth
         args.steps = 2 if args.steps is None else args.steps

@@ -352,12 +352,14 @@ def hertz_3d_run(
     degree: int = 1,
     default_eps: bool = False,
     multiplier_degree: int | str = 1,
+    petsc_options: dict | None = None,
     **options,
 ) -> tuple[dict, ContactProblem]:
     """Solve :func:`~contact_ufl.verification.scenes.hertz_3d` (``options`` passed to it;
     its geometry ``order`` by default the displacement's ``degree``) in ``steps`` load
     steps (``default_eps``: with the library's default ``eps_N`` instead of the scene's
-    ``E / h``; ``multiplier_degree``: that of the pair); return the record of
+    ``E / h``; ``multiplier_degree``: that of the pair; ``petsc_options``: the solver's,
+    recorded as ``petsc_options``); return the record of
     :func:`hertz_3d_errors` with ``degree``, ``multiplier_degree``, ``geometry_order``,
     ``dofs``, ``h_contact``, ``slave_points``, ``newton_iterations``, ``newton_per_step``,
     ``wall_s`` (the solve), ``cpu_s`` (its CPU time), ``search_s`` (its closest-point
@@ -368,12 +370,13 @@ def hertz_3d_run(
     if default_eps:
         pair = dataclasses.replace(pair, eps_N=None)
     hertz.scene.contacts[0] = pair
-    problem = ContactProblem(hertz.scene, degree=degree, verbose=False)
+    problem = ContactProblem(hertz.scene, degree=degree, verbose=False, petsc_options=petsc_options)
     start, cpu = time.perf_counter(), time.process_time()
     problem.solve(num_steps=steps)
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     newton = sum(s.newton_iterations for s in problem.history.steps)
     record = {
+        "petsc_options": dict(petsc_options or {}),
         "degree": degree,
         "multiplier_degree": multiplier_degree,
         "geometry_order": options["order"],
