@@ -394,12 +394,12 @@ class NewtonSolver:
         (block size the dimension, for GAMG), and ``lambda``, the other unknowns (the
         multipliers; a control's load factor). Their solvers take the options
         ``<prefix>fieldsplit_u_...`` and ``<prefix>fieldsplit_lambda_...``."""
+        if not self._has_other_unknowns():
+            return  # no multipliers: one field
         layout, meshes = self.problem.layout, len(self.problem.bulks)
         blocks = [layout.owned(b, np.arange(n)) for b, n in enumerate(layout.local_sizes)]
         u = np.concatenate(blocks[:meshes]).astype(PETSc.IntType)
         rest = np.concatenate([np.zeros(0, np.int64), *blocks[meshes:]]).astype(PETSc.IntType)
-        if not self._has_other_unknowns():
-            return  # no multipliers: one field
         displacements = PETSc.IS().createGeneral(u, comm=self.comm)
         displacements.setBlockSize(self.problem.gdim)
         pc.setFieldSplitIS(
