@@ -48,13 +48,10 @@ double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64
 int same_values(i64 len, const double *p, const double *q);
 int morton_order(int g, i64 n, const double *x, i64 *order);
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const void *tree, double rmax, i64 npts,
-              const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
-              double *dist, i64 *edge, unsigned char *vertex, i64 *point, i64 *written,
-              const i64 *index, i64 *facet,
-              double *oxi, double *y, double *normal, double *gap, double *distance,
-              double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
-              const i64 *fnodes, const double *axis);
+              const void *tree, double rmax, i64 npts, const double *x, double radius,
+              const i64 *index, i64 *facet, double *oxi, double *y, double *normal,
+              double *gap, double *distance, double *sliding, int mp, const i64 *pnodes,
+              const double *pnormal, int mf, const i64 *fnodes, const double *axis);
 """
 
 FLAGS = ("-O3", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")

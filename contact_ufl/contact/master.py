@@ -128,32 +128,32 @@ class MeshMaster:
             self._ring_flags = np.zeros((len(fans), 0), dtype=bool)
         if smoothed:
             self.nx += int(self.V.mesh.comm.allreduce(self._ring.shape[1], MPI.MAX))
-        self._columns: tuple[StackedLayout, np.ndarray, np.ndarray] | None = None
+        self._fixed: tuple[StackedLayout, np.ndarray] | None = None
 
     def candidates(self, layout: StackedLayout) -> MasterCandidates:
         """This rank's facets at the current displacement (collective with ``smoothed``)."""
         comm = self.V.mesh.comm
         current = self.current_nodes()
-        flags = np.zeros((len(current), 0), dtype=np.int64)
         if self.smoothed:  # carry the neighbour nodes of every facet along
             global_nodes = self.global_nodes.astype(np.int64)
             ring = gathered_node_positions(comm, global_nodes, current, self._ring)
             current = np.concatenate([current, ring], axis=1)
-            flags = self._ring_flags.astype(np.int64)
-        columns, keys = self._columns_and_keys(layout)
-        return MasterCandidates(current, columns, keys, self.boundary_edges, flags)
+        return MasterCandidates(current, self._table(layout))
 
-    def _columns_and_keys(self, layout: StackedLayout) -> tuple[np.ndarray, np.ndarray]:
-        """The columns of the facets' carried nodes in ``layout`` and their vertex keys
-        (``int64``): fixed by the mesh, made once per layout."""
-        if self._columns is None or self._columns[0] is not layout:
+    def _table(self, layout: StackedLayout) -> np.ndarray:
+        """The fixed data of the facets side by side (:class:`MasterCandidates`): made once
+        per layout."""
+        if self._fixed is None or self._fixed[0] is not layout:
             global_nodes = self.global_nodes.astype(np.int64)
+            flags = np.zeros((len(global_nodes), 0), dtype=np.int64)
             if self.smoothed:
                 global_nodes = np.hstack([global_nodes, self._ring])
+                flags = self._ring_flags.astype(np.int64)
             bs = self.V.dofmap.index_map_bs
             columns = layout.from_block_global(self.block, global_nodes * bs)
-            self._columns = (layout, columns, self.keys.astype(np.int64))
-        return self._columns[1], self._columns[2]
+            keys, boundary = self.keys.astype(np.int64), self.boundary_edges.astype(np.int64)
+            self._fixed = (layout, np.hstack([columns, keys, boundary, flags]))
+        return self._fixed[1]
 
     def _build(self) -> None:
         mesh = self.V.mesh
@@ -443,7 +443,8 @@ def gathered_node_positions(
 
 @dataclass
 class MasterCandidates:
-    """The master facets of one rank, as the search exchanges them.
+    """The master facets of one rank, as the search exchanges them: their current nodes and
+    a table of their fixed data.
 
     Attributes
     ----------
@@ -451,22 +452,26 @@ class MasterCandidates:
         Current positions of the gathered nodes of each facet, ``(nf, nx, gdim)``: the facet's
         own ``nn`` nodes first, then (smoothed normal) in 2D the nodes before and after it,
         in 3D the fans of its nodes (:func:`node_fans`).
-    columns
-        Stacked index of the first displacement unknown of each gathered node, ``(nf, nx)``.
-    keys
-        Rank-independent keys of the facets (tie-break), ``(nf, nn)``.
-    boundary
-        Which facet edges lie on the boundary of the master surface, ``(nf, ne)``.
-    flags
-        (smoothed normal, 2D) whether the neighbour before / after exists, ``(nf, 2)``, else
-        ``(nf, 0)``.
+    table
+        The fixed data of each facet side by side, ``int64`` ``(nf, nx + nv + ne + nflags)``
+        (its parts: :func:`table_parts`): the stacked index of the first displacement
+        unknown of each gathered node (``columns``, ``nx``), the rank-independent keys of the
+        facet (tie-break: its sorted vertex input indices, ``keys``, ``nv``), which of its
+        edges lie on the boundary of the master surface (``boundary``, ``ne``) and (smoothed
+        normal, 2D) whether the neighbour before / after exists (``flags``, 2; else none).
     """
 
     nodes: np.ndarray
-    columns: np.ndarray
-    keys: np.ndarray
-    boundary: np.ndarray
-    flags: np.ndarray
+    table: np.ndarray
+
+
+def table_parts(table: np.ndarray, nx: int, nv: int) -> tuple[np.ndarray, ...]:
+    """The columns, keys, boundary edges (``bool``) and flags (``bool``) of the rows of a
+    table of :class:`MasterCandidates` (``nx`` gathered nodes and ``nv`` vertices a facet)."""
+    ne = len(FACET_EDGES[nv])
+    columns, keys = table[:, :nx], table[:, nx : nx + nv]
+    boundary = table[:, nx + nv : nx + nv + ne].astype(bool)
+    return columns, keys, boundary, table[:, nx + nv + ne :].astype(bool)
 
 
 def smoothed_normals(xi: np.ndarray, nodes: np.ndarray, flags: np.ndarray) -> np.ndarray:

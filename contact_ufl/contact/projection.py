@@ -4,8 +4,8 @@ Every facet kind (segments, triangles, bilinear quadrilaterals, and the quadrati
 segments, 6-node triangles and 9-node quadrilaterals) is searched by a compiled kernel
 (``search_kernel.c``, built on first use by :mod:`.compiled`): a bounding-volume hierarchy
 over the facets walked by branch and bound per point, with the exact projections of the
-NumPy kernels below (and of :mod:`.curved`) in C; the tie-break between equidistant facets
-stays in NumPy (:func:`_select`). ``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search
+NumPy kernels below (and of :mod:`.curved`) and the tie-break between equidistant facets
+(:func:`_select`) in C. ``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search
 (plus :class:`scipy.spatial.cKDTree` for the
 candidates), vectorised over points and facets: the only Python loops run over a fixed small
 number of items (nodes, edges and coordinates of a facet, Newton iterations, blocks of points,
@@ -66,7 +66,6 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-from contact_ufl import keysets
 from contact_ufl.contact import compiled
 from contact_ufl.contact.curved import (
     CURVED_EDGES,
@@ -146,7 +145,6 @@ _COMPILED_KINDS = {
     "triangle6": 4,
     "quadrilateral9": 5,
 }
-_CAP = 4  # pairs per point returned by the compiled query (more: that point is queried again)
 NON_FINITE = "{what} of the closest-point search hold non-finite values (NaN or infinity)"
 
 
@@ -535,26 +533,6 @@ def _bilinear(X: list[list[FloatArray]]) -> list[list[FloatArray]]:
     ]
 
 
-class _Facets:
-    """The per-facet data that the selection (:func:`_select`) needs, of some facets: their
-    nodes, centroids, radii ``R_f`` and (quadrilaterals) bilinear coefficients, computed as
-    :class:`_Master` computes them."""
-
-    def __init__(self, nodes: FloatArray) -> None:
-        self.nodes = nodes
-        self.nf, self.nn, self.gdim = nodes.shape
-        self.kind = facet_kind(self.nn, self.gdim)
-        # of a quadratic facet, the centroid and radius of its Bernstein control points
-        hull = bernstein_hull(self.kind, nodes) if self.kind in QUADRATIC else nodes
-        X = [
-            [np.ascontiguousarray(hull[:, a, k]) for k in range(self.gdim)] for a in range(self.nn)
-        ]
-        c, _, self.size = _centroid_radius(X)
-        self.centroid = np.stack(c, axis=1)
-        if self.kind == "quadrilateral":
-            self.bilinear = _bilinear(X)
-
-
 class _Hierarchy:
     """A bounding-volume hierarchy (axis-aligned boxes) over master facets, in C.
 
@@ -637,44 +615,29 @@ class _Hierarchy:
         self,
         x: FloatArray,
         radius: float,
-        cap: int,
+        out: Projection,
         rule: tuple | None = None,
-        out: Projection | None = None,
         index: IntArray | None = None,
-    ) -> tuple[IntArray, IntArray, IntArray, _Pairs]:
-        """The pairs of each point ``x`` (C-contiguous) within the tie reach of its closest
-        facet (at most ``cap`` a point): their number per point (``npts``), and a row for
-        each point with pairs (``rows``, in the order the walks end): its point, its facets
-        ``(rows, cap)`` and their projections ``(rows, cap)``; ``rule``: the arrays of a
-        self-contact search (point nodes, point normals, facet nodes, facet centre normals).
-        ``out``: a :class:`Projection` (C-contiguous fields) in which each point with one
-        pair gets its closest point, at its row of ``index`` (its count set to 0 if it is
-        beyond ``radius``), and no row (the rows written are the first ones of arrays for
-        all the points: the memory pages of the others are never touched)."""
-        npts, fdim = x.shape[0], self.gdim - 1
-        count = np.zeros(npts, dtype=np.int64)
-        point = np.empty(npts, dtype=np.int64)
-        written = np.zeros(1, dtype=np.int64)
-        f = np.empty((npts, cap), dtype=np.int64)
-        xi = np.empty((npts, cap, fdim))
-        dist = np.empty((npts, cap))
-        edge = np.empty((npts, cap), dtype=np.int64)
-        vertex = np.empty((npts, cap), dtype=np.uint8)
+    ) -> None:
+        """The closest point of each point ``x`` (C-contiguous) written to ``out`` (a
+        :class:`Projection` of C-contiguous fields) at its row of ``index`` (its own row
+        without): of the facets whose exact distance is within the tie reach of the smallest
+        one, the one of the tie-break of :func:`_select` (in C); the placeholders where that
+        point is beyond ``radius``, the row left as it is where no facet is within it.
+        ``rule``: the arrays of a self-contact search (point nodes, point normals, facet
+        nodes, facet centre normals)."""
         p = self._pointers
         null = self.ffi.NULL
-        final = [null] * 8
-        if out is not None:
-            rows = null if index is None else _ptr(self, index)
-            final = [rows, *p(out.facet, out.xi, out.y, out.normal, out.gap, out.distance)]
-            final.append(_ptr(self, out.sliding))
+        rows = null if index is None else _ptr(self, index)
+        fields = p(out.facet, out.xi, out.y, out.normal, out.gap, out.distance, out.sliding)
         contact = [0, null, null, 0, null, null]
         if rule is not None:
             pn, pnormal, fn, axis = rule
             contact = [pn.shape[1], *p(pn, pnormal), fn.shape[1], *p(fn, axis)]
         status = self.lib.bvh_query(
             self.kind, self.gdim, self.nn, *p(self.leaf_nodes, self.perm), self.m,
-            _ptr(self, self.tree), self.R_max, npts, _ptr(self, x), radius, cap,
-            *p(count, f, xi, dist, edge, vertex, point, written), *final, *contact,
+            _ptr(self, self.tree), self.R_max, len(x), _ptr(self, x), radius, rows, *fields,
+            *contact,
         )  # fmt: skip
         if status == -1:
             raise MemoryError("the compiled closest-point search ran out of memory")
@@ -687,9 +650,6 @@ class _Hierarchy:
             raise ValueError(f"no compiled search for {self.nn}-node facets in {self.gdim}D")
         #: exact projections made by the last query (the work of its pruning)
         self.projections = int(status)
-        r = int(written[0])
-        pairs = _Pairs(xi=xi[:r], dist=dist[:r], edge=edge[:r], vertex=vertex[:r].view(bool))
-        return count, point[:r], f[:r], pairs
 
 
 def _ptr(h: _Hierarchy, array: np.ndarray):
@@ -1463,9 +1423,10 @@ def closest_points(
     when the walk is done, and only if the bounds of its distance from its chord facet (the
     straight facet of its vertices, within a distance fixed by its midpoint nodes of it)
     do not rule it out: by increasing lower bound, the bound tightened by the distances
-    found. A point with one facet within that reach gets its closest point, normal,
-    proximity and ``M`` from C; the points with several go through the NumPy tie-break
-    below. Self-contact: the inadmissible facets are skipped in the walk (the same rule).
+    found. Of the facets within that reach the tie-break below picks one (in C, in the
+    operations of the NumPy search), and its closest point, normal, proximity and ``M``
+    come from C too. Self-contact: the inadmissible facets are skipped in the walk (the
+    same rule).
 
     Candidate search with ``CONTACT_UFL_SEARCH=numpy``:
     KD-trees of the facet centroids (the mean of the nodes; of a quadratic facet, of its
@@ -1568,10 +1529,9 @@ def _search_compiled(
     """Fill ``out`` with the closest points of :func:`closest_points` (checked input) by
     the compiled search: a branch-and-bound walk of a bounding-volume hierarchy per point
     (``search_kernel.c``) finds its closest facet and those within the tie reach of it (the
-    exact projections of the NumPy kernels, in C). A point with one facet there gets its
-    closest point from C; :func:`_select` picks among the others' pairs (the tie-break).
-    On a master of over ``_SORT`` facets the points are walked in a Z-order of cells
-    (:meth:`_Hierarchy.order`)."""
+    exact projections of the NumPy kernels, in C), breaks the ties as :func:`_select` does
+    and writes the closest point. On a master of over ``_SORT`` facets the points are walked
+    in a Z-order of cells (:meth:`_Hierarchy.order`)."""
     nodes = np.ascontiguousarray(nodes)
     tree = trees.hierarchy(nodes)
     rule = None if self_contact is None else _self_contact_arrays(self_contact, nodes)
@@ -1579,22 +1539,7 @@ def _search_compiled(
     x = np.ascontiguousarray(points if order is None else points[order])
     if rule is not None and order is not None:
         rule = (rule[0][order], rule[1][order], rule[2], rule[3])
-    # the points with one facet within the tie reach get their closest point in C
-    count, point, f, pairs = tree.query(x, radius, _CAP, rule, out, order)
-    rows, fid, pairs = _tied_pairs(tree, x, radius, rule, count, point, f, pairs)
-    if rows.size == 0:
-        return
-    pid = rows if order is None else order[rows]
-    # the selection over the facets met only (their data computed as _Master does)
-    facets, local = np.unique(fid, return_inverse=True)
-    tied = keysets.unique(pid)
-    part = Projection(*(getattr(out, k)[tied] for k in _FIELDS))
-    _select(_Facets(nodes[facets]), points[tied], radius, part, np.searchsorted(tied, pid),
-            local, pairs)  # fmt: skip
-    paired = part.facet >= 0
-    part.facet[paired] = facets[part.facet[paired]]
-    for k in _FIELDS:
-        getattr(out, k)[tied] = getattr(part, k)
+    tree.query(x, radius, out, rule, order)
 
 
 def _search(
@@ -1658,38 +1603,3 @@ def _self_contact_arrays(rule: SelfContact, nodes: FloatArray) -> tuple[np.ndarr
             (axis, np.float64),
         )
     )
-
-
-def _tied_pairs(
-    tree: _Hierarchy,
-    x: FloatArray,
-    radius: float,
-    rule: tuple | None,
-    count: IntArray,
-    point: IntArray,
-    f: IntArray,
-    pairs: _Pairs,
-) -> tuple[IntArray, IntArray, _Pairs]:
-    """The pairs of the points ``x`` with several facets within the tie reach (``count``,
-    ``point``, ``f``, ``pairs``: the query's result, at most ``_CAP`` a point; the points
-    with more queried again with room for all): point rows, facets and projections."""
-    fields = ("xi", "dist", "edge", "vertex")
-    several = np.flatnonzero(count[point] > 1)
-    kept = np.arange(_CAP) < count[point[several], None]
-    rows, fid = point[several][np.nonzero(kept)[0]], f[several][kept]
-    pairs = _Pairs(*(getattr(pairs, k)[several][kept] for k in fields))
-    more = np.flatnonzero(count > _CAP)
-    if more.size:
-        cap = int(count[more].max())
-        sub = None if rule is None else (rule[0][more], rule[1][more], rule[2], rule[3])
-        x_more = np.ascontiguousarray(x[more])
-        count_m, point_m, f_m, pairs_m = tree.query(x_more, radius, cap, sub)
-        kept_m = np.arange(cap) < count_m[point_m, None]
-        keep = np.flatnonzero(count[rows] <= _CAP)
-        rows = np.concatenate([rows[keep], more[point_m[np.nonzero(kept_m)[0]]]])
-        fid = np.concatenate([fid[keep], f_m[kept_m]])
-        pairs = _concatenate(
-            _Pairs(*(getattr(pairs, k)[keep] for k in fields)),
-            _Pairs(*(getattr(pairs_m, k)[kept_m] for k in fields)),
-        )
-    return rows, fid, pairs

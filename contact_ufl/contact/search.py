@@ -23,7 +23,12 @@ from mpi4py import MPI
 
 from contact_ufl.contact import compiled
 from contact_ufl.contact.facets import on_edges
-from contact_ufl.contact.master import MeshMaster, smoothed_normals, smoothed_normals_3d
+from contact_ufl.contact.master import (
+    MeshMaster,
+    smoothed_normals,
+    smoothed_normals_3d,
+    table_parts,
+)
 from contact_ufl.contact.projection import (
     Projection,
     SelfContact,
@@ -77,6 +82,51 @@ class Pairing:
         return self.projection.facet >= 0
 
 
+@dataclass
+class Candidates:
+    """The fixed data of the candidate facets a rank received, in the search order (that of
+    their vertex keys: rank-independent, so that ties between equidistant facets break the
+    same way on any number of ranks).
+
+    Attributes
+    ----------
+    table
+        The rows received (of :class:`~contact_ufl.contact.master.MasterCandidates`'s
+        table), in the order received.
+    order
+        The search order of the received rows.
+    keys, boundary, flags
+        Their vertex keys, boundary edges and (smoothed normal, 2D) neighbour flags, in the
+        search order.
+    gather
+        The stacked index of the unknown of every coordinate of every gathered node,
+        ``(ncand, nx, gdim)``.
+    fans, counts
+        The fan columns (:func:`fan_columns`) of each candidate and their numbers (the rest
+        of a row is ``-1``).
+    """
+
+    table: np.ndarray
+    order: np.ndarray
+    keys: np.ndarray
+    boundary: np.ndarray
+    flags: np.ndarray
+    gather: np.ndarray
+    fans: np.ndarray
+    counts: np.ndarray
+
+    @classmethod
+    def of(cls, table: np.ndarray, nx: int, nv: int, nn: int, gdim: int) -> Candidates:
+        """The data of the received rows ``table`` (``nx`` gathered nodes, ``nv`` vertices,
+        ``nn`` nodes a facet, in ``gdim``)."""
+        order = np.lexsort(table[:, nx : nx + nv].T[::-1])
+        columns, keys, boundary, flags = table_parts(table[order], nx, nv)
+        fans = fan_columns(columns, nn, np.arange(len(columns)))
+        counts = np.count_nonzero(fans >= 0, axis=1)
+        gather = columns[:, :, None] + np.arange(gdim)
+        return cls(table.copy(), order, keys, boundary, flags, gather, fans, counts)
+
+
 class ClosestPointSearch:
     """Closest points of the slave points of a pair on its meshed master surface.
 
@@ -112,8 +162,7 @@ class ClosestPointSearch:
         self.time = 0.0
         #: search trees of the master facets, reused from one search to the next
         self.trees = TreeCache()
-        self._order: tuple[np.ndarray, np.ndarray] | None = None
-        self._fans: tuple[np.ndarray, np.ndarray] | None = None
+        self._candidates: Candidates | None = None
         # the compiled kernel on every rank now: a rank with no slave points never builds
         # it, so a build error would otherwise be raised on the searching ranks only
         if self.comm.allreduce(_compiled(master.nn, self.gdim), MPI.LOR):
@@ -122,18 +171,23 @@ class ClosestPointSearch:
     def exchange(self, master_nodes: np.ndarray, points: np.ndarray, payload=None):
         """Master facets of all ranks near this rank's ``points`` (bounding-box filter).
 
-        Returns the received facet nodes and their ``payload`` rows (on one rank with
-        every facet near: the arguments themselves). Raises a
-        ``ValueError`` on every rank if a rank's points or master nodes are not all finite
-        (the search would pair them silently).
+        Returns the received facet nodes and their ``payload`` rows (on one rank the
+        arguments themselves: nothing to send, and the search skips the far facets itself).
+        Raises a ``ValueError`` on every rank if a rank's points or master nodes are not all
+        finite (the search would pair them silently).
         """
         comm = self.comm
-        box = self.slave.bounding_box(points, comm)
         n = len(master_nodes)
         payload = np.zeros((n, 0)) if payload is None else payload
+        if comm.size == 1:  # nothing to send: the search skips the far facets itself
+            problem = _non_finite(points, master_nodes.reshape(n, -1))
+            if problem is not None:
+                raise ValueError(f"{problem} (on rank 0)")
+            return master_nodes, payload
+        box = self.slave.bounding_box(points, comm)
         if n:
             lo, hi = _node_bounds(master_nodes)
-        problem = _non_finite(points, lo if n else None, hi if n else None)
+        problem = _non_finite(points, np.concatenate([lo, hi], axis=1) if n else None)
         problem = None if problem is None else f"{problem} (on rank {comm.rank})"
         gathered = comm.allgather((box, problem))
         problems = [p for _, p in gathered if p is not None]
@@ -149,35 +203,20 @@ class ClosestPointSearch:
                 sends.append((master_nodes, payload))
             else:
                 sends.append((master_nodes[near], payload[near]))
-        if comm.size == 1:
-            return sends[0]
         received = comm.alltoall(sends)
         nodes = np.concatenate([r[0] for r in received]).reshape(-1, *master_nodes.shape[1:])
         data = np.concatenate([r[1] for r in received]).reshape(len(nodes), *payload.shape[1:])
         return nodes, data
 
-    def order(self, keys: np.ndarray) -> np.ndarray:
-        """The order of the received candidate facets by their vertex ``keys`` (a
-        rank-independent order: ties between equidistant facets break the same way on any
-        number of ranks); that of the last search while the keys are the same."""
-        if self._order is not None and np.array_equal(self._order[0], keys):
-            return self._order[1]
-        order = np.lexsort(keys.T[::-1])
-        self._order = (keys.copy(), order)
-        return order
-
-    def fans(self, columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The fan columns (:func:`fan_columns`) of every candidate facet of the gathered
-        ``columns`` and their numbers (the rest of a row is ``-1``): those of the last
-        search while its candidates are the same (the same columns in the same order, as on
-        one rank and whenever the exchange sends the same facets), else anew."""
-        if self._fans is not None and np.array_equal(self._fans[0], columns):
-            return self._fans[1], self._fans[2]
-        nn = self.master.nn
-        fans = fan_columns(columns, nn, np.arange(len(columns)))
-        counts = np.count_nonzero(fans >= 0, axis=1)
-        self._fans = (columns.copy(), fans, counts)
-        return fans, counts
+    def candidates(self, table: np.ndarray) -> Candidates:
+        """The fixed data of the received candidate facets (their rows of the master's
+        :class:`~contact_ufl.contact.master.MasterCandidates` table) in the search order:
+        those of the last search while the same rows are received in the same order (on one
+        rank, always), else anew."""
+        if self._candidates is None or not np.array_equal(self._candidates.table, table):
+            self._candidates = Candidates.of(table, self.master.nx, self.master.nv,
+                                             self.master.nn, self.gdim)  # fmt: skip
+        return self._candidates
 
     def check_facing(self, description: str) -> None:
         """Raise (on every rank) if no slave point faces the master surface in the reference
@@ -231,32 +270,26 @@ class ClosestPointSearch:
             ``master.block``).
         """
         start = time.perf_counter()
-        gdim, nn, nx = self.gdim, self.master.nn, self.master.nx
-        nk = self.master.nv  # the keys of a facet: its vertices
+        gdim, nn = self.gdim, self.master.nn
         points = self.slave.positions(u).reshape(-1, gdim)
         mine = self.master.candidates(layout)
-        ne = mine.boundary.shape[1]
-        payload = np.hstack([mine.columns, mine.keys, mine.boundary.astype(np.int64), mine.flags])
-        nodes, payload = self.exchange(mine.nodes, points, payload)
-        # candidates in a rank-independent order: ties between facets break the same way
-        order = self.order(payload[:, nx : nx + nk])
-        nodes, payload = nodes[order], payload[order]
-        columns = payload[:, :nx]
-        boundary = payload[:, nx + nk : nx + nk + ne].astype(bool)
+        nodes, table = self.exchange(mine.nodes, points, mine.table)
+        candidates = self.candidates(table)
+        nodes = np.take(nodes, candidates.order, axis=0)
         rule = None
         if self.self_contact:  # the current normals only where the rule needs them
-            rule = self._self_contact(payload[:, nx : nx + nk], self.slave.current_normals(u))
+            rule = self._self_contact(candidates.keys, self.slave.current_normals(u))
         proj = closest_points(points, nodes[:, :nn], self.radius, self.trees, rule)
         if rule is not None:
             release_beside_own_facet(proj, points, rule, self.touching)
             release_master_side(proj, rule)
-        release_beyond_boundary(proj, points, boundary, self.touching)
+        release_beyond_boundary(proj, points, candidates.boundary, self.touching)
         paired = proj.facet >= 0
         flags = None
         if self.master.smoothed:
             facet_nodes = nodes[proj.facet[paired]]
             if gdim == 2:
-                facet_flags = payload[proj.facet[paired], nx + nk + ne :].astype(bool)
+                facet_flags = candidates.flags[proj.facet[paired]]
                 normal = smoothed_normals(proj.xi[paired], facet_nodes, facet_flags)
                 flags = np.zeros((len(points), 2))
                 flags[paired] = facet_flags
@@ -265,20 +298,21 @@ class ClosestPointSearch:
             proj.normal[paired] = normal
             proj.gap[paired] = -np.einsum("pd,pd->p", normal, points[paired] - proj.y[paired])
         gathered = _at_points(nodes, proj.facet, paired, 0.0)
-        gather = _at_points(columns[:, :, None] + np.arange(gdim), proj.facet, paired, -1)
-        fans, counts = self.fans(columns)
-        width = counts[proj.facet[paired]].max(initial=0)  # the rest of the rows is -1
-        neighbourhood = _at_points(fans[:, :width], proj.facet, paired, -1)
+        gather = _at_points(candidates.gather, proj.facet, paired, -1)
+        width = candidates.counts[proj.facet[paired]].max(initial=0)  # the rest of a row: -1
+        neighbourhood = _at_points(candidates.fans[:, :width], proj.facet, paired, -1)
         self.time += time.perf_counter() - start
         return Pairing(points, proj, gathered, gather, flags, neighbourhood)
 
 
 def _at_points(rows: np.ndarray, facet: np.ndarray, paired: np.ndarray, fill) -> np.ndarray:
-    """``rows[facet]`` at the ``paired`` points, ``fill`` at the others (an integer take:
-    faster than an assignment through the mask)."""
+    """``rows[facet]`` at the ``paired`` points, ``fill`` at the others (``np.take``: several
+    times faster than indexing)."""
     if len(rows) == 0:
         return np.full((len(facet), *rows.shape[1:]), fill, dtype=rows.dtype)
-    out = rows[np.where(paired, facet, 0)]
+    if paired.all():
+        return np.take(rows, facet, axis=0)
+    out = np.take(rows, np.where(paired, facet, 0), axis=0)
     out[~paired] = fill
     return out
 
@@ -302,14 +336,14 @@ def _node_bounds(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def _non_finite(points: np.ndarray, lo: np.ndarray | None, hi: np.ndarray | None) -> str | None:
+def _non_finite(points: np.ndarray, nodes: np.ndarray | None) -> str | None:
     """The message naming what is not finite among a rank's slave ``points`` and its master
-    facets' node bounds ``lo``, ``hi`` (a NaN or infinite node makes its facet's bound
-    non-finite), or ``None``."""
+    facets' ``nodes`` (a row a facet: its nodes, or the bounds of its nodes, which a NaN or
+    infinite node makes non-finite), or ``None``."""
     if not np.isfinite(points).all():
         return non_finite("the slave points", points)
-    if lo is not None and not (np.isfinite(lo).all() and np.isfinite(hi).all()):
-        return non_finite("the master nodes", np.concatenate([lo, hi], axis=1))
+    if nodes is not None and not np.isfinite(nodes).all():
+        return non_finite("the master nodes", nodes)
     return None
 
 

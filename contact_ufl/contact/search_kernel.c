@@ -1272,14 +1272,14 @@ typedef struct {
     double key; /* q.dist once projected; before, a lower bound of it (a deferred facet) */
 } hit_t;
 
-/* The closest point of x on the facet X at q.xi and what projection._select computes of it:
- * y (g), the unit normal nu (g), gap -nu . (x - y), distance |x - y| and the linearisation
- * M (fdim, fdim; projection._sliding). Returns whether the distance is within radius. */
-INLINE int finish(int kind, int g, int nn, const double *X, const double *x, const pair_t *q,
-                  double radius, double *y, double *nu, double *gap, double *distance,
-                  double *M)
+/* The closest point y (g) of x on the facet X at q.xi as projection._select computes it, with
+ * r = x - y, the unit normal nu (g; zero on a degenerate facet), the tangents a and (a
+ * quadratic facet) the second derivatives d2N of the shape functions. Returns |x - y|. */
+INLINE double closest_point(int kind, int g, int nn, const double *X, const double *x,
+                            const pair_t *q, double *y, double *r, double *nu, double (*a)[3],
+                            double (*d2N)[2][9])
 {
-    double N[9], dN[2][9], d2N[2][2][9], a[2][3] = {{0.0}}, r[3];
+    double N[9], dN[2][9];
     int fdim = g - 1;
     if (kind >= 3) {
         quadratic_shape(kind, q->xi, N, dN, d2N);
@@ -1322,14 +1322,27 @@ INLINE int finish(int kind, int g, int nn, const double *X, const double *x, con
         n3[2] = a[0][0] * a[1][1] - a[0][1] * a[1][0];
     }
     for (int k = 0; k < g; k++) len2 += n3[k] * n3[k];
-    double len = sqrt(len2), rr = 0.0, nr = 0.0;
+    double len = sqrt(len2), rr = 0.0;
     for (int k = 0; k < g; k++) {
         nu[k] = len > 0 ? n3[k] / len : 0.0;
         rr += r[k] * r[k];
-        nr += nu[k] * r[k];
     }
-    *distance = sqrt(rr);
+    return sqrt(rr);
+}
+
+/* The closest point of x on the facet X at q.xi and what projection._select computes of it:
+ * y (g), the unit normal nu (g), gap -nu . (x - y), distance |x - y| and the linearisation
+ * M (fdim, fdim; projection._sliding). Returns whether the distance is within radius. */
+INLINE int finish(int kind, int g, int nn, const double *X, const double *x, const pair_t *q,
+                  double radius, double *y, double *nu, double *gap, double *distance,
+                  double *M)
+{
+    double d2N[2][2][9], a[2][3] = {{0.0}}, r[3];
+    int fdim = g - 1;
+    *distance = closest_point(kind, g, nn, X, x, q, y, r, nu, a, d2N);
     if (!(*distance <= radius)) return 0;
+    double nr = 0.0;
+    for (int k = 0; k < g; k++) nr += nu[k] * r[k];
     *gap = -nr;
     /* the curvature terms (x - y) . d2y/dxi_a dxi_b of a quadratic facet */
     double curv[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
@@ -1484,10 +1497,7 @@ typedef struct {
     const node_t *T;
     i64 m;
     double rmax, radius;
-    int cap, mp, mf;
-    i64 *count, *f, *edge, *point, used;
-    double *xi, *dist;
-    unsigned char *vertex;
+    int mp, mf;
     const i64 *index;
     i64 *facet;
     double *oxi, *y, *normal, *gap, *distance, *sliding;
@@ -1515,7 +1525,6 @@ INLINE void start(int g, const query_t *Q, lane_t *L, i64 p)
     W->best = INFINITY;
     W->bound = reach(Q->radius, Q->rmax);
     W->bound2 = W->bound * W->bound;
-    Q->count[p] = 0;
     if (Q->m == 0) return;
     double root[WIDE];
     row_distance2(g, Q->T + Q->m, Q->x + p * g, root);
@@ -1611,8 +1620,76 @@ INLINE void resolve(int kind, int g, int nn, const query_t *Q, lane_t *L)
     }
 }
 
-/* The results of the point of lane L, its walk done: its count, and its pairs at the next
- * row or its closest point (see bvh_query). */
+/* The centroid c (g) and the radius R_f (the largest distance from it) of the hull points
+ * of the facet X, in the operations of projection._centroid_radius. */
+INLINE double centroid_radius(int kind, int g, int nn, const double *X, double *c)
+{
+    double H[27];
+    const double *P = hull(kind, g, X, H);
+    for (int k = 0; k < g; k++) {
+        double s = P[k] + P[g + k];
+        for (int q = 2; q < nn; q++) s += P[q * g + k];
+        c[k] = s / nn;
+    }
+    double r2max = 0.0;
+    for (int q = 0; q < nn; q++) {
+        double r2 = 0.0;
+        for (int k = 0; k < g; k++) {
+            double d = P[q * g + k] - c[k];
+            r2 += d * d;
+        }
+        r2max = q == 0 || r2 > r2max ? r2 : r2max;
+    }
+    return sqrt(r2max);
+}
+
+/* The hit of the closest point of x among the hits within bound (nh of them, k > 0 within
+ * bound): those within the tie tolerance of the smallest distance dmin (dmin + TIE (dmin +
+ * 2 R_f)), and of several of them the one whose normal is the most aligned with x - y,
+ * then the one of the nearer centroid, then the one of the lower facet index (perm): the
+ * tie-break of projection._select and _tie_break, in their operations. */
+#define TIE 1e-10 /* projection._TIE */
+INLINE i64 tie_break(int kind, int g, int nn, const query_t *Q, const walk_t *W,
+                     const double *xp)
+{
+    const hit_t *hits = W->hits;
+    double dmin = INFINITY;
+    for (i64 h = 0; h < W->nh; h++)
+        if (hits[h].q.dist <= W->bound && hits[h].q.dist < dmin) dmin = hits[h].q.dist;
+    i64 won = -1;
+    double best_align = 0.0, best_c2 = 0.0;
+    int tied = 0;
+    for (i64 h = 0; h < W->nh; h++) {
+        const hit_t *H = hits + h;
+        if (!(H->q.dist <= W->bound)) continue;
+        const double *X = Q->leaf_nodes + H->j * nn * g;
+        double c[3];
+        double size = centroid_radius(kind, g, nn, X, c);
+        if (!(H->q.dist <= dmin + TIE * (dmin + 2.0 * size))) continue;
+        double y[3], r[3], nu[3], a[2][3], d2N[2][2][9], nr = 0.0, c2 = 0.0;
+        double dist = closest_point(kind, g, nn, X, xp, &H->q, y, r, nu, a, d2N);
+        for (int k = 0; k < g; k++) {
+            nr += nu[k] * r[k];
+            c[k] = xp[k] - c[k];
+            c2 += c[k] * c[k];
+        }
+        double align = dist > 0 ? fabs(nr) / dist : 0.0;
+        tied++;
+        if (won < 0 || align > best_align ||
+            (align == best_align &&
+             (c2 < best_c2 || (c2 == best_c2 && Q->perm[H->j] < Q->perm[hits[won].j])))) {
+            won = h;
+            best_align = align;
+            best_c2 = c2;
+        }
+    }
+    return won;
+}
+
+/* The results of the point of lane L, its walk done: where a facet is within reach(radius),
+ * its closest point (of the facet chosen by tie_break among several) at row index[p] (p if
+ * index is NULL); the placeholders where that point is beyond radius, nothing else where
+ * there is none. */
 INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
 {
     const int fdim = g - 1;
@@ -1626,24 +1703,8 @@ INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
             last = h;
             k++;
         }
-    Q->count[p] = k;
     if (k == 0) return;
-    if (k > 1 || !Q->y) {
-        /* the pairs, at the next row */
-        Q->point[Q->used] = p;
-        for (i64 h = 0, c = 0; h < nh && c < Q->cap; h++) {
-            if (hits[h].q.dist > bound) continue;
-            i64 o = Q->used * Q->cap + c++;
-            Q->f[o] = Q->perm[hits[h].j];
-            for (int j = 0; j < fdim; j++) Q->xi[o * fdim + j] = hits[h].q.xi[j];
-            Q->dist[o] = hits[h].q.dist;
-            Q->edge[o] = hits[h].q.edge;
-            Q->vertex[o] = (unsigned char)hits[h].q.vertex;
-        }
-        Q->used++;
-        return;
-    }
-    /* one facet within the tie reach: the closest point, no tie-break */
+    if (k > 1) last = tie_break(kind, g, nn, Q, W, xp);
     const pair_t *q = &hits[last].q;
     const double *X = Q->leaf_nodes + hits[last].j * nn * g;
     i64 o = Q->index ? Q->index[p] : p;
@@ -1653,7 +1714,6 @@ INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
         for (int j = 0; j < fdim; j++) Q->oxi[o * fdim + j] = q->xi[j];
         return;
     }
-    Q->count[p] = 0;
     for (int c = 0; c < g; c++) { /* the placeholders of an unpaired point */
         y[c] = xp[c];
         normal[c] = 0.0;
@@ -1669,32 +1729,25 @@ INLINE void free_lanes(lane_t *L, int lanes)
     free(L);
 }
 
-/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: the facets whose
- * exact distance is within reach() of the smallest one, if that smallest one is within
- * reach(radius). count[p] is their number; up to cap of them are written at row r (r cap
- * to r cap + cap - 1) of f, xi (fdim per pair), dist, edge, vertex (projection._Pairs),
- * point[r] = p, *written the number of rows (the arrays' first rows only: the pages of the
- * others never touched), unless y is given and the count is 1: where one facet is within
- * that reach and y is not NULL, the fields of its closest point are written instead at row
- * index[p] (p if index is NULL) of facet, oxi, y, normal, gap, distance and sliding (a
- * projection.Projection; count set to 0 and the placeholders written if it is beyond
- * radius). Self-contact (pnodes not NULL): only the admissible facets, with pnodes (npts,
+/* For each point x[p] (npts, g), on the tree of bvh_build and bvh_refit: its closest point
+ * on the facets, if within radius, at row index[p] (p if index is NULL) of facet, oxi, y,
+ * normal, gap, distance and sliding (a projection.Projection, its placeholders written where
+ * a facet is within reach(radius) but its closest point beyond radius, untouched where none
+ * is): of the facets whose exact distance is within reach() of the smallest one, the one of
+ * tie_break. Self-contact (pnodes not NULL): only the admissible facets, with pnodes (npts,
  * m) the node numbers of each point's facet, pnormal (npts, g) its normal, fnodes (n, mf)
  * the facets' node numbers, axis (n, g) their centre normals. The points are walked LANES
- * at a time (surfaces; segments one at a time), a step of each by turns. Returns the number of exact projections made, -1 when
- * out of memory, -3 when the walk overflows its stack (a tree far deeper than a balanced
- * one); bvh_query -2 for an unknown facet kind. */
+ * at a time (surfaces; segments one at a time), a step of each by turns. Returns the number
+ * of exact projections made, -1 when out of memory, -3 when the walk overflows its stack (a
+ * tree far deeper than a balanced one); bvh_query -2 for an unknown facet kind. */
 INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
                  const void *tree, double rmax, i64 npts, const double *x, double radius,
-                 int cap, i64 *count, i64 *f, double *xi, double *dist, i64 *edge,
-                 unsigned char *vertex, i64 *point, i64 *written, const i64 *index,
-                 i64 *facet, double *oxi, double *y, double *normal, double *gap,
-                 double *distance, double *sliding, int mp, const i64 *pnodes,
+                 const i64 *index, i64 *facet, double *oxi, double *y, double *normal,
+                 double *gap, double *distance, double *sliding, int mp, const i64 *pnodes,
                  const double *pnormal, int mf, const i64 *fnodes, const double *axis)
 {
-    query_t Q = {leaf_nodes, x, perm, rows(tree), m, rmax, radius, cap, mp, mf,
-                 count, f, edge, point, 0, xi, dist, vertex, index, facet, oxi, y, normal,
-                 gap, distance, sliding, pnodes, fnodes, pnormal, axis};
+    query_t Q = {leaf_nodes, x, perm, rows(tree), m, rmax, radius, mp, mf, index, facet,
+                 oxi, y, normal, gap, distance, sliding, pnodes, fnodes, pnormal, axis};
     /* one lane for segments: their walks are short and their projections cheap, the turns
      * cost more than they save */
     const int lanes = g == 2 ? 1 : LANES;
@@ -1735,24 +1788,19 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
     i64 projected = 0;
     for (int l = 0; l < lanes; l++) projected += L[l].W.projected;
     free_lanes(L, lanes);
-    *written = Q.used;
     return projected;
 }
 
 i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
-              const void *tree, double rmax, i64 npts,
-              const double *x, double radius, int cap, i64 *count, i64 *f, double *xi,
-              double *dist, i64 *edge, unsigned char *vertex, i64 *point, i64 *written,
-              const i64 *index, i64 *facet,
-              double *oxi, double *y, double *normal, double *gap, double *distance,
-              double *sliding, int mp, const i64 *pnodes, const double *pnormal, int mf,
-              const i64 *fnodes, const double *axis)
+              const void *tree, double rmax, i64 npts, const double *x, double radius,
+              const i64 *index, i64 *facet, double *oxi, double *y, double *normal,
+              double *gap, double *distance, double *sliding, int mp, const i64 *pnodes,
+              const double *pnormal, int mf, const i64 *fnodes, const double *axis)
 {
     /* one copy of the walk per facet kind, its dimensions constant */
 #define QUERY(K, G, NN)                                                                     \
-    query(K, G, NN, leaf_nodes, perm, m, tree, rmax, npts, x, radius, cap, count, f, xi,   \
-          dist, edge, vertex, point, written, index, facet, oxi, y, normal, gap, distance, \
-          sliding, mp, pnodes, pnormal, mf, fnodes, axis)
+    query(K, G, NN, leaf_nodes, perm, m, tree, rmax, npts, x, radius, index, facet, oxi, y, \
+          normal, gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis)
     switch (kind) {
     case 0: return QUERY(0, 2, 2);
     case 1: return QUERY(1, 3, 3);

@@ -24,6 +24,7 @@ import basix
 import basix.ufl
 import dolfinx
 import numpy as np
+import scipy.sparse
 import ufl
 from mpi4py import MPI
 from scipy.spatial import cKDTree
@@ -243,8 +244,24 @@ class SlaveSurface:
     def displacement(self, u: dolfinx.fem.Function) -> np.ndarray:
         """Displacement at the quadrature points, ``(ncells, nq, gdim)``."""
         bs = self.V.dofmap.index_map_bs
-        values = u.x.array.reshape(-1, bs)[self._cell_dofs]  # (nc, ndofs, gdim)
-        return np.matmul(self._phi_u, values)  # (nc, nq, gdim); einsum is 5x slower here
+        values = self._interpolation @ u.x.array.reshape(-1, bs)  # (npoints, gdim)
+        return values.reshape(*self._phi_u.shape[:2], bs)
+
+    @functools.cached_property
+    def _interpolation(self) -> scipy.sparse.csr_array:
+        """The values of the displacement basis at the points, ``(npoints, nblocks)``: a
+        point's row holds those of its cell's dofs, in their cell order (zeros included, so
+        that a non-finite value anywhere in the cell reaches the point), so that ``P @ u``
+        sums as the cell's basis does; four to five times faster than gathering the cells'
+        values and multiplying per cell."""
+        nc, nq, nd = self._phi_u.shape
+        rows = np.repeat(np.arange(nc * nq), nd)
+        columns = np.repeat(self._cell_dofs, nq, axis=0).ravel()
+        blocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
+        P = scipy.sparse.csr_array((self._phi_u.ravel(), columns, np.arange(0, len(rows) + 1, nd)),
+                                   shape=(nc * nq, blocks))  # fmt: skip
+        P.has_sorted_indices = False  # keep the cell order: no sorting, no summing
+        return P
 
     def deformation_gradient(self, u: dolfinx.fem.Function) -> np.ndarray:
         """Deformation gradient at the quadrature points, ``(ncells, nq, gdim, gdim)``."""
