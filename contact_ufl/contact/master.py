@@ -128,6 +128,8 @@ class MeshMaster:
             self._ring_flags = np.zeros((len(fans), 0), dtype=bool)
         if smoothed:
             self.nx += int(self.V.mesh.comm.allreduce(self._ring.shape[1], MPI.MAX))
+            #: the rows of the ring's nodes in the facets' nodes of all ranks (fixed)
+            self._ring_rows = node_rows(self.V.mesh.comm, self.global_nodes, self._ring)
         self._fixed: tuple[StackedLayout, np.ndarray] | None = None
 
     def candidates(self, layout: StackedLayout) -> MasterCandidates:
@@ -135,8 +137,11 @@ class MeshMaster:
         comm = self.V.mesh.comm
         current = self.current_nodes()
         if self.smoothed:  # carry the neighbour nodes of every facet along
-            global_nodes = self.global_nodes.astype(np.int64)
-            ring = gathered_node_positions(comm, global_nodes, current, self._ring)
+            gdim = current.shape[-1]
+            everyone = current.reshape(-1, gdim)
+            if comm.size > 1:
+                everyone = np.concatenate(comm.allgather(everyone))
+            ring = everyone[self._ring_rows].reshape(*self._ring.shape, gdim)
             current = np.concatenate([current, ring], axis=1)
         return MasterCandidates(current, self._table(layout))
 
@@ -428,17 +433,13 @@ def _lookup(keys: np.ndarray):
     return find, bool(np.all(np.diff(ordered) != 0))
 
 
-def gathered_node_positions(
-    comm: MPI.Comm, global_nodes: np.ndarray, positions: np.ndarray, wanted: np.ndarray
-) -> np.ndarray:
-    """Positions of the nodes ``wanted`` (global indices, any shape) from the nodes
-    ``global_nodes`` with ``positions`` (``(..., gdim)``) of all ranks."""
-    gdim = positions.shape[-1]
+def node_rows(comm: MPI.Comm, global_nodes: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """The rows of the nodes ``wanted`` (global indices, any shape) in the nodes
+    ``global_nodes`` of all ranks, in rank order (one row per node and entry of
+    ``global_nodes``: the first that holds it), raveled."""
     keys = np.concatenate(comm.allgather(global_nodes.reshape(-1).astype(np.int64)))
-    values = np.concatenate(comm.allgather(positions.reshape(-1, gdim)))
     keys, first = np.unique(keys, return_index=True)
-    pos = np.searchsorted(keys, wanted.reshape(-1))
-    return values[first][pos].reshape(*wanted.shape, gdim)
+    return first[np.searchsorted(keys, wanted.reshape(-1))]
 
 
 @dataclass
@@ -477,20 +478,21 @@ def table_parts(table: np.ndarray, nx: int, nv: int) -> tuple[np.ndarray, ...]:
 def smoothed_normals(xi: np.ndarray, nodes: np.ndarray, flags: np.ndarray) -> np.ndarray:
     """NumPy twin of :func:`contact_ufl.contact.kinematics.smoothed_normal` for paired
     points: ``xi (n, 1)``, ``nodes (n, 4, 2)``, ``flags (n, 2)``; returns unit normals
-    ``(n, 2)``."""
-    a, b, before, after = (nodes[:, k] for k in range(4))
-    segment = b - a
-    incoming = np.where(flags[:, :1], a - before, segment)
-    outgoing = np.where(flags[:, 1:], after - b, segment)
+    ``(n, 2)`` (by coordinate columns: NumPy reduces rows of two numbers slowly)."""
+    a, b, before, after = ([nodes[:, k, d] for d in range(2)] for k in range(4))
+    segment = [b[d] - a[d] for d in range(2)]
+    incoming = [np.where(flags[:, 0], a[d] - before[d], segment[d]) for d in range(2)]
+    outgoing = [np.where(flags[:, 1], after[d] - b[d], segment[d]) for d in range(2)]
 
     def unit_perp(t):
-        perp = np.stack([t[:, 1], -t[:, 0]], axis=1)
-        return perp / np.linalg.norm(perp, axis=1, keepdims=True)
+        length = np.sqrt(t[1] * t[1] + t[0] * t[0])
+        return [t[1] / length, -t[0] / length]
 
-    n = (1.0 - xi) * (unit_perp(incoming) + unit_perp(segment)) + xi * (
-        unit_perp(segment) + unit_perp(outgoing)
-    )
-    return n / np.linalg.norm(n, axis=1, keepdims=True)
+    s, u = xi[:, 0], 1.0 - xi[:, 0]
+    ends = [unit_perp(incoming), unit_perp(segment), unit_perp(outgoing)]
+    n = [u * (ends[0][d] + ends[1][d]) + s * (ends[1][d] + ends[2][d]) for d in range(2)]
+    length = np.sqrt(n[0] * n[0] + n[1] * n[1])
+    return np.stack([n[0] / length, n[1] / length], axis=1)
 
 
 def fan_normals(nodes: np.ndarray, nn: int) -> np.ndarray:
