@@ -1658,7 +1658,6 @@ INLINE i64 tie_break(int kind, int g, int nn, const query_t *Q, const walk_t *W,
         if (hits[h].q.dist <= W->bound && hits[h].q.dist < dmin) dmin = hits[h].q.dist;
     i64 won = -1;
     double best_align = 0.0, best_c2 = 0.0;
-    int tied = 0;
     for (i64 h = 0; h < W->nh; h++) {
         const hit_t *H = hits + h;
         if (!(H->q.dist <= W->bound)) continue;
@@ -1674,7 +1673,6 @@ INLINE i64 tie_break(int kind, int g, int nn, const query_t *Q, const walk_t *W,
             c2 += c[k] * c[k];
         }
         double align = dist > 0 ? fabs(nr) / dist : 0.0;
-        tied++;
         if (won < 0 || align > best_align ||
             (align == best_align &&
              (c2 < best_c2 || (c2 == best_c2 && Q->perm[H->j] < Q->perm[hits[won].j])))) {
