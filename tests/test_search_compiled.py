@@ -38,7 +38,11 @@ def wavy_triangle6(rng: np.random.Generator, n: int) -> np.ndarray:
     """About ``n`` curved 6-node triangles sharing their edges (each quadratic cell of a
     wavy lattice split in two)."""
     m = max(int(round(np.sqrt(n / 2))), 1)
-    V = _wavy_lattice(rng, m)
+    return _triangle6_cells(_wavy_lattice(rng, m), m)
+
+
+def _triangle6_cells(V: np.ndarray, m: int) -> np.ndarray:
+    """The 6-node triangles of the lattice ``V`` (2m + 1, 2m + 1, 3), two a quadratic cell."""
     i, j = np.meshgrid(2 * np.arange(m), 2 * np.arange(m), indexing="ij")
     i, j = i.ravel(), j.ravel()
     # vertices, then the midpoints of the edges 01, 12, 02
@@ -52,7 +56,11 @@ def wavy_quadrilateral9(rng: np.random.Generator, n: int) -> np.ndarray:
     """About ``n`` curved 9-node quadrilaterals sharing their edges (basix vertices, the
     midpoints of the edges 01, 13, 23, 02, the centre) on a wavy lattice."""
     m = max(int(round(np.sqrt(n))), 1)
-    V = _wavy_lattice(rng, m)
+    return _quadrilateral9_cells(_wavy_lattice(rng, m), m)
+
+
+def _quadrilateral9_cells(V: np.ndarray, m: int) -> np.ndarray:
+    """The 9-node quadrilaterals of the lattice ``V`` (2m + 1, 2m + 1, 3)."""
     i, j = np.meshgrid(2 * np.arange(m), 2 * np.arange(m), indexing="ij")
     i, j = i.ravel(), j.ravel()
     nodes = [V[i, j], V[i + 2, j], V[i, j + 2], V[i + 2, j + 2], V[i + 1, j], V[i + 2, j + 1],
@@ -383,6 +391,32 @@ def test_compiled_order_is_the_cell_order():
         np.testing.assert_array_equal(tree.order(points), cell_order(points))
         same = np.ones((7, g))
         np.testing.assert_array_equal(tree.order(same), np.arange(7))
+
+
+@pytest.mark.parametrize("cells", [_triangle6_cells, _quadrilateral9_cells])
+def test_exact_ties_break_as_the_numpy_search(cells, monkeypatch):
+    """Points above the shared vertices, edge midpoints and cell centres of a flat lattice
+    of quadratic facets (given in two orders), where up to eight facets are at exactly the
+    same distance and alignment: the compiled tie-break (in C) picks the facets of the
+    NumPy one (the nearer centroid of the Bernstein control points, then the lower index)."""
+    m = 3
+    s = np.linspace(0.0, 1.0, 2 * m + 1)
+    X, Y = np.meshgrid(s, s, indexing="ij")
+    nodes = cells(np.stack([X, Y, np.zeros_like(X)], axis=-1), m)
+    grid = np.linspace(0.0, 1.0, 4 * m + 1)
+    gx, gy = (a.ravel() for a in np.meshgrid(grid, grid, indexing="ij"))
+    points = np.concatenate(
+        [np.stack([gx, gy, np.full_like(gx, height)], axis=1) for height in (0.25, -0.1)]
+    )
+    rng = np.random.default_rng(5)
+    for order in (np.arange(len(nodes)), rng.permutation(len(nodes))):
+        fast = closest_points(points, nodes[order], np.inf)
+        monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
+        slow = closest_points(points, nodes[order], np.inf)
+        monkeypatch.delenv("CONTACT_UFL_SEARCH")
+        np.testing.assert_array_equal(fast.facet, slow.facet)
+        for k in ("xi", "y", "gap", "distance"):
+            np.testing.assert_allclose(getattr(fast, k), getattr(slow, k), rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("offset", [-1e5, 3e4])

@@ -40,8 +40,12 @@ def reference(points: np.ndarray, nodes: np.ndarray, radius: float = np.inf):
             abs(each[f].normal[0] @ rf) / np.linalg.norm(rf) if rf.any() else 0.0
             for f, rf in zip(tied, r, strict=True)
         ]
-        near = [np.sum((x - centroid[f]) ** 2) for f in tied]
-        best = tied[min(range(len(tied)), key=lambda k: (-align[k], near[k], tied[k]))]
+        near = np.array([np.sum((x - centroid[f]) ** 2) for f in tied])
+        # the most aligned, then the nearest centroid, then the lowest index (alignments and
+        # relative squared centroid distances within 1e-12 are equal)
+        aligned = np.asarray(align) >= max(align) - 1e-12
+        nearest = aligned & (near <= near[aligned].min() * (1 + 1e-12))
+        best = tied[nearest].min()
         if each[best].distance[0] <= radius:
             facet[i] = best
         for k in FIELDS:

@@ -131,6 +131,7 @@ _BLOCK = 1 << 12  # points processed at once (keeps the arrays of the candidate 
 _NEWTON_ITERATIONS = 25
 _NEWTON_TOL = 1e-13  # on the reference-coordinate step
 _TIE = 1e-10  # relative distance tolerance of the tie-break
+_ALIGN = 1e-12  # alignments (and relative squared centroid distances) equal in the tie-break
 _CELLS = 64  # cells per dimension of the grid that orders the points
 _SORT = 1 << 14  # facets above which the points are ordered by cells
 _DIRECTIONS = {2: 8, 3: 32}  # normal bins of a self-contact search, by dimension
@@ -1318,7 +1319,9 @@ def _tie_break(
 ) -> IntArray:
     """Positions in ``e`` of the winners among the tied pairs ``e`` (of the points ``pe``,
     several per point): the normal most aligned with ``x - y``, then the nearer centroid,
-    then the lower facet index."""
+    then the lower facet index, alignments within ``_ALIGN`` and squared centroid distances
+    within ``_ALIGN`` of each other counting as equal (a tie of the geometry is broken by the
+    geometry, not by the round-off of two implementations)."""
     fe, xi = fid[e], pairs.xi[e]
     N, dN, _ = shape_functions(master.nn, master.gdim, xi)
     X = master.nodes[fe]
@@ -1327,10 +1330,18 @@ def _tie_break(
     dist = np.linalg.norm(r, axis=1)
     align = np.divide(np.abs(_dot(nu, r)), dist, out=np.zeros_like(dist), where=dist > 0)
     c = x[pe] - master.centroid[fe]
-    order = np.lexsort((fe, _dot(c, c), -align, pe))
-    head = np.ones(order.size, dtype=bool)
-    head[1:] = pe[order[1:]] != pe[order[:-1]]
-    return order[head]
+    c2 = _dot(c, c)
+    points, local = np.unique(pe, return_inverse=True)
+    best = np.full(len(points), -np.inf)
+    np.maximum.at(best, local, align)
+    keep = align >= best[local] - _ALIGN
+    nearest = np.full(len(points), np.inf)
+    np.minimum.at(nearest, local[keep], c2[keep])
+    keep &= c2 <= nearest[local] * (1.0 + _ALIGN)
+    lowest = np.full(len(points), np.iinfo(np.int64).max)
+    np.minimum.at(lowest, local[keep], fe[keep])
+    won = np.flatnonzero(keep & (fe == lowest[local]))
+    return won[np.argsort(pe[won], kind="stable")]
 
 
 def _check_self_contact(self_contact: SelfContact, npts: int, nf: int, gdim: int) -> None:
@@ -1459,8 +1470,10 @@ def closest_points(
 
     When several facets are at the same distance up to ``1e-10 (distance + facet size)``
     (the point projects onto a shared edge or vertex), the facet whose normal is the most
-    aligned with ``x - y`` wins; at equal alignment the one with the nearer centroid, then the
-    lower index (so that the order the caller gives the facets in decides exact ties).
+    aligned with ``x - y`` wins; at equal alignment (to ``1e-12``) the one with the nearer
+    centroid (its squared distance to ``1e-12`` relative), then the lower index (so that the
+    order the caller gives the facets in decides exact ties, whatever the round-off of the
+    closest points).
 
     Self-contact (``self_contact`` given): the inadmissible pairs are dropped before any
     distance bounds the search, so the bound ``d1`` is the distance of the facet of the

@@ -1643,44 +1643,60 @@ INLINE double centroid_radius(int kind, int g, int nn, const double *X, double *
     return sqrt(r2max);
 }
 
-/* The hit of the closest point of x among the hits within bound (nh of them, k > 0 within
- * bound): those within the tie tolerance of the smallest distance dmin (dmin + TIE (dmin +
- * 2 R_f)), and of several of them the one whose normal is the most aligned with x - y,
- * then the one of the nearer centroid, then the one of the lower facet index (perm): the
- * tie-break of projection._select and _tie_break, in their operations. */
-#define TIE 1e-10 /* projection._TIE */
+/* Whether hit H of the point x is within the tie tolerance of the smallest distance dmin
+ * (dmin + TIE (dmin + 2 R_f)), and then its alignment |nu . (x - y)| / |x - y| and the
+ * squared distance of x from its centroid (of the hull points), as projection._tie_break. */
+#define TIE 1e-10  /* projection._TIE */
+#define ALIGN 1e-12 /* projection._ALIGN */
+INLINE int tie_measures(int kind, int g, int nn, const query_t *Q, const hit_t *H,
+                        const double *xp, double dmin, double *align, double *c2)
+{
+    const double *X = Q->leaf_nodes + H->j * nn * g;
+    double c[3];
+    double size = centroid_radius(kind, g, nn, X, c);
+    if (!(H->q.dist <= dmin + TIE * (dmin + 2.0 * size))) return 0;
+    double y[3], r[3], nu[3], a[2][3], d2N[2][2][9], nr = 0.0, cc = 0.0;
+    double dist = closest_point(kind, g, nn, X, xp, &H->q, y, r, nu, a, d2N);
+    for (int k = 0; k < g; k++) {
+        nr += nu[k] * r[k];
+        c[k] = xp[k] - c[k];
+        cc += c[k] * c[k];
+    }
+    *align = dist > 0 ? fabs(nr) / dist : 0.0;
+    *c2 = cc;
+    return 1;
+}
+
+/* The hit of the closest point of x among the hits within bound (at least one): of those
+ * within the tie tolerance of the smallest distance, the one whose normal is the most
+ * aligned with x - y, then the one of the nearer centroid, then the one of the lower facet
+ * index (perm), alignments and relative squared centroid distances within ALIGN counting as
+ * equal: the tie-break of projection._select and _tie_break (three passes over the few
+ * tied hits: the largest alignment, the nearest centroid among the aligned, the lowest
+ * index among those). */
 INLINE i64 tie_break(int kind, int g, int nn, const query_t *Q, const walk_t *W,
                      const double *xp)
 {
     const hit_t *hits = W->hits;
-    double dmin = INFINITY;
+    double dmin = INFINITY, align, c2, best = -INFINITY, nearest = INFINITY;
     for (i64 h = 0; h < W->nh; h++)
         if (hits[h].q.dist <= W->bound && hits[h].q.dist < dmin) dmin = hits[h].q.dist;
+    for (i64 h = 0; h < W->nh; h++)
+        if (hits[h].q.dist <= W->bound &&
+            tie_measures(kind, g, nn, Q, hits + h, xp, dmin, &align, &c2) && align > best)
+            best = align;
+    for (i64 h = 0; h < W->nh; h++)
+        if (hits[h].q.dist <= W->bound &&
+            tie_measures(kind, g, nn, Q, hits + h, xp, dmin, &align, &c2) &&
+            align >= best - ALIGN && c2 < nearest)
+            nearest = c2;
     i64 won = -1;
-    double best_align = 0.0, best_c2 = 0.0;
-    for (i64 h = 0; h < W->nh; h++) {
-        const hit_t *H = hits + h;
-        if (!(H->q.dist <= W->bound)) continue;
-        const double *X = Q->leaf_nodes + H->j * nn * g;
-        double c[3];
-        double size = centroid_radius(kind, g, nn, X, c);
-        if (!(H->q.dist <= dmin + TIE * (dmin + 2.0 * size))) continue;
-        double y[3], r[3], nu[3], a[2][3], d2N[2][2][9], nr = 0.0, c2 = 0.0;
-        double dist = closest_point(kind, g, nn, X, xp, &H->q, y, r, nu, a, d2N);
-        for (int k = 0; k < g; k++) {
-            nr += nu[k] * r[k];
-            c[k] = xp[k] - c[k];
-            c2 += c[k] * c[k];
-        }
-        double align = dist > 0 ? fabs(nr) / dist : 0.0;
-        if (won < 0 || align > best_align ||
-            (align == best_align &&
-             (c2 < best_c2 || (c2 == best_c2 && Q->perm[H->j] < Q->perm[hits[won].j])))) {
+    for (i64 h = 0; h < W->nh; h++)
+        if (hits[h].q.dist <= W->bound &&
+            tie_measures(kind, g, nn, Q, hits + h, xp, dmin, &align, &c2) &&
+            align >= best - ALIGN && c2 <= nearest * (1.0 + ALIGN) &&
+            (won < 0 || Q->perm[hits[h].j] < Q->perm[hits[won].j]))
             won = h;
-            best_align = align;
-            best_c2 = c2;
-        }
-    }
     return won;
 }
 
