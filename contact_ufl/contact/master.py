@@ -438,8 +438,8 @@ def node_rows(comm: MPI.Comm, global_nodes: np.ndarray, wanted: np.ndarray) -> n
     ``global_nodes`` of all ranks, in rank order (one row per node and entry of
     ``global_nodes``: the first that holds it), raveled."""
     keys = np.concatenate(comm.allgather(global_nodes.reshape(-1).astype(np.int64)))
-    keys, first = np.unique(keys, return_index=True)
-    return first[np.searchsorted(keys, wanted.reshape(-1))]
+    find, _ = _lookup(keys)  # a stable order: of equal keys, the first row is found
+    return find(wanted.reshape(-1))[0]
 
 
 @dataclass

@@ -1331,17 +1331,16 @@ def _tie_break(
     align = np.divide(np.abs(_dot(nu, r)), dist, out=np.zeros_like(dist), where=dist > 0)
     c = x[pe] - master.centroid[fe]
     c2 = _dot(c, c)
-    points, local = np.unique(pe, return_inverse=True)
-    best = np.full(len(points), -np.inf)
-    np.maximum.at(best, local, align)
-    keep = align >= best[local] - _ALIGN
-    nearest = np.full(len(points), np.inf)
-    np.minimum.at(nearest, local[keep], c2[keep])
-    keep &= c2 <= nearest[local] * (1.0 + _ALIGN)
-    lowest = np.full(len(points), np.iinfo(np.int64).max)
-    np.minimum.at(lowest, local[keep], fe[keep])
-    won = np.flatnonzero(keep & (fe == lowest[local]))
-    return won[np.argsort(pe[won], kind="stable")]
+    npts = x.shape[0]  # per point, as _select: the largest alignment, the nearest centroid
+    best = np.full(npts, -np.inf)
+    np.maximum.at(best, pe, align)
+    keep = align >= best[pe] - _ALIGN
+    nearest = np.full(npts, np.inf)
+    np.minimum.at(nearest, pe[keep], c2[keep])
+    keep &= c2 <= nearest[pe] * (1.0 + _ALIGN)
+    lowest = np.full(npts, np.iinfo(np.int64).max)
+    np.minimum.at(lowest, pe[keep], fe[keep])
+    return np.flatnonzero(keep & (fe == lowest[pe]))
 
 
 def _check_self_contact(self_contact: SelfContact, npts: int, nf: int, gdim: int) -> None:

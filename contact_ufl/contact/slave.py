@@ -255,11 +255,10 @@ class SlaveSurface:
         sums as the cell's basis does; four to five times faster than gathering the cells'
         values and multiplying per cell."""
         nc, nq, nd = self._phi_u.shape
-        rows = np.repeat(np.arange(nc * nq), nd)
         columns = np.repeat(self._cell_dofs, nq, axis=0).ravel()
         blocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
-        P = scipy.sparse.csr_array((self._phi_u.ravel(), columns, np.arange(0, len(rows) + 1, nd)),
-                                   shape=(nc * nq, blocks))  # fmt: skip
+        starts = np.arange(0, nc * nq * nd + 1, nd)  # nd entries a point
+        P = scipy.sparse.csr_array((self._phi_u.ravel(), columns, starts), shape=(nc * nq, blocks))
         P.has_sorted_indices = False  # keep the cell order: no sorting, no summing
         return P
 
