@@ -560,7 +560,8 @@ class _Hierarchy:
         self.m = int(self.lib.bvh_build(self.gdim, nf, *p(centroid, self.perm, self.a, self.b)))
         # the rows of the walk: 128 bytes a tree node at most, one more, 128 to align them
         self.tree = np.empty((self.m + 2) * 128, dtype=np.uint8)
-        self.leaf_nodes = np.empty_like(nodes)
+        #: the facets' records in the order of the leaves (nodes, box, chord deviation)
+        self.leaves = np.empty((nf, int(self.lib.bvh_record(self.gdim, self.nn))))
         self.fitted_nodes = np.empty_like(nodes)  # the nodes of the last refit, as given
         self.is_fitted = False
         #: a bound of the largest node movement since the build (the sum of the largest
@@ -581,7 +582,7 @@ class _Hierarchy:
         )
 
     def refit(self, nodes: FloatArray) -> float:
-        """The boxes, largest facet radius and leaf-ordered nodes of the current ``nodes``
+        """The boxes, largest facet radius and leaf-ordered facet records of the current ``nodes``
         (C-contiguous), in one pass with the copy of the nodes and their largest coordinate
         change since the last refit, which it returns (meaningless after none); a
         ``ValueError`` if a coordinate is not finite."""
@@ -592,7 +593,7 @@ class _Hierarchy:
         R_max = float(
             self.lib.bvh_refit(
                 g, nn, nf, *p(nodes, self.perm), self.m,
-                *p(self.a, self.b, self.tree, self.leaf_nodes, self.fitted_nodes, change),
+                *p(self.a, self.b, self.tree, self.leaves, self.fitted_nodes, change),
             )
         )  # fmt: skip
         if R_max == -2.0:
@@ -636,7 +637,7 @@ class _Hierarchy:
             pn, pnormal, fn, axis = rule
             contact = [pn.shape[1], *p(pn, pnormal), fn.shape[1], *p(fn, axis)]
         status = self.lib.bvh_query(
-            self.kind, self.gdim, self.nn, *p(self.leaf_nodes, self.perm), self.m,
+            self.kind, self.gdim, self.nn, *p(self.leaves, self.perm), self.m,
             _ptr(self, self.tree), self.R_max, len(x), _ptr(self, x), radius, rows, *fields,
             *contact,
         )  # fmt: skip

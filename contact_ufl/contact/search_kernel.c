@@ -47,6 +47,12 @@ typedef struct {
 /* projection.py allocates the tree buffer as (m + 2) * 128 bytes */
 _Static_assert(sizeof(node_t) == 128, "a row of the tree is 128 bytes");
 
+/* The record of a facet in the order of the leaves (bvh_refit writes them, the walk reads
+ * them): its nn g node coordinates, its box (lo, hi: 2 g values, of its hull points) and the
+ * deviation of a quadratic facet from its chord facet (chord_deviation; 0 of a flat one), so
+ * that the walk reads a facet's box and bounds from the lines it loads for its nodes. */
+#define RECORD(g, nn) ((nn) * (g) + 2 * (g) + 1)
+
 /* the rows of a tree buffer of at least (m + 1) sizeof(node_t) + 128 bytes, 128-byte
  * aligned (a row in two cache lines that are loaded together) */
 static node_t *rows(const void *buffer)
@@ -165,7 +171,7 @@ typedef struct {
     i64 n;
     const double *nodes; /* (n, nn, g) as given */
     const i64 *perm, *a, *b;
-    double *leaf_nodes; /* (n, nn, g) in the order of perm */
+    double *leaves;     /* (n, RECORD) in the order of perm */
     double *fitted;     /* (n, nn, g) as given: the nodes of the last refit, then these */
     node_t *T;
     i64 used; /* rows written */
@@ -206,8 +212,11 @@ INLINE const double *hull(int kind, int g, const double *X, double *H)
     return H;
 }
 
-/* The facets of a leaf copied in the order of perm, their box (lo, hi) (of their hull
- * points), and the largest facet radius and finiteness so far updated. */
+static double chord_deviation(int kind, const double *X);
+
+/* The records of the facets of a leaf written in the order of perm (their nodes, boxes and
+ * chord deviations), the leaf's box (lo, hi) (of their hull points), and the largest facet
+ * radius and finiteness so far updated. */
 INLINE void fit_leaf(fit_t *F, i64 i, double *box, const int kind, const int g, const int nn)
 {
     const int w = nn * g;
@@ -217,7 +226,7 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box, const int kind, const int g, 
     i64 start = -F->a[i] - 1;
     for (i64 j = start; j < start + F->b[i]; j++) {
         const double *X = F->nodes + F->perm[j] * w;
-        double *Y = F->leaf_nodes + j * w, *Z = F->fitted + F->perm[j] * w, c[3];
+        double *Y = F->leaves + j * RECORD(g, nn), *Z = F->fitted + F->perm[j] * w, c[3];
         for (int q = 0; q < w; q++) {
             double d = fabs(X[q] - Z[q]);
             change = d > change ? d : change;
@@ -239,16 +248,23 @@ INLINE void fit_leaf(fit_t *F, i64 i, double *box, const int kind, const int g, 
             c[k] = s;
             finite &= isfinite(s); /* a NaN or infinite coordinate makes its sum so */
         }
+        double *B = Y + w; /* the facet's box */
+        for (int k = 0; k < g; k++) B[k] = B[g + k] = P[k];
         for (int q = 0; q < nn; q++) {
             double d2 = 0.0; /* nn^2 times the squared distance from the centroid */
             for (int k = 0; k < g; k++) {
                 double v = P[q * g + k], d = nn * v - c[k];
                 d2 += d * d;
-                lo[k] = v < lo[k] ? v : lo[k];
-                hi[k] = v > hi[k] ? v : hi[k];
+                B[k] = v < B[k] ? v : B[k];
+                B[g + k] = v > B[g + k] ? v : B[g + k];
             }
             r2max = d2 > r2max ? d2 : r2max;
         }
+        for (int k = 0; k < g; k++) {
+            lo[k] = B[k] < lo[k] ? B[k] : lo[k];
+            hi[k] = B[g + k] > hi[k] ? B[g + k] : hi[k];
+        }
+        B[2 * g] = kind >= 3 ? chord_deviation(kind, X) : 0.0;
     }
     F->r2max = r2max; /* nn^2 times the largest squared facet radius */
     F->change = change;
@@ -321,10 +337,10 @@ static i64 fit(fit_t *F, i64 i, double *box)
 }
 
 INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                    const i64 *a, const i64 *b, void *tree, double *leaf_nodes, double *fitted,
+                    const i64 *a, const i64 *b, void *tree, double *leaves, double *fitted,
                     double *change)
 {
-    fit_t F = {kind_of(g, nn), g, nn, n, nodes, perm, a, b, leaf_nodes, fitted, rows(tree), 0,
+    fit_t F = {kind_of(g, nn), g, nn, n, nodes, perm, a, b, leaves, fitted, rows(tree), 0,
                0.0, 0.0, 1};
     if (m > 0) {
         double B[6];
@@ -343,23 +359,26 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
 
 /* The tree over the current nodes (n, nn, g) of the facets: tree (a buffer of (m + 1)
  * sizeof(node_t) + 128 bytes) gets the rows of the walk (every facet point lies in the box of
- * its nodes' convex hull); leaf_nodes (n, nn, g) the nodes in the order of perm (the facets
- * of a leaf contiguous); fitted (n, nn, g), the nodes of the last refit, these nodes, and
+ * its nodes' convex hull); leaves (n, bvh_record(g, nn)) the facets' records in the order
+ * of perm (RECORD: nodes, box, chord deviation; the facets of a leaf contiguous); fitted (n, nn, g), the nodes of the last refit, these nodes, and
  * change the largest coordinate change from the one to the other (one pass over the nodes
  * for all three). Returns the largest facet radius (node distance from the mean of the
  * nodes), -1 for an unknown facet kind, -2 if a coordinate is not finite. */
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, void *tree, double *leaf_nodes, double *fitted,
+                 const i64 *a, const i64 *b, void *tree, double *leaves, double *fitted,
                  double *change)
 {
-    if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
-    if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
-    if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
-    if (g == 2 && nn == 3) return refit(2, 3, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
-    if (g == 3 && nn == 6) return refit(3, 6, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
-    if (g == 3 && nn == 9) return refit(3, 9, n, nodes, perm, m, a, b, tree, leaf_nodes, fitted, change);
+    if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaves, fitted, change);
+    if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaves, fitted, change);
+    if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaves, fitted, change);
+    if (g == 2 && nn == 3) return refit(2, 3, n, nodes, perm, m, a, b, tree, leaves, fitted, change);
+    if (g == 3 && nn == 6) return refit(3, 6, n, nodes, perm, m, a, b, tree, leaves, fitted, change);
+    if (g == 3 && nn == 9) return refit(3, 9, n, nodes, perm, m, a, b, tree, leaves, fitted, change);
     return -1.0;
 }
+
+/* The length of a facet's record in the leaves (RECORD) of nn nodes in g dimensions. */
+int bvh_record(int g, int nn) { return RECORD(g, nn); }
 
 /* Whether two arrays of len values are equal to the last bit (memcmp: one sequential sweep,
  * stopped at the first difference). */
@@ -834,30 +853,49 @@ static void make_patch(int kind, const double *X, patch_t *P)
     for (int k = 0; k < 3; k++) P->C[0][2][k] = 0.5 * c[k];
 }
 
+/* The state of a Newton iteration on a quadratic facet at xi: x - y, the tangents a, the
+ * Hessian H of |x - y|^2 / 2 and the metric gm (curved._state). */
+typedef struct {
+    double r[3], a[2][3], H[2][2], gm[2][2];
+} state_t;
+
 /* x - y(xi) */
-INLINE void patch_residual(const patch_t *P, const double *x, const double *xi, double *r)
+INLINE void patch_residual(int kind, const patch_t *P, const double *x, const double *xi,
+                           double *r)
 {
     const double s = xi[0], t = xi[1], t2 = t * t, S[3] = {1.0, s, s * s};
     for (int k = 0; k < 3; k++) {
         double v = 0.0;
-        for (int p = 0; p < 3; p++)
-            v += S[p] * (P->C[p][0][k] + t * P->C[p][1][k] + t2 * P->C[p][2][k]);
+        if (kind == 4) /* the terms of the 9-node sum that are not zero, in its order */
+            v = ((P->C[0][0][k] + t * P->C[0][1][k]) + t2 * P->C[0][2][k])
+                + S[1] * (P->C[1][0][k] + t * P->C[1][1][k]) + S[2] * P->C[2][0][k];
+        else
+            for (int p = 0; p < 3; p++)
+                v += S[p] * (P->C[p][0][k] + t * P->C[p][1][k] + t2 * P->C[p][2][k]);
         r[k] = x[k] - v;
     }
 }
 
-/* x - y, the tangents a and the Hessian H of |x - y|^2 / 2 (and the metric gm) at xi
- * (curved._state) */
-INLINE void patch_state(const patch_t *P, const double *x, const double *xi, double *r,
-                        double (*a)[3], double (*H)[2], double (*gm)[2])
+/* The state at xi (the monomials of a 6-node triangle, p + q <= 2, only: the others are
+ * zero, and the sums of the nine terms the same without them) */
+INLINE void patch_state(int kind, const patch_t *P, const double *x, const double *xi,
+                        state_t *Z)
 {
     const double s = xi[0], t = xi[1];
     const double S[3] = {1.0, s, s * s}, T[3] = {1.0, t, t * t};
     const double dS[3] = {0.0, 1.0, 2.0 * s}, dT[3] = {0.0, 1.0, 2.0 * t};
     const double d2[3] = {0.0, 0.0, 2.0};
     double y2[2][2][3] = {{{0.0}}};
-    patch_residual(P, x, xi, r);
+    patch_residual(kind, P, x, xi, Z->r);
     for (int k = 0; k < 3; k++) {
+        if (kind == 4) {
+            Z->a[0][k] = (P->C[1][0][k] + t * P->C[1][1][k]) + dS[2] * P->C[2][0][k];
+            Z->a[1][k] = (P->C[0][1][k] + dT[2] * P->C[0][2][k]) + s * P->C[1][1][k];
+            y2[0][0][k] = 2.0 * P->C[2][0][k];
+            y2[0][1][k] = P->C[1][1][k];
+            y2[1][1][k] = 2.0 * P->C[0][2][k];
+            continue;
+        }
         double a0 = 0.0, a1 = 0.0;
         for (int p = 0; p < 3; p++)
             for (int q = 0; q < 3; q++) {
@@ -868,60 +906,65 @@ INLINE void patch_state(const patch_t *P, const double *x, const double *xi, dou
                 y2[0][1][k] += dS[p] * dT[q] * c;
                 y2[1][1][k] += S[p] * d2[q] * c;
             }
-        a[0][k] = a0;
-        a[1][k] = a1;
+        Z->a[0][k] = a0;
+        Z->a[1][k] = a1;
     }
     for (int al = 0; al < 2; al++)
         for (int be = al; be < 2; be++) {
-            gm[al][be] = gm[be][al] = dot3(a[al], a[be]);
-            H[al][be] = H[be][al] = gm[al][be] - dot3(r, y2[al][be]);
+            Z->gm[al][be] = Z->gm[be][al] = dot3(Z->a[al], Z->a[be]);
+            Z->H[al][be] = Z->H[be][al] = Z->gm[al][be] - dot3(Z->r, y2[al][be]);
         }
 }
 
 /* curved._newton for one pair from xi (in/out): returns the distance; *settled whether xi is
  * a strict local minimum (converged, positive definite Hessian), *good whether it is one
- * inside the facet. */
-static double curved_newton(int kind, const patch_t *P, const double *x, double *xi, int *good,
+ * inside the facet. The state of an accepted iterate (whose residual the line search
+ * checks) is the next iteration's. */
+INLINE double curved_newton(int kind, const patch_t *P, const double *x, double *xi, int *good,
                             int *settled)
 {
-    double r[3], a[2][3], H[2][2], gm[2][2], rn[3];
+    state_t Z, Zn;
     int conv = 0;
+    patch_state(kind, P, x, xi, &Z);
     for (int it = 0; it < NEWTON_ITERATIONS; it++) {
-        patch_state(P, x, xi, r, a, H, gm);
-        double g0 = -dot3(r, a[0]), g1 = -dot3(r, a[1]);
+        double H[2][2];
+        double g0 = -dot3(Z.r, Z.a[0]), g1 = -dot3(Z.r, Z.a[1]);
+        memcpy(H, Z.H, sizeof H);
         double det = H[0][0] * H[1][1] - H[0][1] * H[1][0];
-        if (det <= 1e-12 * H[0][0] * H[1][1] || H[0][0] <= 0) memcpy(H, gm, sizeof H);
+        if (det <= 1e-12 * H[0][0] * H[1][1] || H[0][0] <= 0) memcpy(H, Z.gm, sizeof H);
         det = H[0][0] * H[1][1] - H[0][1] * H[1][0];
         det = det > 0 ? det : INFINITY;
         double step[2] = {-(H[1][1] * g0 - H[0][1] * g1) / det,
                           -(H[0][0] * g1 - H[1][0] * g0) / det};
         for (int j = 0; j < 2; j++) /* keep the iterate near the facet */
             step[j] = step[j] < -0.5 ? -0.5 : (step[j] > 0.5 ? 0.5 : step[j]);
-        double f0 = dot3(r, r), next[2] = {xi[0] + step[0], xi[1] + step[1]};
-        for (int half = 0; half < 3; half++) {
-            patch_residual(P, x, next, rn);
-            if (!(dot3(rn, rn) > f0 * (1 + 1e-10))) break;
+        double f0 = dot3(Z.r, Z.r), next[2] = {xi[0] + step[0], xi[1] + step[1]};
+        int half = 0;
+        for (; half < 3; half++) {
+            patch_state(kind, P, x, next, &Zn);
+            if (!(dot3(Zn.r, Zn.r) > f0 * (1 + 1e-10))) break;
             for (int j = 0; j < 2; j++) {
                 step[j] *= 0.5;
                 next[j] = xi[j] + step[j];
             }
         }
+        if (half == 3) patch_state(kind, P, x, next, &Zn); /* the last halving, unchecked */
         double d0 = fabs(next[0] - xi[0]), d1 = fabs(next[1] - xi[1]);
         int done = (d0 > d1 ? d0 : d1) <= NEWTON_TOL;
         xi[0] = next[0];
         xi[1] = next[1];
+        Z = Zn;
         if (done) {
             conv = 1;
             break;
         }
     }
-    patch_state(P, x, xi, r, a, H, gm);
     int inside = xi[0] > 0.0 && xi[1] > 0.0
                  && (kind == 4 ? xi[0] + xi[1] < 1.0 : xi[0] < 1.0 && xi[1] < 1.0);
-    int pd = H[0][0] > 0 && H[0][0] * H[1][1] - H[0][1] * H[1][0] > 0;
+    int pd = Z.H[0][0] > 0 && Z.H[0][0] * Z.H[1][1] - Z.H[0][1] * Z.H[1][0] > 0;
     *settled = conv && pd;
     *good = *settled && inside;
-    return sqrt(dot3(r, r));
+    return sqrt(dot3(Z.r, Z.r));
 }
 
 /* The largest squared distance of the points P[m] of the ne edges (i, j, m) of E from the
@@ -1081,45 +1124,54 @@ static void quadratic(int kind, const double *X, const double *x, pair_t *out)
     out->vertex = best_u == 0.0 || best_u == 1.0;
 }
 
-/* Bounds of the distance of x from a quadratic facet X (kind 3, 4 or 5) without its
- * projection, from a chord facet of its vertices that is within dev of it point for point
- * (at the same reference coordinates, both ways): its distance is within dev of the chord
- * facet's (an exact projection, cheap).
+/* The deviation of the quadratic facet X (kind 3, 4 or 5) from its chord facet, the
+ * straight facet of its vertices: a bound of their distance point for point (at the same
+ * reference coordinates, both ways), so that the distance of a point from the facet is
+ * within it of the distance from the chord facet (an exact projection, cheap).
  * - 3-node segment: the chord AB, y = chord + 4 u (1 - u) delta, delta the midpoint node's
- *   offset from the chord's midpoint: dev = |delta|.
+ *   offset from the chord's midpoint: |delta|.
  * - 6-node triangle: the triangle of the vertices plus sum_e 4 L_i L_j delta_e (weights
- *   summing to at most 4/3): dev = 4/3 max |delta_e|.
+ *   summing to at most 4/3): 4/3 max |delta_e|.
  * - 9-node quadrilateral: the two triangles (v0, v1, v2), (v1, v3, v2) of its corners. The
  *   facet minus the bilinear patch of the corners has the Bernstein control points H - P (P
  *   those of the bilinear patch: the corners, the edges' chord midpoints, the corners'
  *   mean), so it is within max |H - P|; the bilinear patch is within |c3| / 4 of the two
- *   triangles (s t c3, (1 - s)(1 - t) c3 at most a quarter, c3 = x0 - x1 - x2 + x3). */
-INLINE void chord_bounds(int kind, const double *X, const double *x, double *lower,
-                         double *upper)
+ *   triangles (s t c3, (1 - s)(1 - t) c3 at most a quarter, c3 = x0 - x1 - x2 + x3).
+ * Made once per refit (the facet's record). */
+static double chord_deviation(int kind, const double *X)
 {
-    double chord, dev;
     if (kind == 3) {
         double delta[2] = {X[4] - 0.5 * (X[0] + X[2]), X[5] - 0.5 * (X[1] + X[3])};
+        return sqrt(sum_prod(2, delta, delta));
+    }
+    if (kind == 4) return 4.0 / 3.0 * sqrt(largest_offset(3, TRI6_EDGES, X, X));
+    double H[27], c3[3], d[3];
+    hull(5, 3, X, H);
+    double dev2 = largest_offset(4, QUAD9_EDGES, H, X); /* H - chord midpoints */
+    for (int k = 0; k < 3; k++) { /* the centre: H - the corners' mean */
+        d[k] = H[24 + k] - 0.25 * (X[k] + X[3 + k] + X[6 + k] + X[9 + k]);
+        c3[k] = X[k] - X[3 + k] - X[6 + k] + X[9 + k];
+    }
+    double d2 = dot3(d, d);
+    dev2 = d2 > dev2 ? d2 : dev2;
+    return sqrt(dev2) + 0.25 * sqrt(dot3(c3, c3));
+}
+
+/* Bounds of the distance of x from a quadratic facet X (kind 3, 4 or 5) without its
+ * projection: the distance from its chord facet (of kind 5, the nearer of the two
+ * triangles of its corners) widened by the facet's chord deviation dev. */
+INLINE void chord_bounds(int kind, const double *X, double dev, const double *x,
+                         double *lower, double *upper)
+{
+    double chord;
+    if (kind == 3) {
         chord = segment_distance(2, x, X, X + 2);
-        dev = sqrt(sum_prod(2, delta, delta));
     } else if (kind == 4) {
         pair_t q;
         triangle(X, x, &q);
         chord = q.dist;
-        dev = 4.0 / 3.0 * sqrt(largest_offset(3, TRI6_EDGES, X, X));
     } else {
-        double H[27], T[9], c3[3];
-        hull(5, 3, X, H);
-        double dev2 = largest_offset(4, QUAD9_EDGES, H, X); /* H - chord midpoints */
-        { /* the centre: H - the corners' mean */
-            double d[3];
-            for (int k = 0; k < 3; k++) {
-                d[k] = H[24 + k] - 0.25 * (X[k] + X[3 + k] + X[6 + k] + X[9 + k]);
-                c3[k] = X[k] - X[3 + k] - X[6 + k] + X[9 + k];
-            }
-            double d2 = dot3(d, d);
-            dev2 = d2 > dev2 ? d2 : dev2;
-        }
+        double T[9];
         pair_t q0, q1;
         triangle(X, x, &q0);
         for (int k = 0; k < 3; k++) { /* v1, v3, v2 */
@@ -1129,7 +1181,6 @@ INLINE void chord_bounds(int kind, const double *X, const double *x, double *low
         }
         triangle(T, x, &q1);
         chord = q0.dist < q1.dist ? q0.dist : q1.dist;
-        dev = sqrt(dev2) + 0.25 * sqrt(dot3(c3, c3));
     }
     /* widened by far more than the round-off of the distances */
     *lower = chord - dev * (1 + 1e-12);
@@ -1251,13 +1302,13 @@ INLINE int beyond_slab(int kind, const double *X, const double *x, double bound,
 
 /* Start loading what the walk reads of a child (code as in node_t): its row, or the nodes
  * of the leaf's facets. */
-INLINE void prefetch_child(const node_t *T, const double *leaf_nodes, int w, i64 code)
+INLINE void prefetch_child(const node_t *T, const double *leaves, int w, i64 code)
 {
     if (code >= 0) {
         PREFETCH(T + code);
         PREFETCH((const char *)(T + code) + 64);
     } else {
-        const double *X = leaf_nodes + ((-code - 1) >> 3) * w;
+        const double *X = leaves + ((-code - 1) >> 3) * w;
         for (int q = 0; q < ((-code - 1) & 7) * w; q += 8) PREFETCH(X + q);
     }
 }
@@ -1421,31 +1472,20 @@ typedef struct {
  * slab is beyond the bound or (self-contact: pn, the point's facet's nodes, not NULL) it is
  * not admissible; else projected, and a hit if within the bound, which then tightens to the
  * reach of the best distance. Returns 1 if projected, 0 if not, -1 when out of memory. */
-INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 j,
+INLINE int visit(int kind, int g, int nn, const double *leaves, const i64 *perm, i64 j,
                  const double *xp, double rmax, walk_t *W, int mp, const i64 *pn,
                  const double *pnu, int mf, const i64 *fnodes, const double *axis)
 {
-    const double *X = leaf_nodes + j * nn * g;
-    { /* the facet's box (of its hull points) before its exact projection */
-        double B[6], H[27];
-        const double *P = hull(kind, g, X, H);
-        for (int k = 0; k < g; k++) {
-            B[k] = B[g + k] = P[k];
-            for (int q = 1; q < nn; q++) {
-                double v = P[q * g + k];
-                if (v < B[k]) B[k] = v;
-                if (v > B[g + k]) B[g + k] = v;
-            }
-        }
-        if (box_distance2(g, B, xp) > W->bound2) return 0;
-    }
+    const double *X = leaves + j * RECORD(g, nn);
+    /* the facet's box (of its hull points) before its exact projection */
+    if (box_distance2(g, X + nn * g, xp) > W->bound2) return 0;
     if (kind == 2 && beyond_slab(kind, X, xp, W->bound, rmax)) return 0;
     if (pn && !admissible(g, mp, pn, pnu, mf, fnodes + perm[j] * mf, axis + perm[j] * g))
         return 0;
     pair_t q;
     double key, upper = INFINITY;
     if (DEFERRED(kind)) { /* projected when the walk is done (resolve) */
-        chord_bounds(kind, X, xp, &key, &upper);
+        chord_bounds(kind, X, X[RECORD(g, nn) - 1], xp, &key, &upper);
         if (key > W->bound + 1e-10 * (W->bound + rmax)) return 0;
     } else {
         project(kind, X, xp, &q);
@@ -1492,7 +1532,7 @@ INLINE int visit(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
 
 /* What a query reads and writes (bvh_query's arguments). */
 typedef struct {
-    const double *leaf_nodes, *x;
+    const double *leaves, *x;
     const i64 *perm;
     const node_t *T;
     i64 m;
@@ -1566,7 +1606,7 @@ INLINE int step(int kind, int g, int nn, const query_t *Q, lane_t *L)
         for (int j = 0; j < k; j++) {
             L->stack[top] = c[j];
             L->lower[top++] = d[j];
-            prefetch_child(Q->T, Q->leaf_nodes, nn * g, c[j]);
+            prefetch_child(Q->T, Q->leaves, RECORD(g, nn), c[j]);
         }
         L->top = top;
         return 0;
@@ -1575,7 +1615,7 @@ INLINE int step(int kind, int g, int nn, const query_t *Q, lane_t *L)
     const double *pnu = Q->pnodes ? Q->pnormal + L->p * g : NULL;
     i64 first = (-code - 1) >> 3, end = first + ((-code - 1) & 7);
     for (i64 j = first; j < end; j++) {
-        int status = visit(kind, g, nn, Q->leaf_nodes, Q->perm, j, xp, Q->rmax, W, Q->mp, pn,
+        int status = visit(kind, g, nn, Q->leaves, Q->perm, j, xp, Q->rmax, W, Q->mp, pn,
                            pnu, Q->mf, Q->fnodes, Q->axis);
         if (status < 0) return -1;
         W->projected += status;
@@ -1606,7 +1646,7 @@ INLINE void resolve(int kind, int g, int nn, const query_t *Q, lane_t *L)
             H->key = INFINITY;
             continue;
         }
-        project(kind, Q->leaf_nodes + H->j * nn * g, xp, &H->q);
+        project(kind, Q->leaves + H->j * RECORD(g, nn), xp, &H->q);
         H->key = H->q.dist;
         W->projected++;
         if (H->q.dist < W->best) {
@@ -1651,7 +1691,7 @@ INLINE double centroid_radius(int kind, int g, int nn, const double *X, double *
 INLINE int tie_measures(int kind, int g, int nn, const query_t *Q, const hit_t *H,
                         const double *xp, double dmin, double *align, double *c2)
 {
-    const double *X = Q->leaf_nodes + H->j * nn * g;
+    const double *X = Q->leaves + H->j * RECORD(g, nn);
     double c[3];
     double size = centroid_radius(kind, g, nn, X, c);
     if (!(H->q.dist <= dmin + TIE * (dmin + 2.0 * size))) return 0;
@@ -1720,7 +1760,7 @@ INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
     if (k == 0) return;
     if (k > 1) last = tie_break(kind, g, nn, Q, W, xp);
     const pair_t *q = &hits[last].q;
-    const double *X = Q->leaf_nodes + hits[last].j * nn * g;
+    const double *X = Q->leaves + hits[last].j * RECORD(g, nn);
     i64 o = Q->index ? Q->index[p] : p;
     double *y = Q->y + o * g, *normal = Q->normal + o * g, *M = Q->sliding + o * fdim * fdim;
     if (finish(kind, g, nn, X, xp, q, Q->radius, y, normal, Q->gap + o, Q->distance + o, M)) {
@@ -1754,13 +1794,13 @@ INLINE void free_lanes(lane_t *L, int lanes)
  * at a time (surfaces; segments one at a time), a step of each by turns. Returns the number
  * of exact projections made, -1 when out of memory, -3 when the walk overflows its stack (a
  * tree far deeper than a balanced one); bvh_query -2 for an unknown facet kind. */
-INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
+INLINE i64 query(int kind, int g, int nn, const double *leaves, const i64 *perm, i64 m,
                  const void *tree, double rmax, i64 npts, const double *x, double radius,
                  const i64 *index, i64 *facet, double *oxi, double *y, double *normal,
                  double *gap, double *distance, double *sliding, int mp, const i64 *pnodes,
                  const double *pnormal, int mf, const i64 *fnodes, const double *axis)
 {
-    query_t Q = {leaf_nodes, x, perm, rows(tree), m, rmax, radius, mp, mf, index, facet,
+    query_t Q = {leaves, x, perm, rows(tree), m, rmax, radius, mp, mf, index, facet,
                  oxi, y, normal, gap, distance, sliding, pnodes, fnodes, pnormal, axis};
     /* one lane for segments: their walks are short and their projections cheap, the turns
      * cost more than they save */
@@ -1805,7 +1845,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaf_nodes, const i64 *p
     return projected;
 }
 
-i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm, i64 m,
+i64 bvh_query(int kind, int g, int nn, const double *leaves, const i64 *perm, i64 m,
               const void *tree, double rmax, i64 npts, const double *x, double radius,
               const i64 *index, i64 *facet, double *oxi, double *y, double *normal,
               double *gap, double *distance, double *sliding, int mp, const i64 *pnodes,
@@ -1813,7 +1853,7 @@ i64 bvh_query(int kind, int g, int nn, const double *leaf_nodes, const i64 *perm
 {
     /* one copy of the walk per facet kind, its dimensions constant */
 #define QUERY(K, G, NN)                                                                     \
-    query(K, G, NN, leaf_nodes, perm, m, tree, rmax, npts, x, radius, index, facet, oxi, y, \
+    query(K, G, NN, leaves, perm, m, tree, rmax, npts, x, radius, index, facet, oxi, y, \
           normal, gap, distance, sliding, mp, pnodes, pnormal, mf, fnodes, axis)
     switch (kind) {
     case 0: return QUERY(0, 2, 2);
