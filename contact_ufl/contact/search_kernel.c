@@ -1543,6 +1543,7 @@ typedef struct {
     double *oxi, *y, *normal, *gap, *distance, *sliding;
     const i64 *pnodes, *fnodes;
     const double *pnormal, *axis;
+    i64 hint; /* the leaf position of the facet of the last point concluded, -1 before */
 } query_t;
 
 /* The walk of point p in a lane (the lanes of a query walk their points by turns: one
@@ -1555,8 +1556,14 @@ typedef struct {
     double lower[STACK];
 } lane_t;
 
-/* Start the walk of point p in lane L: its root pushed if within the bound. */
-INLINE void start(int g, const query_t *Q, lane_t *L, i64 p)
+/* Start the walk of point p in lane L: its root pushed if within the bound. On quadratic
+ * facets the bound starts from the upper chord bound of the facet of the last point
+ * concluded (a neighbour in the points' Morton order, often of the same facet; not in a
+ * self-contact search, where it may not be admissible): the closest facet is no farther, so
+ * the walk prunes from its first row and keeps the same facets (those within the reach of
+ * the smallest distance, which every bound is above). 2 to 4% of a query on the 6-node
+ * facets of 3D Hertz; none on flat facets, where the bound would cost an exact projection. */
+INLINE void start(int kind, int g, int nn, const query_t *Q, lane_t *L, i64 p)
 {
     walk_t *W = &L->W;
     L->p = p;
@@ -1566,6 +1573,16 @@ INLINE void start(int g, const query_t *Q, lane_t *L, i64 p)
     W->bound = reach(Q->radius, Q->rmax);
     W->bound2 = W->bound * W->bound;
     if (Q->m == 0) return;
+    if (DEFERRED(kind) && Q->hint >= 0 && !Q->pnodes) {
+        const double *X = Q->leaves + Q->hint * RECORD(g, nn);
+        double lower, upper;
+        chord_bounds(kind, X, X[RECORD(g, nn) - 1], Q->x + p * g, &lower, &upper);
+        double r = reach(upper < W->radius ? upper : W->radius, Q->rmax);
+        if (r < W->bound) {
+            W->bound = r;
+            W->bound2 = r * r;
+        }
+    }
     double root[WIDE];
     row_distance2(g, Q->T + Q->m, Q->x + p * g, root);
     if (!(root[0] <= W->bound2)) return;
@@ -1762,6 +1779,7 @@ INLINE void conclude(int kind, int g, int nn, query_t *Q, lane_t *L)
     const pair_t *q = &hits[last].q;
     const double *X = Q->leaves + hits[last].j * RECORD(g, nn);
     i64 o = Q->index ? Q->index[p] : p;
+    Q->hint = hits[last].j;
     double *y = Q->y + o * g, *normal = Q->normal + o * g, *M = Q->sliding + o * fdim * fdim;
     if (finish(kind, g, nn, X, xp, q, Q->radius, y, normal, Q->gap + o, Q->distance + o, M)) {
         Q->facet[o] = Q->perm[hits[last].j];
@@ -1801,7 +1819,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaves, const i64 *perm,
                  const double *pnormal, int mf, const i64 *fnodes, const double *axis)
 {
     query_t Q = {leaves, x, perm, rows(tree), m, rmax, radius, mp, mf, index, facet,
-                 oxi, y, normal, gap, distance, sliding, pnodes, fnodes, pnormal, axis};
+                 oxi, y, normal, gap, distance, sliding, pnodes, fnodes, pnormal, axis, -1};
     /* one lane for segments: their walks are short and their projections cheap, the turns
      * cost more than they save */
     const int lanes = g == 2 ? 1 : LANES;
@@ -1828,7 +1846,7 @@ INLINE i64 query(int kind, int g, int nn, const double *leaves, const i64 *perm,
                 if (A->p >= 0) conclude(kind, g, nn, &Q, A);
                 A->p = -1;
                 if (next == npts) break;
-                start(g, &Q, A, next++);
+                start(kind, g, nn, &Q, A, next++);
             }
             if (A->p < 0) continue;
             busy = 1;
