@@ -1157,6 +1157,45 @@ static double chord_deviation(int kind, const double *X)
     return sqrt(dev2) + 0.25 * sqrt(dot3(c3, c3));
 }
 
+/* The squared distance of x from the segment A, A + e (3D). */
+INLINE double segment_distance2(const double *x, const double *A, const double *e)
+{
+    double r[3] = {x[0] - A[0], x[1] - A[1], x[2] - A[2]}, ee = dot3(e, e);
+    double u = clip01(dot3(r, e) / (ee > 0 ? ee : 1.0));
+    for (int k = 0; k < 3; k++) r[k] -= u * e[k];
+    return dot3(r, r);
+}
+
+/* The distance of x from the triangle A, B, C (3D) for a chord bound: from its plane where
+ * the projection on it is inside, else from the edges whose lines the projection is beyond
+ * (the closest point of a triangle lies on such an edge: one or two edges, not three), every
+ * edge of a degenerate triangle. The distance of triangle() to round-off. */
+INLINE double triangle_distance(const double *A, const double *B, const double *C,
+                                const double *x)
+{
+    double a1[3], a2[3], a3[3], r[3];
+    for (int k = 0; k < 3; k++) {
+        a1[k] = B[k] - A[k];
+        a2[k] = C[k] - A[k];
+        a3[k] = C[k] - B[k];
+        r[k] = x[k] - A[k];
+    }
+    double g11 = dot3(a1, a1), g12 = dot3(a1, a2), g22 = dot3(a2, a2);
+    double det = g11 * g22 - g12 * g12, b1 = dot3(r, a1), b2 = dot3(r, a2);
+    int flat = !(det > 1e-14 * g11 * g22);
+    double s1 = g22 * b1 - g12 * b2, s2 = g11 * b2 - g12 * b1; /* det xi */
+    if (!flat && s1 > 0.0 && s2 > 0.0 && s1 + s2 < det) {
+        double xi1 = s1 / det, xi2 = s2 / det, w[3];
+        for (int k = 0; k < 3; k++) w[k] = r[k] - xi1 * a1[k] - xi2 * a2[k];
+        return sqrt(dot3(w, w));
+    }
+    double d2 = INFINITY, e;
+    if (flat || s2 <= 0.0) d2 = segment_distance2(x, A, a1);
+    if (flat || s1 <= 0.0) d2 = (e = segment_distance2(x, A, a2)) < d2 ? e : d2;
+    if (flat || s1 + s2 >= det) d2 = (e = segment_distance2(x, B, a3)) < d2 ? e : d2;
+    return sqrt(d2);
+}
+
 /* Bounds of the distance of x from a quadratic facet X (kind 3, 4 or 5) without its
  * projection: the distance from its chord facet (of kind 5, the nearer of the two
  * triangles of its corners) widened by the facet's chord deviation dev. */
@@ -1167,20 +1206,11 @@ INLINE void chord_bounds(int kind, const double *X, double dev, const double *x,
     if (kind == 3) {
         chord = segment_distance(2, x, X, X + 2);
     } else if (kind == 4) {
-        pair_t q;
-        triangle(X, x, &q);
-        chord = q.dist;
-    } else {
-        double T[9];
-        pair_t q0, q1;
-        triangle(X, x, &q0);
-        for (int k = 0; k < 3; k++) { /* v1, v3, v2 */
-            T[k] = X[3 + k];
-            T[3 + k] = X[9 + k];
-            T[6 + k] = X[6 + k];
-        }
-        triangle(T, x, &q1);
-        chord = q0.dist < q1.dist ? q0.dist : q1.dist;
+        chord = triangle_distance(X, X + 3, X + 6, x);
+    } else { /* (v0, v1, v2) and (v1, v3, v2) */
+        double d0 = triangle_distance(X, X + 3, X + 6, x);
+        double d1 = triangle_distance(X + 3, X + 9, X + 6, x);
+        chord = d0 < d1 ? d0 : d1;
     }
     /* widened by far more than the round-off of the distances */
     *lower = chord - dev * (1 + 1e-12);
