@@ -896,16 +896,17 @@ INLINE void patch_state(int kind, const patch_t *P, const double *x, const doubl
             y2[1][1][k] = 2.0 * P->C[0][2][k];
             continue;
         }
+        /* the sums over p, q in that order without their zero terms (dS[0] = dT[0] = 0,
+         * d2[0] = d2[1] = 0) */
         double a0 = 0.0, a1 = 0.0;
+        for (int p = 1; p < 3; p++)
+            for (int q = 0; q < 3; q++) a0 += dS[p] * T[q] * P->C[p][q][k];
         for (int p = 0; p < 3; p++)
-            for (int q = 0; q < 3; q++) {
-                double c = P->C[p][q][k];
-                a0 += dS[p] * T[q] * c;
-                a1 += S[p] * dT[q] * c;
-                y2[0][0][k] += d2[p] * T[q] * c;
-                y2[0][1][k] += dS[p] * dT[q] * c;
-                y2[1][1][k] += S[p] * d2[q] * c;
-            }
+            for (int q = 1; q < 3; q++) a1 += S[p] * dT[q] * P->C[p][q][k];
+        for (int q = 0; q < 3; q++) y2[0][0][k] += d2[2] * T[q] * P->C[2][q][k];
+        for (int p = 1; p < 3; p++)
+            for (int q = 1; q < 3; q++) y2[0][1][k] += dS[p] * dT[q] * P->C[p][q][k];
+        for (int p = 0; p < 3; p++) y2[1][1][k] += S[p] * d2[2] * P->C[p][2][k];
         Z->a[0][k] = a0;
         Z->a[1][k] = a1;
     }
