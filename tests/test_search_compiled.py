@@ -168,6 +168,63 @@ def test_work_does_not_grow_with_the_radius(quadratic):
     assert work[np.inf] < 40
 
 
+#: a row of the walk's tree (``node_t`` of ``search_kernel.c``)
+_ROW = np.dtype([("lo", "<f4", (3, 4)), ("hi", "<f4", (3, 4)), ("child", "<i8", (4,))])
+_EMPTY = 1 << 62
+
+
+def _leaf_slots(hierarchy: projection._Hierarchy):
+    """The slots of the walk's rows that hold a leaf: their float boxes (lo, hi: (L, 3)) and
+    the leaves' facets (start, count)."""
+    buffer = hierarchy.tree
+    offset = (-buffer.ctypes.data) % 128
+    rows = buffer[offset : offset + (hierarchy.m + 1) * 128].view(_ROW)
+    walked, level = [], [hierarchy.m]  # the rows reached from the root's (row m)
+    while level:
+        walked += level
+        child = rows["child"][level]
+        level = list(child[(child >= 0) & (child != _EMPTY)])
+    child = rows["child"][walked]
+    row, slot = np.nonzero(child < 0)
+    code = -1 - child[row, slot]
+    row = np.asarray(walked)[row]
+    return rows["lo"][row, :, slot], rows["hi"][row, :, slot], code >> 3, code & 7
+
+
+@pytest.mark.parametrize(
+    "make, scale",
+    [
+        (segment_polyline, 1.0),
+        (triangle_soup, 1.0),
+        (triangle_soup, -1e-42),  # floats below the normal range
+        (triangle_soup, 1e-50),  # every coordinate rounds to a signed zero
+        (warped_quads, 3e37),
+        (random_triangles, 1.0),
+        (random_quadrilaterals, -1.0),
+    ],
+)
+def test_tree_boxes_are_the_tightest_floats_around_the_leaves(make, scale):
+    """Every leaf's box in the walk's rows is the tightest single-precision box holding the
+    double-precision boxes of its facets (of their hull points): the outward rounding moves
+    a bound by one float exactly where the nearest float is on the wrong side of it."""
+    rng = np.random.default_rng(11)
+    nodes = np.ascontiguousarray(make(rng, 300) * scale)
+    hierarchy = projection._Hierarchy(nodes)
+    hierarchy.refit(nodes)
+    nf, nn, g = nodes.shape
+    kind = projection.facet_kind(nn, g)
+    hull = projection.bernstein_hull(kind, nodes) if kind in projection.QUADRATIC else nodes
+    lo_f, hi_f, start, count = _leaf_slots(hierarchy)
+    assert count.sum() == nf and count.min() >= 1
+    for k in range(g):
+        facet_lo, facet_hi = hull[..., k].min(axis=1), hull[..., k].max(axis=1)
+        lo = np.array([facet_lo[hierarchy.perm[a : a + c]].min() for a, c in zip(start, count)])
+        hi = np.array([facet_hi[hierarchy.perm[a : a + c]].max() for a, c in zip(start, count)])
+        up, down = np.float32(np.inf), np.float32(-np.inf)
+        assert np.all(lo_f[:, k] <= lo) and np.all(np.nextafter(lo_f[:, k], up) > lo)
+        assert np.all(hi_f[:, k] >= hi) and np.all(np.nextafter(hi_f[:, k], down) < hi)
+
+
 @pytest.mark.serial  # it starts Python processes of its own
 def test_build_cache_and_concurrent_builds(tmp_path):
     """Four processes building the kernel at once into an empty cache directory: all load

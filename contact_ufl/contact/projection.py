@@ -563,6 +563,7 @@ class _Hierarchy:
         #: the facets' records in the order of the leaves (nodes, box, chord deviation)
         self.leaves = np.empty((nf, int(self.lib.bvh_record(self.gdim, self.nn))))
         self.fitted_nodes = np.empty_like(nodes)  # the nodes of the last refit, as given
+        self.leaf_boxes = np.empty((nf, 2 * self.gdim))  # the refit's scratch: < nf leaves
         self.is_fitted = False
         #: a bound of the largest node movement since the build (the sum of the largest
         #: movements from one refit to the next)
@@ -593,7 +594,7 @@ class _Hierarchy:
         R_max = float(
             self.lib.bvh_refit(
                 g, nn, nf, *p(nodes, self.perm), self.m,
-                *p(self.a, self.b, self.tree, self.leaves, self.fitted_nodes, change),
+                *p(self.a, self.b, self.tree, self.leaves, self.fitted_nodes, self.leaf_boxes, change),
             )
         )  # fmt: skip
         if R_max == -2.0:
