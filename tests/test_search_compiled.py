@@ -225,6 +225,33 @@ def test_tree_boxes_are_the_tightest_floats_around_the_leaves(make, scale):
         assert np.all(hi_f[:, k] >= hi) and np.all(np.nextafter(hi_f[:, k], down) < hi)
 
 
+def test_refit_measures_the_change_and_knows_an_unchanged_master():
+    """The refit returns the largest coordinate change since the last one (from its records'
+    copy of the nodes); the hierarchy knows the nodes of its last refit to the last bit, and
+    a tree cache keeps a hierarchy while its nodes moved less than a quarter of the largest
+    facet radius, and replaces it beyond."""
+    rng = np.random.default_rng(5)
+    nodes = np.ascontiguousarray(triangle_soup(rng, 500))
+    hierarchy = projection._Hierarchy(nodes)
+    hierarchy.refit(nodes)
+    assert hierarchy.fitted(nodes)
+    moved = nodes.copy()
+    moved[-1, 2, 1] += 3e-3
+    moved[7, 0, 0] -= 1e-3
+    assert not hierarchy.fitted(moved)
+    assert hierarchy.refit(moved) == pytest.approx(3e-3, rel=1e-12)
+    assert hierarchy.fitted(moved) and not hierarchy.fitted(nodes)
+    last_bit = moved.copy()
+    last_bit[-1, -1, -1] = np.nextafter(last_bit[-1, -1, -1], np.inf)
+    assert not hierarchy.fitted(last_bit)
+
+    trees = TreeCache()
+    first = trees.hierarchy(nodes)
+    R = first.R_max
+    assert trees.hierarchy(np.ascontiguousarray(nodes + 0.1 * R)) is first
+    assert trees.hierarchy(np.ascontiguousarray(nodes + 0.4 * R)) is not first
+
+
 @pytest.mark.serial  # it starts Python processes of its own
 def test_build_cache_and_concurrent_builds(tmp_path):
     """Four processes building the kernel at once into an empty cache directory: all load

@@ -43,10 +43,11 @@ CDEF = """
 typedef long long i64;
 i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b);
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, void *tree, double *leaves, double *fitted,
-                 double *boxes, double *change);
+                 const i64 *a, const i64 *b, void *tree, double *leaves, double *boxes,
+                 double *change);
 int bvh_record(int g, int nn);
-int same_values(i64 len, const double *p, const double *q);
+int same_nodes(int g, int nn, i64 n, const double *nodes, const i64 *perm,
+               const double *leaves);
 int morton_order(int g, i64 n, const double *x, i64 *order);
 i64 bvh_query(int kind, int g, int nn, const double *leaves, const i64 *perm, i64 m,
               const void *tree, double rmax, i64 npts, const double *x, double radius,

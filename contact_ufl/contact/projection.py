@@ -539,11 +539,13 @@ class _Hierarchy:
 
     Built once over the facets' centroids (median splits on the longest axis, two to four
     facets a leaf: ``O(n log n)``), its boxes refitted over the current nodes at every search
-    whose nodes differ from the last one's (``O(n)``, one pass with a copy of the nodes in the
-    order of the leaves; an unchanged master costs one comparison with the nodes of the last
-    refit): exact however far the nodes moved since the build (only slower once they moved
-    far). The walk reads rows of four children (two levels of the binary tree) with their
-    boxes in single precision, rounded outwards.
+    whose nodes differ from the last one's (``O(n)``: a pass over the facets writing each
+    one's record in the order of the leaves, its nodes, box and chord deviation, then the
+    rows from the leaves' boxes; an unchanged master costs one comparison with the nodes of
+    the records, a moved one a facet of it): exact however far the nodes moved since the
+    build (only slower once they moved far). The walk reads rows of four children (two
+    levels of the binary tree) with their boxes in single precision, rounded outwards, and
+    the records of the facets it meets.
     """
 
     def __init__(self, nodes: FloatArray) -> None:
@@ -562,7 +564,6 @@ class _Hierarchy:
         self.tree = np.empty((self.m + 2) * 128, dtype=np.uint8)
         #: the facets' records in the order of the leaves (nodes, box, chord deviation)
         self.leaves = np.empty((nf, int(self.lib.bvh_record(self.gdim, self.nn))))
-        self.fitted_nodes = np.empty_like(nodes)  # the nodes of the last refit, as given
         self.leaf_boxes = np.empty((nf, 2 * self.gdim))  # the refit's scratch: < nf leaves
         self.is_fitted = False
         #: a bound of the largest node movement since the build (the sum of the largest
@@ -579,13 +580,13 @@ class _Hierarchy:
         (successful) refit, to the last bit."""
         p = self._pointers
         return self.is_fitted and bool(
-            self.lib.same_values(nodes.size, *p(nodes, self.fitted_nodes))
+            self.lib.same_nodes(self.gdim, self.nn, len(nodes), *p(nodes, self.perm, self.leaves))
         )
 
     def refit(self, nodes: FloatArray) -> float:
-        """The boxes, largest facet radius and leaf-ordered facet records of the current ``nodes``
-        (C-contiguous), in one pass with the copy of the nodes and their largest coordinate
-        change since the last refit, which it returns (meaningless after none); a
+        """The boxes, largest facet radius and leaf-ordered facet records of the current
+        ``nodes`` (C-contiguous), with the nodes' largest coordinate change since the last
+        refit (against the records' copy), which it returns (meaningless after none); a
         ``ValueError`` if a coordinate is not finite."""
         nf, nn, g = nodes.shape
         p = self._pointers
@@ -594,7 +595,7 @@ class _Hierarchy:
         R_max = float(
             self.lib.bvh_refit(
                 g, nn, nf, *p(nodes, self.perm), self.m,
-                *p(self.a, self.b, self.tree, self.leaves, self.fitted_nodes, self.leaf_boxes, change),
+                *p(self.a, self.b, self.tree, self.leaves, self.leaf_boxes, change),
             )
         )  # fmt: skip
         if R_max == -2.0:

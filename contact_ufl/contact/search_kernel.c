@@ -177,7 +177,6 @@ typedef struct {
     const double *nodes; /* (n, nn, g) as given */
     const i64 *perm, *a, *b;
     double *leaves;     /* (n, RECORD) in the order of perm */
-    double *fitted;     /* (n, nn, g) as given: the nodes of the last refit, then these */
     double *boxes;      /* the leaves' boxes (lo, hi), in preorder */
     i64 m;              /* tree nodes (of the binary tree, in preorder) */
     node_t *T;
@@ -242,19 +241,16 @@ INLINE void fit_records(fit_t *F, const int kind, const int g, const int nn)
         }
         for (i64 j = start; j < start + F->b[i]; j++) {
             const double *X = F->nodes + F->perm[j] * w;
-            double *Y = F->leaves + j * RECORD(g, nn), *Z = F->fitted + F->perm[j] * w, c[3];
+            double *Y = F->leaves + j * RECORD(g, nn), c[3]; /* the nodes of the last refit */
             for (int q = 0; q < w; q++) {
-                double d = fabs(X[q] - Z[q]);
+                double d = fabs(X[q] - Y[q]);
                 change = d > change ? d : change;
-                Z[q] = Y[q] = X[q];
+                Y[q] = X[q];
             }
             if (j + AHEAD < F->n) { /* the nodes of a facet a few on: the gather's latency hidden */
                 const double *next = F->nodes + F->perm[j + AHEAD] * w;
-                const double *last = F->fitted + F->perm[j + AHEAD] * w;
                 PREFETCH(next);
                 PREFETCH(next + w - 1);
-                PREFETCH(last);
-                PREFETCH(last + w - 1);
             }
             double H[27];
             const double *P = hull(kind, g, X, H);
@@ -344,10 +340,10 @@ static i64 fit(fit_t *F, i64 i, double *box)
 }
 
 INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                    const i64 *a, const i64 *b, void *tree, double *leaves, double *fitted,
-                    double *boxes, double *change)
+                    const i64 *a, const i64 *b, void *tree, double *leaves, double *boxes,
+                    double *change)
 {
-    fit_t F = {kind_of(g, nn), g, nn, n, nodes, perm, a, b, leaves, fitted, boxes, m,
+    fit_t F = {kind_of(g, nn), g, nn, n, nodes, perm, a, b, leaves, boxes, m,
                rows(tree), 0, 0, 0.0, 0.0, 1};
     fit_records(&F, F.kind, g, nn);
     if (m > 0) {
@@ -368,31 +364,38 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
 /* The tree over the current nodes (n, nn, g) of the facets: tree (a buffer of (m + 1)
  * sizeof(node_t) + 128 bytes) gets the rows of the walk (every facet point lies in the box of
  * its nodes' convex hull); leaves (n, bvh_record(g, nn)) the facets' records in the order
- * of perm (RECORD: nodes, box, chord deviation; the facets of a leaf contiguous); fitted (n, nn, g), the nodes of the last refit, these nodes, and
- * change the largest coordinate change from the one to the other (one pass over the nodes
- * for all three). Returns the largest facet radius (node distance from the mean of the
+ * of perm (RECORD: nodes, box, chord deviation; the facets of a leaf contiguous), their
+ * nodes those of the last refit before, so that change gets the largest coordinate change
+ * from those to these; boxes (at least n 2 g values) is scratch. Returns the largest facet radius (node distance from the mean of the
  * nodes), -1 for an unknown facet kind, -2 if a coordinate is not finite. */
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
-                 const i64 *a, const i64 *b, void *tree, double *leaves, double *fitted,
-                 double *boxes, double *change)
+                 const i64 *a, const i64 *b, void *tree, double *leaves, double *boxes,
+                 double *change)
 {
-    if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaves, fitted, boxes, change);
-    if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaves, fitted, boxes, change);
-    if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaves, fitted, boxes, change);
-    if (g == 2 && nn == 3) return refit(2, 3, n, nodes, perm, m, a, b, tree, leaves, fitted, boxes, change);
-    if (g == 3 && nn == 6) return refit(3, 6, n, nodes, perm, m, a, b, tree, leaves, fitted, boxes, change);
-    if (g == 3 && nn == 9) return refit(3, 9, n, nodes, perm, m, a, b, tree, leaves, fitted, boxes, change);
+    if (g == 2 && nn == 2) return refit(2, 2, n, nodes, perm, m, a, b, tree, leaves, boxes, change);
+    if (g == 3 && nn == 3) return refit(3, 3, n, nodes, perm, m, a, b, tree, leaves, boxes, change);
+    if (g == 3 && nn == 4) return refit(3, 4, n, nodes, perm, m, a, b, tree, leaves, boxes, change);
+    if (g == 2 && nn == 3) return refit(2, 3, n, nodes, perm, m, a, b, tree, leaves, boxes, change);
+    if (g == 3 && nn == 6) return refit(3, 6, n, nodes, perm, m, a, b, tree, leaves, boxes, change);
+    if (g == 3 && nn == 9) return refit(3, 9, n, nodes, perm, m, a, b, tree, leaves, boxes, change);
     return -1.0;
 }
 
 /* The length of a facet's record in the leaves (RECORD) of nn nodes in g dimensions. */
 int bvh_record(int g, int nn) { return RECORD(g, nn); }
 
-/* Whether two arrays of len values are equal to the last bit (memcmp: one sequential sweep,
- * stopped at the first difference). */
-int same_values(i64 len, const double *p, const double *q)
+/* Whether the nodes (n, nn, g) are those of the last refit, in the records of leaves, to the
+ * last bit (facet by facet in the order of the leaves, stopped at the first difference: a
+ * moved master costs one facet). */
+int same_nodes(int g, int nn, i64 n, const double *nodes, const i64 *perm, const double *leaves)
 {
-    return memcmp(p, q, (size_t)len * sizeof(double)) == 0;
+    const int w = nn * g, rec = RECORD(g, nn);
+    for (i64 j = 0; j < n; j++) {
+        if (j + AHEAD < n) PREFETCH(nodes + perm[j + AHEAD] * w);
+        if (memcmp(nodes + perm[j] * w, leaves + j * rec, (size_t)w * sizeof(double)) != 0)
+            return 0;
+    }
+    return 1;
 }
 
 /* -- the order of the points: a Z-order (Morton) curve ----------------------------------- */
