@@ -215,11 +215,14 @@ def test_tree_boxes_are_the_tightest_floats_around_the_leaves(make, scale):
     kind = projection.facet_kind(nn, g)
     hull = projection.bernstein_hull(kind, nodes) if kind in projection.QUADRATIC else nodes
     lo_f, hi_f, start, count = _leaf_slots(hierarchy)
+    order = np.argsort(start)
+    lo_f, hi_f, start = lo_f[order], hi_f[order], start[order]
+    assert np.array_equal(start, np.cumsum(count[order]) - count[order])  # a partition
     assert count.sum() == nf and count.min() >= 1
     for k in range(g):
-        facet_lo, facet_hi = hull[..., k].min(axis=1), hull[..., k].max(axis=1)
-        lo = np.array([facet_lo[hierarchy.perm[a : a + c]].min() for a, c in zip(start, count)])
-        hi = np.array([facet_hi[hierarchy.perm[a : a + c]].max() for a, c in zip(start, count)])
+        leaf_order = hull[hierarchy.perm, :, k]
+        lo = np.minimum.reduceat(leaf_order.min(axis=1), start)
+        hi = np.maximum.reduceat(leaf_order.max(axis=1), start)
         up, down = np.float32(np.inf), np.float32(-np.inf)
         assert np.all(lo_f[:, k] <= lo) and np.all(np.nextafter(lo_f[:, k], up) > lo)
         assert np.all(hi_f[:, k] >= hi) and np.all(np.nextafter(hi_f[:, k], down) < hi)

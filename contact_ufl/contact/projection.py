@@ -1436,7 +1436,9 @@ def closest_points(
     when the walk is done, and only if the bounds of its distance from its chord facet (the
     straight facet of its vertices, within a distance fixed by its midpoint nodes of it)
     do not rule it out: by increasing lower bound, the bound tightened by the distances
-    found. Of the facets within that reach the tie-break below picks one (in C, in the
+    found; its walk's bound starts from the upper bound of the facet of the point before (a
+    neighbour in the points' order; not in a self-contact search). Of the facets within
+    that reach the tie-break below picks one (in C, in the
     operations of the NumPy search), and its closest point, normal, proximity and ``M``
     come from C too. Self-contact: the inadmissible facets are skipped in the walk (the
     same rule).
