@@ -564,7 +564,7 @@ class _Hierarchy:
         self.tree = np.empty((self.m + 2) * 128, dtype=np.uint8)
         #: the facets' records in the order of the leaves (nodes, box, chord deviation)
         self.leaves = np.empty((nf, int(self.lib.bvh_record(self.gdim, self.nn))))
-        self.leaf_boxes = np.empty((nf, 2 * self.gdim))  # the refit's scratch: < nf leaves
+        self.leaf_boxes = np.empty((nf, 2 * self.gdim))  # the refit's scratch: <= nf leaves
         self.is_fitted = False
         #: a bound of the largest node movement since the build (the sum of the largest
         #: movements from one refit to the next)

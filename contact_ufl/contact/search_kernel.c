@@ -895,7 +895,7 @@ INLINE void patch_residual(int kind, const patch_t *P, const double *x, const do
     const double s = xi[0], t = xi[1], t2 = t * t, S[3] = {1.0, s, s * s};
     for (int k = 0; k < 3; k++) {
         double v = 0.0;
-        if (kind == 4) /* the terms of the 9-node sum that are not zero, in its order */
+        if (kind == 4) /* the terms of the nine-term sum that are not zero, in its order */
             v = ((P->C[0][0][k] + t * P->C[0][1][k]) + t2 * P->C[0][2][k])
                 + S[1] * (P->C[1][0][k] + t * P->C[1][1][k]) + S[2] * P->C[2][0][k];
         else
