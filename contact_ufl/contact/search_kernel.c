@@ -23,6 +23,8 @@
  * the closest points are the same), and their codes (a row index, or -1 - (8 start + count)
  * for a leaf, EMPTY for an unused slot), so that two levels of the binary tree cost one
  * row. The rows are in preorder; row m holds the root's box and code as its first child.
+ * The facets themselves are records in the order of the leaves (RECORD: nodes, box, chord
+ * deviation), written with the rows by bvh_refit.
  *
  * The query walks LANES points at a time on a surface, one step of each by turns (a row's
  * children pushed, or a leaf's facets visited): the loads one walk has just started
