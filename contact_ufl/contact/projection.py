@@ -1438,10 +1438,9 @@ def closest_points(
     do not rule it out: by increasing lower bound, the bound tightened by the distances
     found; its walk's bound starts from the upper bound of the facet of the point before (a
     neighbour in the points' order; not in a self-contact search). Of the facets within
-    that reach the tie-break below picks one (in C, in the
-    operations of the NumPy search), and its closest point, normal, proximity and ``M``
-    come from C too. Self-contact: the inadmissible facets are skipped in the walk (the
-    same rule).
+    that reach the tie-break below picks one (in C, in the operations of the NumPy search),
+    and its closest point, normal, proximity and ``M`` come from C too. Self-contact: the
+    inadmissible facets are skipped in the walk (the same rule).
 
     Candidate search with ``CONTACT_UFL_SEARCH=numpy``:
     KD-trees of the facet centroids (the mean of the nodes; of a quadratic facet, of its

@@ -368,8 +368,9 @@ INLINE double refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, 
  * its nodes' convex hull); leaves (n, bvh_record(g, nn)) the facets' records in the order
  * of perm (RECORD: nodes, box, chord deviation; the facets of a leaf contiguous), their
  * nodes those of the last refit before, so that change gets the largest coordinate change
- * from those to these; boxes (at least n 2 g values) is scratch. Returns the largest facet radius (node distance from the mean of the
- * nodes), -1 for an unknown facet kind, -2 if a coordinate is not finite. */
+ * from those to these; boxes (at least n 2 g values) is scratch. Returns the largest facet
+ * radius (node distance from the mean of the nodes), -1 for an unknown facet kind, -2 if a
+ * coordinate is not finite. */
 double bvh_refit(int g, int nn, i64 n, const double *nodes, const i64 *perm, i64 m,
                  const i64 *a, const i64 *b, void *tree, double *leaves, double *boxes,
                  double *change)
@@ -408,14 +409,14 @@ INLINE int same(const int g, const int nn, i64 n, const double *nodes, const i64
 
 int same_nodes(int g, int nn, i64 n, const double *nodes, const i64 *perm, const double *leaves)
 {
-    switch (g * 16 + nn) { /* the loops of each kind unrolled */
-    case 34: return same(2, 2, n, nodes, perm, leaves);
-    case 35: return same(2, 3, n, nodes, perm, leaves);
-    case 51: return same(3, 3, n, nodes, perm, leaves);
-    case 52: return same(3, 4, n, nodes, perm, leaves);
-    case 54: return same(3, 6, n, nodes, perm, leaves);
-    default: return same(3, 9, n, nodes, perm, leaves);
-    }
+    /* the loops of each kind unrolled, as bvh_refit's; an unknown kind is never the same */
+    if (g == 2 && nn == 2) return same(2, 2, n, nodes, perm, leaves);
+    if (g == 3 && nn == 3) return same(3, 3, n, nodes, perm, leaves);
+    if (g == 3 && nn == 4) return same(3, 4, n, nodes, perm, leaves);
+    if (g == 2 && nn == 3) return same(2, 3, n, nodes, perm, leaves);
+    if (g == 3 && nn == 6) return same(3, 6, n, nodes, perm, leaves);
+    if (g == 3 && nn == 9) return same(3, 9, n, nodes, perm, leaves);
+    return 0;
 }
 
 /* -- the order of the points: a Z-order (Morton) curve ----------------------------------- */
@@ -907,8 +908,9 @@ INLINE void patch_residual(int kind, const patch_t *P, const double *x, const do
     }
 }
 
-/* The state at xi (the monomials of a 6-node triangle, p + q <= 2, only: the others are
- * zero, and the sums of the nine terms the same without them) */
+/* The state at xi, the sums over the monomials without their terms that are zero (of a
+ * 6-node triangle only those of p + q <= 2; the factors dS[0], dT[0], d2[0], d2[1]), in the
+ * order of the full sums: the same values. */
 INLINE void patch_state(int kind, const patch_t *P, const double *x, const double *xi,
                         state_t *Z)
 {
