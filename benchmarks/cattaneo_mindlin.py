@@ -9,9 +9,9 @@ shear traction inside |x| < 0.8 a relative to mu p0, Newton iterations and times
 """
 
 import argparse
-import json
 import time
 
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.verification.runs import cattaneo_mindlin_run
@@ -52,8 +52,7 @@ def main() -> None:
                     f"{r['newton_iterations']:6d}"
                 )
     if comm.rank == 0:
-        with open(args.json, "w") as f:
-            json.dump(runs, f, indent=2)
+        resultfile.write(args.json, runs)
 
 
 if __name__ == "__main__":

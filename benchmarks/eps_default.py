@@ -44,11 +44,11 @@ previous iterate; see :func:`trace_iterates`).
 
 import argparse
 import dataclasses
-import json
 import time
 from collections.abc import Callable, Sequence
 
 import numpy as np
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.materials import LinearElastic
@@ -221,8 +221,7 @@ def main() -> None:
             if rank0:
                 print(row(r), flush=True)
     if rank0:
-        with open(args.json, "w") as f:
-            json.dump(records, f, indent=1)
+        resultfile.write(args.json, records)
 
 
 if __name__ == "__main__":

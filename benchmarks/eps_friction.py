@@ -27,9 +27,9 @@ default's on the same mesh), ``wall_s``, ``ranks``.
 """
 
 import argparse
-import json
 import time
 
+import resultfile
 from eps_default import compared_to_default
 from mpi4py import MPI
 
@@ -118,8 +118,7 @@ def main() -> None:
             if comm.rank == 0:
                 print(row(r), flush=True)
         if comm.rank == 0:
-            with open(args.json, "w") as f:
-                json.dump(records, f, indent=2)
+            resultfile.write(args.json, records)
 
 
 if __name__ == "__main__":

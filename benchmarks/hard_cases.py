@@ -27,9 +27,8 @@ stopped (a time-out) keeps the cases it finished; the cases it did not reach are
 """
 
 import argparse
-import json
-from pathlib import Path
 
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.verification.hard_cases import NOT_IMPLEMENTED, cases, run_case
@@ -90,9 +89,7 @@ NOT_REACHED = "not run this time (the run ended before this case)"
 
 def write(path: str, quick: bool, ranks: int, records: list[dict]) -> None:
     """Write the report to ``path``: ``quick``, ``ranks`` and ``records`` (the suite's order)."""
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w") as f:
-        json.dump({"quick": quick, "ranks": ranks, "cases": records}, f, indent=1)
+    resultfile.write(path, {"quick": quick, "ranks": ranks, "cases": records}, ranks=ranks)
 
 
 def main() -> None:

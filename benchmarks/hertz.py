@@ -43,13 +43,13 @@ on coarser meshes (:data:`FULL_3D_P2`); ``--h`` replaces the meshes by ``(h, Non
 
 import argparse
 import dataclasses
-import json
 import os
 import sys
 import time
 from collections.abc import Callable
 
 import numpy as np
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.materials import LinearElastic
@@ -205,8 +205,7 @@ def plot(path: str, files: list[str], time_key: str = "wall_s") -> None:
 
     fig, ax = plt.subplots(figsize=(7.0, 4.8))
     for name in files:
-        with open(name) as f:
-            records = json.load(f)
+        records = resultfile.load(name)
         seconds = [r[time_key] for r in records]
         error = [abs(nominal_p0_error(r)) for r in records]
         style = "o-" if records[0].get("degree", 1) == 1 else "s--"
@@ -291,8 +290,7 @@ def main_3d(args) -> None:
                 f"{r['newton_per_step']:6.1f} {r['wall_s']:7.1f} {r['search_s']:8.1f}",
                 flush=True,
             )
-            with open(args.json, "w") as f:
-                json.dump(records, f, indent=2)
+            resultfile.write(args.json, records)
 
 
 def main() -> None:
@@ -389,8 +387,7 @@ def main() -> None:
                 flush=True,
             )
     if comm.rank == 0:
-        with open(args.json, "w") as f:
-            json.dump(records, f, indent=2)
+        resultfile.write(args.json, records)
 
 
 if __name__ == "__main__":

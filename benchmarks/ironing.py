@@ -19,9 +19,9 @@ and prescribed displacement of each step) and ``cutbacks``.
 """
 
 import argparse
-import json
 import time
 
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.verification.literature import IRONING_FORCES, IRONING_LITERATURE
@@ -90,8 +90,7 @@ def main() -> None:
         print("published |Fx/Fy| at t = 1.5 with mu = 0.3:")
         for source, value in IRONING_LITERATURE.items():
             print(f"  {value:.2f}  {source}")
-        with open(args.json, "w") as f:
-            json.dump(runs, f, indent=2)
+        resultfile.write(args.json, runs)
 
 
 if __name__ == "__main__":

@@ -22,9 +22,9 @@ JSON (a list of runs, each with ``mu``, ``history``: records ``time``, ``Fx``, `
 """
 
 import argparse
-import json
 import time
 
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.verification.literature import IRONING_3D
@@ -113,8 +113,7 @@ def main() -> None:
             report(run)
     if comm.rank == 0:
         print(f"published force histories: {IRONING_3D['status']}")
-        with open(args.json, "w") as f:
-            json.dump(runs, f, indent=2)
+        resultfile.write(args.json, runs)
         if args.png:
             plot(runs, args.png)
 

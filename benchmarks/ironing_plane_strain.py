@@ -30,10 +30,10 @@ run's times where a cut-back made their steps differ.)
 """
 
 import argparse
-import json
 import time
 
 import numpy as np
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.verification.literature import IRONING_FORCES, IRONING_LITERATURE
@@ -162,8 +162,7 @@ def main() -> None:
         runs += pair
         if MPI.COMM_WORLD.rank == 0:
             report(mu, plane, extruded)
-            with open(args.json, "w") as f:  # after every mu: a long run keeps what it made
-                json.dump(runs, f, indent=2)
+            resultfile.write(args.json, runs)  # after every mu: a long run keeps what it made
 
 
 if __name__ == "__main__":

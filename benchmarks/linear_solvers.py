@@ -23,6 +23,7 @@ import os
 import time
 
 import numpy as np
+import resultfile
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -155,8 +156,7 @@ def main() -> None:
             if comm.rank == 0:
                 print(json.dumps(record), flush=True)
     if comm.rank == 0:
-        with open(args.json, "w") as f:
-            json.dump(records, f, indent=1)
+        resultfile.write(args.json, records)
 
 
 if __name__ == "__main__":

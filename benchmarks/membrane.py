@@ -49,10 +49,10 @@ steps need more than SNES's 25 iterations and are cut back (7 cut-backs); use mo
 from __future__ import annotations
 
 import argparse
-import json
 import time
 
 import numpy as np
+import resultfile
 from mpi4py import MPI
 
 import contact_ufl as cu
@@ -184,8 +184,7 @@ def main() -> None:
             if comm.rank == 0:
                 print(row(records[-1]), flush=True)
     if comm.rank == 0:
-        with open(args.json, "w") as f:
-            json.dump(records, f, indent=2)
+        resultfile.write(args.json, records)
 
 
 if __name__ == "__main__":

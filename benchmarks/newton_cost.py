@@ -73,7 +73,6 @@ the same answers on any number of ranks) and ``contact_force``; contact records 
 
 import argparse
 import dataclasses
-import json
 import os
 import resource
 import subprocess
@@ -82,6 +81,7 @@ import tempfile
 import time
 
 import numpy as np
+import resultfile
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -425,8 +425,7 @@ def _by_ranks(args: argparse.Namespace) -> None:
                 out = os.path.join(tmp, f"n{k}.json")
                 command = [mpirun, "-n", str(k), sys.executable, __file__, *rest, "--json", out]
                 subprocess.run(command, check=True)
-                with open(out) as f:
-                    runs[k].append(json.load(f))
+                runs[k].append(resultfile.load(out))
     records = []
     for k in args.ranks:
         for j in range(len(runs[k][0])):
@@ -439,8 +438,7 @@ def _by_ranks(args: argparse.Namespace) -> None:
             r["cpu_speedup"] = base["cpu_per_it_s"] / r["cpu_per_it_s"]
     for r in records:
         print(f"{r['ranks']:2d} " + row(r) + f" {r.get('speedup', float('nan')):6.2f}")
-    with open(args.json, "w") as f:
-        json.dump(records, f, indent=1)
+    resultfile.write(args.json, records, ranks=args.ranks)
 
 
 def main() -> None:
@@ -500,8 +498,7 @@ def main() -> None:
                     flush=True,
                 )
     if rank0:
-        with open(args.json, "w") as f:
-            json.dump(records, f, indent=1)
+        resultfile.write(args.json, records)
 
 
 if __name__ == "__main__":

@@ -147,11 +147,11 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import json  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 
 import numpy as np  # noqa: E402
+import resultfile  # noqa: E402
 
 from contact_ufl.contact import projection  # noqa: E402
 from contact_ufl.contact.projection import closest_points  # noqa: E402
@@ -706,8 +706,7 @@ def main() -> None:
         ),
     }
     records = [r for name in args.sweeps for r in run[name]()]
-    with open(args.json, "w") as f:
-        json.dump({"quick": args.quick, "records": records}, f, indent=1)
+    resultfile.write(args.json, {"quick": args.quick, "records": records}, ranks=1)
 
 
 if __name__ == "__main__":

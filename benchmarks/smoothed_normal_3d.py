@@ -9,9 +9,9 @@ bottom held and the upper body's top pressed down and slid over the master surfa
 
 import argparse
 import dataclasses
-import json
 import time
 
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.errors import ConvergenceError
@@ -73,8 +73,7 @@ def main() -> None:
                 f"cutbacks={r['cutbacks']} "
                 f"active={r['active_points']} wall={r['wall_s']:.1f}s"
             )
-        with open(args.json, "w") as f:
-            json.dump(records, f, indent=2)
+        resultfile.write(args.json, records)
 
 
 if __name__ == "__main__":

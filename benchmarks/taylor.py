@@ -6,8 +6,8 @@ A consistent tangent gives slope 2; freezing the projected point (``--frozen``) 
 """
 
 import argparse
-import json
 
+import resultfile
 from mpi4py import MPI
 
 from contact_ufl.taylor import taylor_test
@@ -45,8 +45,7 @@ def main() -> None:
                 f"{r['dim']}D frozen={r['frozen_projection']!s:5} active={r['active_points']:5d}"
                 f" slopes: {slopes}  (facets changed: {r['facets_changed']})"
             )
-        with open(args.json, "w") as f:
-            json.dump(records, f, indent=2)
+        resultfile.write(args.json, records)
 
 
 if __name__ == "__main__":

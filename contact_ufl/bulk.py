@@ -17,7 +17,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from contact_ufl import membranes
+from contact_ufl import jit, membranes
 from contact_ufl.control import VolumeControl
 from contact_ufl.loads import (
     BodyForce,
@@ -208,7 +208,7 @@ class Bulk:
             for i in range(gdim):
                 e_i = dolfinx.fem.Constant(mesh, np.eye(gdim)[i])
                 work = sum(self.virtual_work(load, e_i, c) for load, c in self.load_constants)
-                self._load_resultant_forms.append(dolfinx.fem.form(work) if work else None)
+                self._load_resultant_forms.append(jit.form(work) if work else None)
         local = [
             dolfinx.fem.assemble_scalar(f) if f is not None else 0.0
             for f in self._load_resultant_forms
@@ -218,5 +218,5 @@ class Bulk:
     def stored_energy(self) -> float:
         """Elastic energy ``sum_b int psi_b(F) dV`` of the (hyperelastic) bodies."""
         if self._energy_form is None:
-            self._energy_form = dolfinx.fem.form(self.energy())
+            self._energy_form = jit.form(self.energy())
         return self.comm.allreduce(dolfinx.fem.assemble_scalar(self._energy_form))

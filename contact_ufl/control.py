@@ -32,6 +32,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from contact_ufl import jit
 from contact_ufl.loads import evaluate
 from contact_ufl.membranes import area_vector, pressure_virtual_work
 
@@ -100,10 +101,10 @@ class VolumeConstraint:
         u, n0, dx = bulk.u, bulk.n0, bulk.dx(control.tag)
         x = ufl.SpatialCoordinate(mesh) + u
         self.volume_density = ufl.dot(x, area_vector(u, n0)) / self.gdim
-        self._volume_form = dolfinx.fem.form(self.volume_density * dx)
+        self._volume_form = jit.form(self.volume_density * dx)
         self.reference_volume = self.volume()
         one = dolfinx.fem.Constant(mesh, 1.0)
-        self.area = comm.allreduce(dolfinx.fem.assemble_scalar(dolfinx.fem.form(one * dx)))
+        self.area = comm.allreduce(dolfinx.fem.assemble_scalar(jit.form(one * dx)))
         self.scale = scale
         self.block: int | None = None
         self._value = 0.0
@@ -169,7 +170,7 @@ class VolumeConstraint:
             u, n0, dx = self.bulk.u, self.bulk.n0, self.bulk.dx(self.control.tag)
             e = np.eye(self.gdim)
             self._resultant_forms = [
-                dolfinx.fem.form(pressure_virtual_work(u, ufl.as_vector(e[i]), n0, self.p) * dx)
+                jit.form(pressure_virtual_work(u, ufl.as_vector(e[i]), n0, self.p) * dx)
                 for i in range(self.gdim)
             ]
         local = [dolfinx.fem.assemble_scalar(f) for f in self._resultant_forms]

@@ -20,6 +20,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from contact_ufl import jit
 from contact_ufl.errors import ContactInputError
 
 Value = float | Sequence[float] | Callable[[float], float | Sequence[float]]
@@ -74,6 +75,8 @@ class DeadTraction(_DeadLoad):
         Traction vector ``T`` (force per unit reference area), or a callable of ``t``. A
         resultant ``P`` spread over a reference area ``A0`` is ``T = P / A0``.
 
+    Notes
+    -----
     Its external virtual work is ``int T . v dS_o``.
     """
 
@@ -89,6 +92,8 @@ class BodyForce(_DeadLoad):
     value
         Force vector per unit reference volume, or a callable of ``t``.
 
+    Notes
+    -----
     Its external virtual work is ``int rho_0 f . v dOmega_o``.
     """
 
@@ -172,7 +177,7 @@ class FollowerForce:
     def reference_area(self, ds: ufl.Measure, mesh: dolfinx.mesh.Mesh) -> float:
         """``A0 = int_{tag} dS_o``, summed over all ranks."""
         one = dolfinx.fem.Constant(mesh, 1.0)
-        local = dolfinx.fem.assemble_scalar(dolfinx.fem.form(one * ds(self.tag)))
+        local = dolfinx.fem.assemble_scalar(jit.form(one * ds(self.tag)))
         return mesh.comm.allreduce(local, MPI.SUM)
 
     def traction(

@@ -52,6 +52,7 @@ import ufl
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from contact_ufl import jit
 from contact_ufl.errors import ContactInputError, collective_check
 from contact_ufl.loads import deformation_gradient
 from contact_ufl.materials import lame_parameters
@@ -105,7 +106,7 @@ def _cell_integrals(mesh: dolfinx.mesh.Mesh) -> np.ndarray:
     columns = ufl.as_vector([1.0, *xs, *Ns, ufl.dot(N, x)])
     W = dolfinx.fem.functionspace(mesh, ("DG", 0, (2 + 2 * gdim,)))
     dx = ufl.Measure("dx", mesh, metadata={"quadrature_degree": 2})
-    form = dolfinx.fem.form(ufl.dot(columns, ufl.TestFunction(W)) * dx)
+    form = jit.form(ufl.dot(columns, ufl.TestFunction(W)) * dx)
     b = dolfinx.fem.assemble_vector(form)
     b.scatter_reverse(dolfinx.la.InsertMode.add)
     owned = mesh.topology.index_map(mesh.topology.dim).size_local

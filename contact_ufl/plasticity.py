@@ -34,6 +34,7 @@ import numpy as np
 import ufl
 from petsc4py import PETSc
 
+from contact_ufl import jit
 from contact_ufl.loads import deformation_gradient
 from contact_ufl.materials import lame_parameters
 
@@ -189,8 +190,8 @@ class PlasticHistory:
         self.tau, Cp_inv, alpha = material.return_map(self.F3, self.Cp_inv, self.alpha)
         points = self.Cp_inv.function_space.element.interpolation_points
         self._updates = [
-            (self.Cp_inv, dolfinx.fem.Expression(Cp_inv, points)),
-            (self.alpha, dolfinx.fem.Expression(alpha, points)),
+            (self.Cp_inv, jit.expression(Cp_inv, points)),
+            (self.alpha, jit.expression(alpha, points)),
         ]
 
     def first_piola(self) -> ufl.core.expr.Expr:
@@ -205,7 +206,7 @@ class PlasticHistory:
         mesh = self.u.function_space.mesh
         v = ufl.TestFunction(self.plastic_strain.function_space)
         dx = ufl.dx(domain=mesh)
-        return dolfinx.fem.form(self.alpha * v * dx), dolfinx.fem.form(v * dx)
+        return jit.form(self.alpha * v * dx), jit.form(v * dx)
 
     @functools.cached_property
     def plastic_strain(self) -> dolfinx.fem.Function:

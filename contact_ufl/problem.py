@@ -23,7 +23,7 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from contact_ufl import keysets
+from contact_ufl import jit, keysets
 from contact_ufl.bulk import Bulk
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
@@ -279,12 +279,12 @@ class ContactProblem:
             for row in tangent
         ]
         entity_maps = [c.slave.entity_map for c in self.contacts]
-        self.residual_form = dolfinx.fem.form(residuals, entity_maps=entity_maps)
+        self.residual_form = jit.form(residuals, entity_maps=entity_maps)
         # the contact terms alone
         self._contact_residual_ufl = [_summed(on) for on in terms.on_slave]
         self._contact_residual_ufl += [[F] for F in terms.own] + [[] for _ in controls]
         self._contact_residual_form = None
-        self.jacobian_form = dolfinx.fem.form(jacobian, entity_maps=entity_maps)
+        self.jacobian_form = jit.form(jacobian, entity_maps=entity_maps)
         self.full_layout = StackedLayout([f.function_space for f in fields])
         self.layout = StackedLayout([f.function_space for f in unknowns])
 
@@ -489,7 +489,7 @@ class ContactProblem:
         """The contact terms alone of the residual at the current state, as a vector of the
         unknowns (master parts gathered through the chain rule of :attr:`solver`)."""
         if self._contact_residual_form is None:
-            self._contact_residual_form = dolfinx.fem.form(
+            self._contact_residual_form = jit.form(
                 self._contact_residual_ufl, entity_maps=[c.slave.entity_map for c in self.contacts]
             )
         return self.solver.assemble(self._contact_residual_form)

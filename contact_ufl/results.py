@@ -11,7 +11,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from contact_ufl import keysets
+from contact_ufl import jit, keysets
 
 
 @dataclass
@@ -86,7 +86,7 @@ def traction_mismatch(problem, pair: int = 0) -> float:
     forms = [ufl.dot(diff, diff) * c.ds, c.lambda_N**2 * c.ds]
     values = [
         problem.comm.allreduce(
-            dolfinx.fem.assemble_scalar(dolfinx.fem.form(f, entity_maps=[c.slave.entity_map])),
+            dolfinx.fem.assemble_scalar(jit.form(f, entity_maps=[c.slave.entity_map])),
             MPI.SUM,
         )
         for f in forms
@@ -131,7 +131,7 @@ def weak_contact_law(problem, pair: int = 0) -> tuple[float, float]:
     owned = slave.P1.dofmap.index_map.size_local
 
     def nodal(expr):
-        form = dolfinx.fem.form(expr * mu * c.ds, entity_maps=[c.slave.entity_map])
+        form = jit.form(expr * mu * c.ds, entity_maps=[c.slave.entity_map])
         return slave.assemble_nodal(form, slave.P1)[:owned]
 
     active = c.active()
@@ -177,7 +177,7 @@ def _facet_integral(bulk, expr, tag: int) -> np.ndarray:
     """``int_{tag} expr dS_o`` (a vector expression) over the mesh of ``bulk``, summed over
     all ranks."""
     values = [
-        dolfinx.fem.assemble_scalar(dolfinx.fem.form(expr[i] * bulk.ds(tag)))
+        dolfinx.fem.assemble_scalar(jit.form(expr[i] * bulk.ds(tag)))
         for i in range(expr.ufl_shape[0])
     ]
     return bulk.comm.allreduce(np.asarray(values), MPI.SUM)
@@ -390,6 +390,6 @@ def _inverted(bulk) -> np.ndarray:
         return np.zeros(owned, dtype=bool)
     vertices = basix.geometry(basix.CellType[mesh.topology.cell_type.name])
     points = np.vstack([vertices, vertices.mean(axis=0)])
-    J = dolfinx.fem.Expression(ufl.det(deformation_gradient(bulk.u)), points)
+    J = jit.expression(ufl.det(deformation_gradient(bulk.u)), points)
     values = J.eval(mesh, np.arange(owned, dtype=np.int32)).reshape(owned, len(points))
     return ~np.all(values > 0.0, axis=1)  # (NaN too: an iterate beyond the material's domain)

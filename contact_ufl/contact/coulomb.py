@@ -40,6 +40,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from contact_ufl import jit
 from contact_ufl.contact.kinematics import MeshKinematics
 from contact_ufl.contact.obstacles import ObstacleKinematics
 from contact_ufl.contact.slave import SlaveSurface
@@ -218,7 +219,7 @@ class CoulombLaw:
 
     @functools.cached_property
     def _slip_form(self) -> dolfinx.fem.Form:
-        return dolfinx.fem.form(
+        return jit.form(
             ufl.dot(self.slip, ufl.TestFunction(self.L_T)) * self.slave.ds,
             entity_maps=[self.slave.entity_map],
         )

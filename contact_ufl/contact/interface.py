@@ -32,6 +32,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from contact_ufl import jit
 from contact_ufl.contact.coulomb import CoulombLaw
 from contact_ufl.contact.facets import scalar_element
 from contact_ufl.contact.kinematics import MeshKinematics
@@ -425,7 +426,7 @@ class ContactInterface:
             expr = self.surface_integrands()[name]
             parts = [expr[i] for i in range(expr.ufl_shape[0])] if expr.ufl_shape else [expr]
             self._surface_forms[name] = [
-                dolfinx.fem.form(e * self.ds, entity_maps=[self.slave.entity_map]) for e in parts
+                jit.form(e * self.ds, entity_maps=[self.slave.entity_map]) for e in parts
             ]
         local = np.array([dolfinx.fem.assemble_scalar(f) for f in self._surface_forms[name]])
         return self.V.mesh.comm.allreduce(local, MPI.SUM)

@@ -29,7 +29,7 @@ import ufl
 from mpi4py import MPI
 from scipy.spatial import cKDTree
 
-from contact_ufl import keysets
+from contact_ufl import jit, keysets
 from contact_ufl.contact.facets import (
     basix_cell,
     coordinate_element,
@@ -384,7 +384,7 @@ class SlaveSurface:
     @functools.cached_property
     def nodal_mass(self) -> np.ndarray:
         """``int phi_i dS_o`` of the owned multiplier nodes (the reference surface)."""
-        form = dolfinx.fem.form(ufl.TestFunction(self.P1) * self.ds, entity_maps=[self.entity_map])
+        form = jit.form(ufl.TestFunction(self.P1) * self.ds, entity_maps=[self.entity_map])
         return self.assemble_nodal(form, self.P1)[: self.P1.dofmap.index_map.size_local].copy()
 
     def node_blocks(self) -> np.ndarray:
