@@ -20,7 +20,7 @@ A scene is read from a gmsh mesh with named physical groups, and solved::
     problem.solve(num_steps=4)
     print(problem.contact_force())
 
-Bodies on meshes of their own are :class:`Domain` s of one scene
+Bodies on meshes of their own are the domains (:class:`Domain`) of one scene
 (``Scene(domains=[...], contacts=[...])``), each with its own displacement field.
 
 The parts, as modules: :mod:`.scene` (bodies, domains, supports, loads, pairs),

@@ -3,10 +3,10 @@
 DOLFINx packs every coefficient of a form for every entity of each of its integrals. A block
 that added the contact terms (integrals over the slave facets, whose coefficients are the
 point data on the slave submesh) to the bulk's cell integrals would pack that point data,
-as zeros, for every cell of the mesh: in 3D Hertz at 50,000 unknowns 99 values a cell where
-the bulk needs 12, 31 ms of a 44 ms residual. So each block is a list of *parts*, compiled
-one by one (the bulk's cells and loads, then the contact terms) and added into the block one
-after the other.
+as zeros, for every cell of the mesh: many times the values the bulk needs, and most of the
+residual's time in 3D (see ``docs/developer.md``). So each block is a list of *parts*,
+compiled one by one (the bulk's cells and loads, then the contact terms) and added into the
+block one after the other.
 
 Two savings on the tangent: the parts that depend on no coefficient and no constant (a
 linear-elastic bulk's stiffness) can be told apart (:func:`split_constant`) and assembled

@@ -1,10 +1,10 @@
 """How the package's forms are compiled: FFCx writes C, the C compiler builds it.
 
 DOLFINx builds every kernel with ``-O2``. The package's kernels run as fast built with
-``-O1``, which compiles about a third faster: the large 3D contact kernels are most of a
-new scene's set-up time (see the developer guide). A process that finds a form being
-compiled by another (tests on two cores, two notebooks) waits for it, ``timeout`` seconds,
-long enough for the largest contact kernels.
+``-O1``, which compiles faster: the large 3D contact kernels are most of a new scene's
+set-up time (see ``docs/developer.md``). A process that finds a form being compiled by
+another (parallel tests, two notebooks) waits for it, ``timeout`` seconds, long enough for
+the largest contact kernels.
 
 Change :data:`JIT_OPTIONS` before a problem is built to compile otherwise; it takes
 precedence over DOLFINx's ``dolfinx_jit_options.json`` for the options it names.

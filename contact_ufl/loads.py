@@ -83,7 +83,7 @@ class DeadTraction(_DeadLoad):
 
 @dataclass(frozen=True)
 class BodyForce(_DeadLoad):
-    """Dead body force per unit reference volume (``rho_0 f`` of ``formulation.md``).
+    """Dead body force per unit reference volume (``rho_0 f``, ``f`` per unit mass).
 
     Parameters
     ----------

@@ -51,10 +51,10 @@ DEFAULT_PETSC_OPTIONS = {
 #: split of the unknowns (:meth:`NewtonSolver._split_fields`), algebraic multigrid (GAMG) on
 #: the displacements and LU on the multipliers' Schur approximation. MUMPS's work grows like n^2
 #: with the unknowns in 3D, this one's about like n: it pays from some 25,000 unknowns in 3D
-#: with linear elements (with quadratic ones MUMPS was faster at 43,000) and gains more on
-#: two ranks (README, "Solvers for large problems"). Its linear solves end
-#: at a relative residual of 1e-8; Newton's iterations and answers are MUMPS's. A problem
-#: without multipliers (no contact pair) takes the multigrid on the whole.
+#: with linear elements (not with quadratic ones at the sizes tried) and gains more on two
+#: ranks (see :doc:`/guide/solvers`). Its linear solves end at a relative residual of
+#: 1e-8; Newton's iterations and answers are MUMPS's. A problem without multipliers (no
+#: contact pair) takes the multigrid on the whole.
 FIELD_SPLIT_PETSC_OPTIONS = {
     "ksp_type": "fgmres",
     "ksp_rtol": 1e-8,
@@ -160,9 +160,9 @@ class NewtonTimings:
 
 #: The growth of the residual norm above which a first contact's predictor iterate is
 #: undone (:meth:`NewtonSolver._predictor_iterate`): it changes the contact state at once,
-#: so the norm may grow (2D Hertz: by up to 1.3 on the iterate that saves 2 to 3 later),
-#: but a predictor that pulls large overlaps shut in one linear step can throw the state far
-#: off (the beams' first contact without friction: 16 times, and Newton then inverts cells).
+#: so the norm may grow a little on an iterate that saves later ones, but a predictor that
+#: pulls large overlaps shut in one linear step can throw the state far off (the beams' first
+#: contact without friction), and Newton then inverts cells.
 _PREDICTOR_GROWTH = 10.0
 
 
@@ -250,19 +250,17 @@ class NewtonSolver:
         keeps its symbolic analysis. A pairing outside it grows the pattern (a union); a
         union that would hold more than ``1 + pattern_slack`` times the couplings of the
         current superset is rebuilt on the current one instead (at that growth, or at the
-        start of a step). In 3D, where every new pairing grows the pattern, the union of
-        the 40 pairings of the 3D Hertz solve at 50,000 P1 unknowns had 6 times the
-        nonzeros of the rebuilt pattern and 2.6 times its factorisation's flops. A pairing
-        that leaves the last superset but whose product ``T^T K T`` has no nonzero outside
-        those added to the solver matrix keeps the matrix and its analysis (3D Hertz P1,
-        the default ``eps_N``: 7 analyses instead of 10 at 11,000 unknowns, 7 instead of
-        13 at 50,000).
+        start of a step): in 3D, where every new pairing grows the pattern, an unbounded
+        union ends with several times the nonzeros and the factorisation's flops of the
+        rebuilt pattern. A pairing that leaves the last superset but whose product ``T^T K
+        T`` has no nonzero outside those added to the solver matrix keeps the matrix and its
+        analysis, which saves analyses in 3D (see :doc:`/guide/solvers` and, for the
+        numbers, :doc:`/developer`).
     pattern_superset
         Whether the pattern holds the facets beside each point's facet (default: in 2D).
         Without it (the 3D default) the pattern is the union of the pairings met: an analysis
-        for every pairing that leaves it. In 3D the superset's extra fill (9% more flops at
-        11,000 P2 unknowns; more with the smoothed normal's wide gathers, whose tangent was
-        then 15% slower per iteration) outweighed the analyses it saved.
+        for every pairing that leaves it. In 3D the superset's extra fill (larger still with
+        the smoothed normal's wide gathers) costs more than the analyses it saves.
     """
 
     def __init__(
@@ -749,14 +747,11 @@ class NewtonSolver:
            step's increment of the unknowns (displacements and multipliers) times the
            ratio of the step sizes. In a steady process (sliding) a step repeats the last
            one, and the predicted state holds the contact and stick/slip status of the
-           solution much better than the start: in the 2D ironing with mu = 0.3 (quick
-           mesh, steps of 0.1, half a master facet) the full-step Newton from the start
-           (residual 3.4e9 at t = 1.2) turned the 16 sticking points to slip in its first
-           iterate, then swung 16 to 21 contact statuses per iterate on the punch's front
-           until an iterate inverted elements (iterate 10), and the backtracking try fell
-           only to 5.4e4 in 40 iterates; from the predicted state (residual 1.2e8) it
-           converged in 9. With the predictor the quick run takes no cut-back (3 before)
-           and the same forces (6e-10 of the largest);
+           solution much better than the start: in a frictional ironing, where the
+           full-step Newton from the start swings many contact statuses per iterate on the
+           punch's front until an iterate inverts elements, it converges from the
+           predicted state and saves the cut-backs, with the same forces (see
+           :doc:`/guide/robustness`);
         2. from the start, with the backtracking line search :attr:`fallback_linesearch`
            (``None``: not tried): a semismooth Newton can cycle between contact or
            stick/slip states, or overshoot into inverted elements;
@@ -790,18 +785,15 @@ class NewtonSolver:
         half its largest over an elliptic region (a point contact: the zone of Hertz's
         contact of paraboloids, ``a^2 = R delta``) and two thirds over a strip (a line
         contact: 2D, or 3D extruded; in plane strain the zone's edge depends on the bodies'
-        sizes through a logarithm, and lies at two thirds in the 2D Hertz scene: 184 of
-        322 points). Then Newton goes on with the contact law (the same equations, a
-        better start): Hertz P1, 3D 4, 4, 4, 4, 5, 5 iterations on six meshes of 2,000 to
-        17,500 unknowns against 5, 5, 6, 6, 9, 8; 2D 4, 4, 4, 5 on four of 3,300 to 91,000
-        against 6, 9, 8, 9 (half the deepest overlap there: 5, 6, 6, 7). An iterate that
-        leaves the residual over ten times that of the free iterate (a large overlap pulled
-        shut in one linear step: the beams' first contact without friction) is undone.
+        sizes through a logarithm, and lies at two thirds in the 2D Hertz scene). Then
+        Newton goes on with the contact law (the same equations, a better start, fewer
+        iterations: see :doc:`/guide/robustness`). An iterate that leaves the residual over
+        ten times that of the free iterate (a large overlap pulled shut in one linear step:
+        the beams' first contact without friction) is undone.
 
         With :attr:`predictor` ``"first"`` the first try starts from the predicted state
-        (2D ironing, mu = 0.3, quick: 1168 Newton iterations against 1259 with
-        ``"retry"``, the same forces to 6e-10); it changes the iterations of every step,
-        ``"retry"`` only those of steps whose first try failed.
+        (fewer Newton iterations in a long steady sliding, the same forces); it changes the
+        iterations of every step, ``"retry"`` only those of steps whose first try failed.
 
         Returns
         -------
@@ -873,8 +865,8 @@ class NewtonSolver:
 
         On more than one rank PETSc frees an object that Python drops only at a collective
         clean-up on its communicator, which for a dropped problem never comes: its SNES,
-        factorisation and matrices stay in memory (about 11 to 21 MB a problem of 3,900
-        unknowns on two ranks, far more with the factors of large problems). A script that
+        factorisation and matrices stay in memory (megabytes for a small problem, far more
+        with the factors of a large one: see :doc:`/guide/solvers`). A script that
         makes many problems closes each one when done with it
         (:meth:`ContactProblem.close <contact_ufl.problem.ContactProblem.close>`). The
         solver cannot solve afterwards."""
@@ -959,11 +951,12 @@ class NewtonSolver:
         overlap of the overlapping points over the deepest. A curved (non-conforming)
         contact overlaps like a paraboloid near its first touch, ``m`` = 1/2 over a point
         contact's elliptic region and 2/3 over a line contact's strip, and its zone lies
-        where the overlap exceeds the mean (measured on the meshes of the 2D Hertz scene:
-        ``m`` = 0.66 to 0.68). A flatter overlap (``m`` over 0.7: faces pressed together, a
+        where the overlap exceeds the mean (on the meshes of the 2D Hertz scene ``m`` is
+        0.66 to 0.68). A flatter overlap (``m`` over 0.7: faces pressed together, a
         punch) is a conforming contact, whose zone covers it or more: the level falls
         linearly to every overlapping point at ``m`` = 0.8 (a strip's quartic profile; the
-        self-contact slot of the tests: ``m`` = 0.73, 12 points overlap, 16 end in contact).
+        self-contact slot of the tests, ``m`` = 0.73, ends with more points in contact than
+        overlap).
         """
         normal, proj = pair.normal, pair.projection
         deepest = self.comm.allreduce(normal.deepest_overlap(proj), MPI.MAX)

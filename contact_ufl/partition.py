@@ -9,7 +9,7 @@ into ``nparts`` parts with the graph partitioner (SCOTCH by default), so every b
 over all the ranks and its share of the contact surfaces with it.
 
 A body's cells split evenly need not split its contact surface evenly (the graph partitioner
-knows nothing of it: on the 3D Hertz sphere one rank got 962 slave facets, the other 492), and
+knows nothing of it, and can give one rank twice the slave facets of another), and
 the contact work (search, contact assembly, the gathered rows of ``T``, PtAP) goes with the
 surface. Given the cells that touch each contact surface (:func:`surface_cells`, from the
 contact facets of the mesh being read), each component is split in two stages: the cells of

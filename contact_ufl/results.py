@@ -315,9 +315,9 @@ def coulomb_law(problem, pair: int = 0, floor: float = 0.0) -> CoulombCheck:
     The traction applied to the bodies, ``P(q)`` on the disc of radius ``mu t_N``, obeys the
     law at every point by construction; the P1 multipliers equal it weakly (property (c)),
     so pointwise they obey it up to the error of that projection. Where the traction is
-    smooth (the beams, measured 4e-6) that is small; next to a traction singularity, such as
-    the corners of a flat punch, the excess does not vanish under refinement (about 10% of
-    ``max mu lambda_N`` at the pushed block's edges, at 4, 8 and 16 elements across).
+    smooth that is small (4e-6 of ``max mu lambda_N`` on the beams); next to a traction
+    singularity, such as the corners of a flat punch, the excess does not vanish under
+    refinement (about 10% of ``max mu lambda_N`` at the pushed block's edges).
     At the edge of a contact zone that ends inside the slave surface, a point in contact
     (``lambda_N + eps_N g > 0``) can carry a multiplier ``lambda_N`` that is zero to the
     projection error, even slightly negative: there ``|lambda_T| <= mu lambda_N`` fails by

@@ -191,6 +191,7 @@ def test_p2_on_block_within_2_percent(p2_on_block_sequence):
         assert max(s.newton_iterations for s in problem.history.steps) <= 6
 
 
+@pytest.mark.slow  # a refinement study; test_p2_on_block_within_2_percent checks two meshes
 def test_p2_errors_fall_over_four_meshes(p2_on_block_sequence):
     """P2 on the curved mesh over the four meshes of ``benchmarks/hertz.py --dim 3 --degree
     2`` (a / h ~ 2, 3, 4, and 4 with a ring of h = 0.01 about the zone's edge): the

@@ -1,15 +1,15 @@
 """Coulomb friction: the tangential multiplier, the slip increment and the disc projection.
 
-With the normal law of :mod:`.normal` (``formulation.md``):
+With the normal law of :mod:`.normal` (the formulation: ``docs/theory.md``):
 
     traction   T = <lambda_N + eps_N g> nu - P(q),   q = lambda_T + eps_T s_T
     - int_{S_oc} T . (U1* - U2*(Y)) dS_o
-    - int_{S_oc} (lambda_T - P(q)) . lambda_T* dS_o     (the seed's equation times eps_T)
+    - int_{S_oc} (lambda_T - P(q)) . lambda_T* dS_o     (the multiplier equation times eps_T)
 
 with ``P(q) = min(1, mu <lambda_N + eps_N g> / |q|) q``, the projection of q onto the disc of
-radius ``mu <lambda_N + eps_N g>`` (``P(0) = 0``, the seed's rule; the stick test is written
-``|q|^2 <= radius^2`` so that no square root or division is evaluated at ``q = 0``, in the
-residual or in its derivative).
+radius ``mu <lambda_N + eps_N g>`` (``P(0) = 0``, as in the formulation; the stick test is
+written ``|q|^2 <= radius^2`` so that no square root or division is evaluated at ``q = 0``,
+in the residual or in its derivative).
 
 Slip increment (the rate-independent form of ``eps_T V_T``): over a load step,
 
@@ -62,9 +62,8 @@ def disc_projection(q, radius, in_contact=None, round_off=0.0):
     starts touching (``g = 0``, ``lambda = 0``, no slip) has ``q = 0`` and a disc of radius
     0, each up to round-off: without the two, round-off alone would choose between stick
     (tangential stiffness ``eps_T``) and slip (none) for its first iterate, and the Newton
-    path would depend on the number of ranks (the block of ``scenes.pushed_block``: 8 and
-    32 iterations on 1 and 2 ranks; 3 and 3 now). The value changes by at most
-    ``round_off``. The NumPy twin is :func:`disc_projection_at_points`.
+    path would depend on the number of ranks. The value changes by at most ``round_off``.
+    The NumPy twin is :func:`disc_projection_at_points`.
     """
     qq = ufl.dot(q, q)
     safe_norm = ufl.sqrt(qq + ufl.conditional(ufl.eq(qq, 0.0), 1.0, 0.0))

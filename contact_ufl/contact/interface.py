@@ -13,7 +13,7 @@ A :class:`ContactInterface` is what the problem assembles for one :class:`.Conta
 * the normal law (:class:`.NormalLaw`) and, where ``mu > 0``, the Coulomb law
   (:class:`.CoulombLaw`).
 
-Its terms (``formulation.md``, times -1 so that the bulk term reads ``+ int Pi : Grad U*``):
+Its terms (``docs/theory.md``, times -1 so that the bulk term reads ``+ int Pi : Grad U*``):
 
     - int_{S_oc} T . (U1* - U2*(Y)) dS_o,     T = t_N nu - P(q)
     - int_{S_oc} (lambda_N - t_N) lambda_N* dS_o  [ - int (lambda_T - P(q)) . lambda_T* dS_o ]
@@ -304,9 +304,8 @@ class ContactInterface:
         derivatives of both are exactly zero, so their rows of the master's residual are zero
         and they would add only structural zeros to ``T^T K T``: couplings of the two bodies
         that cost fill in the factorisation, and pairing changes away from the contact that
-        cost analyses (3D Hertz P1 at 50,000 unknowns: 4.1 s against 6.2 s per Newton
-        iteration, the same iterations and force to 1e-15; README "Solvers for large
-        problems"). The values of the gathered
+        cost analyses: dropping them makes a large 3D Newton iteration markedly cheaper, with
+        the same iterations and answer (see ``docs/developer.md``). The values of the gathered
         fields stay those of the search (the last step's master nodes of a frictional point
         out of contact are not moved with the master: its slip is not used)."""
         proj = self.kinematics.projection

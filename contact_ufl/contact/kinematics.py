@@ -14,7 +14,7 @@ quadrature point as data on the slave submesh (quadrature elements):
     projection and its linearisation matrix (:mod:`.projection`), held as data.
 
 The projected point is written as ``xi = xi0 + M b(x - x0, xhat - xhat0)`` (the linearised
-closest-point condition of ``consistent-tangent.md``): its value is the one found by the
+closest-point condition, ``docs/theory.md``): its value is the one found by the
 search, and its Gateaux derivative is the implicit-function derivative. The master point
 ``y(xi)``, the tangents ``a_alpha(xi)``, the normal ``nu`` and the proximity ``g = -nu . (x -
 y)`` are then UFL expressions of the unknowns, and ``ufl.derivative`` gives every term of

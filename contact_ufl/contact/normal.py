@@ -1,17 +1,16 @@
 """The normal contact law: the Macaulay bracket and the equation of the normal multiplier.
 
     t_N = <lambda_N + eps_N g>
-    - int_{S_oc} (lambda_N - t_N) lambda_N* dS_o        (the seed's equation times eps_N)
+    - int_{S_oc} (lambda_N - t_N) lambda_N* dS_o        (the multiplier equation times eps_N)
 
 Discrete multiplier: ``lambda_N`` is continuous piecewise linear on the slave submesh (P1).
 It interpolates a continuous contact pressure with the same resolution as the slave trace
 of a P1 displacement, so the active set and the gap condition are imposed in the weak
 (mortar) sense at the contact quadrature points, and the multiplier *is* the nodal pressure
-(property (c) of ``formulation.md``). With a degree-2 displacement it stays P1 by default
-(``ContactPair.multiplier_degree``: 2 gives P2, ``"iso"`` P1-iso-P2; the evidence is in
-``docs/quadratic-contact.md``).
-The slave side should be the finer mesh, as usual
-with standard mortar multipliers.
+(property (c) of the formulation, ``docs/theory.md``). With a degree-2 displacement it stays
+P1 by default (``ContactPair.multiplier_degree``: 2 gives P2, ``"iso"`` P1-iso-P2; the
+evidence is in ``docs/quadratic-contact.md``). The slave side should be the finer mesh, as
+usual with standard mortar multipliers.
 """
 
 from __future__ import annotations

@@ -67,18 +67,14 @@ class ContactPair:
         area-weighted nodal normals) the ring of facets around each node (at most
         :data:`~contact_ufl.contact.master.MAX_FACETS_AROUND_NODE` facets). ``None``
         (default): :meth:`resolved_master_normal`, ``"smoothed"`` on a 2D solid master of a
-        degree-1 displacement, else ``"facet"``. Measured reason: in 2D the smoothed normal
-        costs little (Hertz, h = 0.005, and ironing: the same time per Newton
-        iteration within the noise, 0.031 s on ironing; form compilation 14 s against 9 s
-        on Hertz, 17 s against 14 s on ironing), changes the Hertz numbers by less than
-        2e-5, and the facet normal makes Newton cycle between the normals of neighbouring
-        segments once the master curves (the Hertz half disc pressed down by half its
-        radius stopped at depth 0.24). In 3D it costs about twice the time per iteration
-        (each point carries ``nn (K + 2)`` master nodes, 27 on tetrahedra) and 1.5 to 4
-        minutes of form compilation: ask for it there by name. With degree 2 the normal is
-        the quadratic facet's (no smoothed normal); membranes, self-contact and rigid
-        obstacles keep the facet (or the obstacle's exact) normal. On a flat master both
-        normals are the same.
+        degree-1 displacement, else ``"facet"``. In 2D the smoothed normal costs little, and
+        the facet normal makes Newton cycle between the normals of neighbouring segments
+        once the master curves. In 3D it costs about twice the time per iteration (each
+        point carries ``nn (K + 2)`` master nodes, 27 on tetrahedra) and minutes of form
+        compilation: ask for it there by name (see :doc:`/guide/contact`). With degree 2 the
+        normal is the quadratic facet's (no smoothed normal); membranes, self-contact and
+        rigid obstacles keep the facet (or the obstacle's exact) normal. On a flat master
+        both normals are the same.
     slave_domain, master_domain
         The domains (meshes) of the scene that hold the two surfaces: an index in
         :attr:`Scene.parts <contact_ufl.scene.Scene.parts>` or a domain's name. Needed only
@@ -92,7 +88,7 @@ class ContactPair:
         only): P1-iso-P2, piecewise linear on the once-refined slave facets, one node at each
         node of the displacement's trace (the resolution of the P2 nodes, h / 2); the contact
         rule is then composite over the refined facets (``quadrature_subdivisions`` rounded
-        up to an even number: 1 -> 2, 3 -> 4). See ``docs/quadratic-contact.md`` for the
+        up to an even number: 1 -> 2, 3 -> 4). See :doc:`/quadratic-contact` for the
         comparison.
     geometric_traction
         The normal traction that weights the master's geometric terms of the Newton tangent
@@ -104,10 +100,8 @@ class ContactPair:
         step that starts open: that iterate's penetration ``g`` weights the terms by
         ``eps_N g``, of the order of the bulk stiffness ``E / h`` once ``eps_N g h / E``
         nears 1 (the 3D Hertz with ``eps_N = E / h`` and a step's depth near a master
-        element), and the next iterate crushes the master's facets. README "Robustness of
-        the Newton solve": the 3D Hertz P1 at 17k unknowns in one step, 10 Newton
-        iterations instead of 25 failed and about 13 with the line search, the same force;
-        at 50k, 10 and 7 in two steps instead of 36 and 7.
+        element), and the next iterate crushes the master's facets; there ``"multiplier"``
+        converges with full Newton steps to the same solution (see :doc:`/guide/robustness`).
     """
 
     slave: int | str
@@ -155,7 +149,7 @@ class ContactPair:
         scene with a degree-1 displacement, and ``"facet"`` otherwise: 3D (where the smoothed
         normal costs twice the time per Newton iteration and minutes of form compilation),
         degree 2 (the normal of the quadratic facet: no smoothed normal), membranes and
-        self-contact (facet normal, as before), rigid obstacles (their exact normal).
+        self-contact (facet normal), rigid obstacles (their exact normal).
 
         Parameters
         ----------

@@ -144,10 +144,10 @@ i64 bvh_build(int g, i64 n, const double *c, i64 *perm, i64 *a, i64 *b)
 
 /* The float v rounds to, moved by one unit in the last place down (step -1) or up (step 1)
  * where move is 1, on its bits and without a branch: whether a bound rounds up or down is a
- * coin toss, and the branches' mispredictions were most of the refit of the tree's rows
- * (11 of 16 ms on 1e6 triangles). A float's bits count its magnitude, so a step towards
- * -infinity is -1 on a positive float and +1 on a negative one; a zero rounded from a
- * nonzero v carries v's sign, so it steps away from zero, to the smallest subnormal. */
+ * coin toss, and a branch's mispredictions would be most of the refit of the tree's rows.
+ * A float's bits count its magnitude, so a step towards -infinity is -1 on a positive float
+ * and +1 on a negative one; a zero rounded from a nonzero v carries v's sign, so it steps
+ * away from zero, to the smallest subnormal. */
 INLINE float nudged(float f, int move, int step)
 {
     union {
@@ -227,8 +227,7 @@ static double chord_deviation(int kind, const double *X);
  * preorder, and the largest facet radius, node change and finiteness updated: one flat pass
  * over the tree nodes (numbered in preorder, so the leaves come in the order of their
  * facets), the tree's rows after it from the leaves' boxes. (Fitting the facets inside the
- * recursion over the tree, or reading their boxes back there, cost twice as much: 29 and
- * 32 ms on 1e6 triangles against 19.) */
+ * recursion over the tree, or reading their boxes back there, costs about twice as much.) */
 INLINE void fit_records(fit_t *F, const int kind, const int g, const int nn)
 {
     const int w = nn * g;
@@ -1625,8 +1624,8 @@ typedef struct {
  * concluded (a neighbour in the points' Morton order, often of the same facet; not in a
  * self-contact search, where it may not be admissible): the closest facet is no farther, so
  * the walk prunes from its first row and keeps the same facets (those within the reach of
- * the smallest distance, which every bound is above). 2 to 4% of a query on the 6-node
- * facets of 3D Hertz; none on flat facets, where the bound would cost an exact projection. */
+ * the smallest distance, which every bound is above). A small saving on quadratic facets;
+ * none on flat facets, where the bound would cost an exact projection. */
 INLINE void start(int kind, int g, int nn, const query_t *Q, lane_t *L, i64 p)
 {
     walk_t *W = &L->W;

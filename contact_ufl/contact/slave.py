@@ -5,7 +5,7 @@ The slave surface S_oc^(1) is a submesh of the tagged facets. It carries the mul
 on the submesh) and the per-quadrature-point data of the contact terms (quadrature elements
 on the submesh).
 
-Two facts of DOLFINx 0.11 fix the layout used here (see ``shared/dolfinx-0.11-notes.md``):
+Two facts of DOLFINx 0.11 fix the layout used here:
 
 * a quadrature element on the submesh stores values at the quadrature points of each
   *submesh cell in its own reference orientation*, and a parent ``ds`` integral reads them
@@ -252,7 +252,7 @@ class SlaveSurface:
         """The values of the displacement basis at the points, ``(npoints, nblocks)``: a
         point's row holds those of its cell's dofs, in their cell order (zeros included, so
         that a non-finite value anywhere in the cell reaches the point), so that ``P @ u``
-        sums as the cell's basis does; four to five times faster than gathering the cells'
+        sums as the cell's basis does; several times faster than gathering the cells'
         values and multiplying per cell."""
         nc, nq, nd = self._phi_u.shape
         columns = np.repeat(self._cell_dofs, nq, axis=0).ravel()

@@ -1,10 +1,10 @@
-"""The hard-case suite (issue 13, item 7): runs that test the numerical stability of the
-solver, each reported by its steps, cut-backs, Newton iterations and, where a step failed,
-why (the SNES reasons and diagnoses of the failed tries: inverted elements, active-set
-cycling, a limit point; at the failed state the inverted elements and the contact points
-in contact; along the try the contact-status changes between Newton iterates). A case
-meant to stop (load control beyond a limit point) names the diagnosis it should stop with:
-its stop is recorded as ``"expected stop"``, not as a failure.
+"""The hard-case suite: runs that test the numerical stability of the solver, each
+reported by its steps, cut-backs, Newton iterations and, where a step failed, why (the SNES
+reasons and diagnoses of the failed tries: inverted elements, active-set cycling, a limit
+point; at the failed state the inverted elements and the contact points in contact; along
+the try the contact-status changes between Newton iterates). A case meant to stop (load
+control beyond a limit point) names the diagnosis it should stop with: its stop is recorded
+as ``"expected stop"``, not as a failure.
 
 :func:`cases` lists the cases (quick or full), :func:`run_case` runs one and returns its
 record (a ``dict`` ready for JSON); ``benchmarks/hard_cases.py`` runs them all.
@@ -217,9 +217,9 @@ def large_sliding_3d(mu: float, slide_steps: int = 20) -> Case:
 
 
 def cases(quick: bool = False) -> list[Case]:
-    """The hard cases that exist today (``quick``: the ironing on coarse meshes, with
-    larger sliding steps, and the 2D deep indentation on the coarser mesh only; the
-    self-contact ring and the balloon past its limit point, fast, are in both)."""
+    """The hard cases (``quick``: the ironing on coarse meshes, with larger sliding steps,
+    and the 2D deep indentation on the coarser mesh only; the self-contact ring and the
+    balloon past its limit point, fast, are in both)."""
     ironing_mesh = (0.05, 0.2, 100) if quick else (0.025, 0.1, 200)
     out = [
         Case(

@@ -32,8 +32,8 @@ IRONING_FORCES = {
 #: then slid 4 along it; mu = 0.3): Puso & Laursen 2004, "A mortar segment-to-segment
 #: frictional contact method for large deformations" (CMAME 193, 4891-4913; the report
 #: UCRL-JRNL-200667, https://www.osti.gov/servlets/purl/15013715), example 2 ("ironing"),
-#: whose data the LLNL Smith example ``die-on-slab`` restates. What a search of the stored
-#: public pages, documentation and code found (``sources``): the publication and the later
+#: whose data the LLNL Smith example ``die-on-slab`` restates. What a search of public
+#: pages, documentation and code found (``sources``): the publication and the later
 #: 3D large-sliding papers show their force histories as figures only; no table, data file
 #: or digitised curve of them was found, so there is no published number to compare with
 #: and ``forces`` is empty (no spread can be given). The checks that need no publication
@@ -69,7 +69,7 @@ IRONING_3D = {
             "a different die (a full cylinder); a comparison picture, no numbers"
         ),
         "MOOSE contact tests": "the ironing tests are 2D; the 3D mortar test is a block",
-        # a second search (stored pages, documentation, code, issues), none with numbers:
+        # further sources (pages, documentation, code, issue trackers), none with numbers:
         "KratosMultiphysics/Examples validation/shallow_ironing_3D (Mataix Ferrandiz)": (
             "the 2D shallow ironing extruded in 3D with u_z = 0 on the side faces (what "
             "benchmarks/ironing_plane_strain.py does), frictionless 'literature' set; "

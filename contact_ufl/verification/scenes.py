@@ -194,7 +194,7 @@ def hertz_3d(
         Element size within ``refine_radius`` of the contact point (the block
         ``master_ratio`` times coarser there: by default as fine, the two surface meshes
         still not matching; a coarser block is the stiffer, and its error adds to the
-        ball's: 1.3 gave p0 2.3% high where 1.0 gives 1.9%).
+        ball's: p0 is 2.3% high at 1.3, 1.9% at 1.0).
     depth
         Prescribed displacement of the top of the half ball at t = 1.
     E, nu
@@ -216,8 +216,8 @@ def hertz_3d(
     quadrature_degree, quadrature_subdivisions
         Quadrature rule of the contact integrals (see :class:`ContactPair`); default degree
         2 with ``order`` 1, 4 with ``order`` 2. P1: degree 2 (three points per slave facet)
-        gave the errors of the pair's default degree 3 (six points) to 0.1%, with half the
-        points to search. P2 (h_contact = 0.05): degree 2 gave p0 2.5% low, degree 4 (six
+        gives the errors of the pair's default degree 3 (six points) to 0.1%, with half the
+        points to search. P2 (h_contact = 0.05): degree 2 gives p0 2.5% low, degree 4 (six
         points) 0.6% high.
     order
         Geometry order of the mesh (2: the ball's surface is curved, for a degree-2
@@ -369,16 +369,12 @@ def hertz_2d_driven(
     disc, whose top is held only horizontally, is free to turn about its centre: the top's
     points move vertically, which the dead traction allows, and a circle turning about its
     centre slides over itself, which a frictionless contact does not resist. Only the
-    facets of the discrete arc hold that rotation, with a stiffness of order ``F R``
-    (measured -1.5 to +1.2 ``F R`` at t = 0.25 to 1.5, its sign changing with the load and
-    the active set, against 1078 ``F R`` with the axis held). With the smoothed
-    master normal it passed through zero near t = 1 (-0.004 ``F R``): a singular tangent,
-    Newton wandering along the rotation with the active set fixed, a cut-back, and the disc
-    tilted by 1.3e-3 at t = 1 and 2.7e-2 at t = 1.25. With the facet normal it happened to
-    stay away from zero. Held, the default normal (smoothed) needs no cut-back (5 and 3
-    Newton iterations). Where it crosses zero depends on the mesh: on this mesh (with the
-    axis line) with the axis free the run took no cut-back but 15 iterations at t = 1.
-    A failed step of the disc free to turn says so (:meth:`NewtonSolver.diagnose
+    facets of the discrete arc hold that rotation, with a stiffness of order ``F R`` whose
+    sign changes with the load and the active set (against some 1000 ``F R`` with the axis
+    held). Where it passes through zero, which depends on the mesh and the master normal,
+    the tangent is singular: Newton wanders along the rotation with the active set fixed,
+    the step is cut back, and the disc tilts. Held, the scene needs no cut-back. A failed
+    step of the disc free to turn says so (:meth:`NewtonSolver.diagnose
     <contact_ufl.newton.NewtonSolver.diagnose>`).
     """
     if driven_by not in ("force", "displacement"):
@@ -622,7 +618,7 @@ def ironing_3d(
     slab, so no slave point in contact ever reaches the master's boundary. With
     ``slave="die"`` the die's points beyond the slab's side edges (which bulge out under
     the die) are paired and released in turn at the master's boundary edge, a 2-cycle of
-    Newton that stalled the pressing with mu = 0.3 and made every sliding step take 11 to
+    Newton that stalls the pressing with mu = 0.3 and makes every sliding step take 11 to
     29 iterations with mu = 0 (3 to 5 with ``slave="slab"``). ``quadrature_degree`` is that
     of the contact integrals (2: three points per triangle; each point of the smoothed
     normal carries 27 master nodes, and the cost of the tangent grows with the square of
@@ -1192,7 +1188,7 @@ def pretensioned_drumhead(
     solve from the tensioned state with :func:`pretension` (before the first solve), which
     the edge supports then hold. Without it, the first Newton iterate has the stretched edges
     around an unstretched interior: with no pressure (a solid pressed into the drumhead) its
-    tangent is singular (measured: ``DIVERGED_LINEAR_SOLVE`` at every cut-back); a follower
+    tangent is singular (``DIVERGED_LINEAR_SOLVE`` at every cut-back); a follower
     pressure couples the transverse to the in-plane motion and Newton converges, but in 11-12
     iterations where the pre-tensioned start takes 3. For
     the default :class:`~contact_ufl.membranes.MembraneNeoHookean` (``mu = 1``, ``t0 = 0.01``)
@@ -1490,7 +1486,7 @@ def membrane_dragged_on_plane(
     the cells along the edges, ``"membrane_edges"`` (tag 101, the same law and pressure),
     are not in it: a multiplier at a node whose displacement is prescribed would constrain
     it twice (normally and, in stick, tangentially), and the Jacobian is then singular
-    (measured: ``DIVERGED_LINEAR_SOLVE`` at every cut-back). The multiplier equations use
+    (``DIVERGED_LINEAR_SOLVE`` at every cut-back). The multiplier equations use
     the two-point Lobatto rule per direction (at the vertices: lumped, so the P1 multipliers
     are the contact tractions at the nodes). Returns the scene and the plane.
     """
