@@ -10,6 +10,12 @@ from contact_ufl.problem import ContactProblem
 from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import scenes
 
+#: A comparison of a run on all ranks with the same run on one rank: skipped on one rank,
+#: where it would compare a run with itself.
+across_ranks = pytest.mark.skipif(
+    MPI.COMM_WORLD.size == 1, reason="compares a run on all ranks with one on a single rank"
+)
+
 
 def solve_hertz(h_contact: float, depth: float = 0.005, comm=MPI.COMM_WORLD, steps: int = 4):
     """Solve the 2D Hertz scene; return the problem and the scene's analytic data."""

@@ -3,6 +3,7 @@ friction that changes the result, and independence of the number of ranks."""
 
 import numpy as np
 import pytest
+from conftest import across_ranks
 from mpi4py import MPI
 
 from contact_ufl import output
@@ -63,22 +64,38 @@ def slave_state(problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return X[order], t_N[order], active[order]
 
 
-@pytest.fixture(scope="module")
-def showcase():
+class Showcase:
     """The demo's scene (divisions 3, load 6 EI/L^2, 20 steps) without and with friction,
-    and the Coulomb check of every converged frictional step."""
-    runs, checks = {}, []
-    for mu in (0.0, 0.3):
-        beams = scenes.beams(mu=mu, divisions=3, load=LOAD)
-        problem = ContactProblem(beams.scene, verbose=False)
+    each solved when a test first asks for it, and the Coulomb check of every converged
+    frictional step."""
 
-        def record(problem, step, mu=mu):
-            if mu > 0:
-                checks.append(coulomb_law(problem, floor=FLOOR))
+    def __init__(self) -> None:
+        self._runs: dict[float, ContactProblem] = {}
+        self._checks: list = []
 
-        problem.solve(num_steps=STEPS, callback=record)
-        runs[mu] = problem
-    return runs, checks
+    def __getitem__(self, mu: float) -> ContactProblem:
+        if mu not in self._runs:
+            beams = scenes.beams(mu=mu, divisions=3, load=LOAD)
+            problem = ContactProblem(beams.scene, verbose=False)
+
+            def record(problem, step):
+                if mu > 0:
+                    self._checks.append(coulomb_law(problem, floor=FLOOR))
+
+            problem.solve(num_steps=STEPS, callback=record)
+            self._runs[mu] = problem
+        return self._runs[mu]
+
+    @property
+    def checks(self) -> list:
+        """The Coulomb checks of the frictional run's steps."""
+        self[0.3]
+        return self._checks
+
+
+@pytest.fixture(scope="module")
+def showcase() -> Showcase:
+    return Showcase()
 
 
 def test_two_cantilevers_in_series():
@@ -95,6 +112,7 @@ def test_two_cantilevers_in_series():
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.3], ids=["mu=0", "mu=0.3"])
+@across_ranks
 def test_same_result_on_any_number_of_ranks(mu):
     """The distributed solve equals the solve on one rank (each rank redoes it alone), with
     and without friction: contact force, tip displacement, Newton iterations."""
@@ -111,12 +129,12 @@ def test_same_result_on_any_number_of_ranks(mu):
     ]
 
 
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
 def test_large_rotations_and_equilibrium(showcase):
     """20 steps without a cut-back, a large rotation, and equilibrium. The two balances
     hold by construction (equilibrium of any converged solve, to the solver tolerance):
     they check the reactions and the contact force, not the solution."""
-    runs, _ = showcase
-    for problem in runs.values():
+    for problem in (showcase[0.0], showcase[0.3]):
         assert problem.t == pytest.approx(1.0)
         assert len(problem.history.steps) == STEPS and not problem.history.cutbacks
         _, n_tip = section_motion(problem, problem.scene.tags["upper_tip"])
@@ -129,10 +147,11 @@ def test_large_rotations_and_equilibrium(showcase):
         assert np.linalg.norm(reaction - force) < 1e-6 * np.linalg.norm(force)
 
 
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
 @pytest.mark.parametrize("mu", [0.0, 0.3])
 def test_readme_numbers(showcase, mu):
     """The README's table, at the precision it states (3 decimals, rotation 0.1 degree)."""
-    problem = showcase[0][mu]
+    problem = showcase[mu]
     tip, rotation, force = README[mu]
     u_tip, n_tip = section_motion(problem, problem.scene.tags["upper_tip"])
     assert u_tip[[0, 2]] == pytest.approx(tip, abs=1e-3)
@@ -140,6 +159,7 @@ def test_readme_numbers(showcase, mu):
     assert problem.contact_force()[[0, 2]] == pytest.approx(force, abs=1e-3)
 
 
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
 @pytest.mark.parametrize("mu", [0.0, 0.3])
 def test_distributed_contact_zone(showcase, mu):
     """The upper beam's underside lies on the lower beam over a length, not on its tip
@@ -147,7 +167,7 @@ def test_distributed_contact_zone(showcase, mu):
     the overlap 8), more than 80 of them (measured 107 and 121) are more than one beam
     height from the tip, and there the pressure reaches more than 1.5 (measured 3.9 and
     3.3; at the tip corner, where the follower force pushes it in, 21 and 18)."""
-    problem = showcase[0][mu]
+    problem = showcase[mu]
     g = geometries.BeamPair()
     x, t_N = contact_zone(problem)
     assert x.min() == pytest.approx(g.tip)  # the tip corner is in contact
@@ -157,11 +177,12 @@ def test_distributed_contact_zone(showcase, mu):
     assert t_N[away].max() > 1.5
 
 
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
 def test_coulomb_law_at_every_step(showcase):
     """|lambda_T| <= mu lambda_N at every point in contact (lambda_N above FLOOR of its
     peak) of every step; where a point slips, |lambda_T| = mu lambda_N and the slip runs
     along lambda_T. The underside slides along the lower beam in every step."""
-    _, checks = showcase
+    checks = showcase.checks
     in_contact = [law for law in checks if law.active > 0]
     assert len(in_contact) == STEPS  # the tip lands in the first step
     assert max(law.excess for law in in_contact) < 1e-4
@@ -171,8 +192,9 @@ def test_coulomb_law_at_every_step(showcase):
     assert min(law.alignment for law in slipping) > 0.99
 
 
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
 def test_friction_changes_the_final_state(showcase):
-    runs, _ = showcase
+    runs = showcase
     tip = runs[0.0].scene.tags["upper_tip"]
     u0, u3 = (section_motion(runs[mu], tip)[0] for mu in (0.0, 0.3))
     assert abs(u0[0] - u3[0]) > 0.05 * abs(u0[0])
@@ -188,7 +210,7 @@ def test_showcase_on_any_number_of_ranks(showcase):
     """Under MPI: the showcase (mu = 0) solved on one rank gives the same state."""
     if MPI.COMM_WORLD.size == 1:
         pytest.skip("compares a run on all ranks with one on a single rank")
-    world = showcase[0][0.0]
+    world = showcase[0.0]
     beams = scenes.beams(divisions=3, load=LOAD, comm=MPI.COMM_SELF)
     alone = ContactProblem(beams.scene, verbose=False)
     alone.solve(num_steps=STEPS)
@@ -207,10 +229,11 @@ def test_showcase_on_any_number_of_ranks(showcase):
     ]
 
 
+@pytest.mark.serial  # the gather to rank 0 runs on 2 ranks in tests/test_demos.py
 def test_contact_state_picture(showcase, tmp_path):
     """The picture's surface holds every slave point, with t_N > 0 exactly at the points in
     contact and its peak at the tip corner; bad camera or colour input fails on every rank."""
-    problem = showcase[0][0.3]
+    problem = showcase[0.3]
     surface = output.gathered_contact_surface(problem)
     _, t_N = contact_zone(problem)
     slave = problem.contacts[0].slave

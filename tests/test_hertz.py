@@ -1,6 +1,7 @@
 """2D Hertz: the multiplier against p(x) = p0 sqrt(1 - x^2/a^2) (Johnson 1985, 4.2)."""
 
 import numpy as np
+import pytest
 
 from contact_ufl.results import contact_samples, weak_contact_law
 from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
@@ -19,6 +20,7 @@ def hertz_errors(problem, hertz):
     return (a / exact.a - 1.0, p0 / exact.p0 - 1.0, np.sqrt(np.mean(profile**2)) / exact.p0, exact)
 
 
+@pytest.mark.serial  # 2 ranks: test_properties' comparison with one rank
 def test_hertz_half_width_and_peak_pressure(hertz_moderate):
     """At a/h = 10 the half-width and the peak pressure are within 1% (0.2% and 0.7%
     measured; finer meshes level off at about 0.5%, benchmarks/results/hertz.json)."""
@@ -30,6 +32,7 @@ def test_hertz_half_width_and_peak_pressure(hertz_moderate):
     assert profile_err < 0.03
 
 
+@pytest.mark.serial  # 2 ranks: test_properties' comparison with one rank
 def test_hertz_errors_fall_under_refinement(hertz_sequence):
     """From a/h = 2.5 to 5 to 10 the errors of a and p0 fall (from 6-8% to below 1%)."""
     errors = np.array([np.abs(hertz_errors(p, h)[:2]) for p, h in hertz_sequence])
@@ -37,6 +40,7 @@ def test_hertz_errors_fall_under_refinement(hertz_sequence):
     assert np.all(errors[0] > 0.05) and np.all(errors[-1] < 0.01), errors
 
 
+@pytest.mark.serial  # 2 ranks: test_properties' comparison with one rank
 def test_hertz_contact_law(hertz_moderate):
     """(d): closed gap where the pressure is positive, zero pressure where the gap is open.
 

@@ -13,6 +13,7 @@ import dolfinx
 import numpy as np
 import pytest
 import ufl
+from conftest import across_ranks
 from mpi4py import MPI
 
 from contact_ufl.contact.pair import ContactPair
@@ -111,13 +112,11 @@ def coarse_on_block():
     return solve(h_contact=0.025)
 
 
+@across_ranks
 def test_same_answer_on_any_number_of_ranks(coarse_on_block):
     """The elastic pair on all ranks gives the answer of one rank to solver tolerance."""
-    problem, e = coarse_on_block
-    if problem.comm.size == 1:
-        alone = e
-    else:
-        alone = solve(MPI.COMM_SELF, h_contact=0.025)[1]
+    _, e = coarse_on_block
+    alone = solve(MPI.COMM_SELF, h_contact=0.025)[1]
     for key in ("P", "a_error", "p0_error", "pressure_l2_error", "p0_node_error"):
         assert abs(e[key] - alone[key]) < 1e-8 * max(1.0, abs(alone[key])), (key, e, alone)
     assert abs(e["p0_error"]) < 0.1  # the coarse mesh is still a Hertz contact
@@ -133,6 +132,7 @@ def on_block_sequence():
     ]
 
 
+@pytest.mark.serial  # 2 ranks: test_same_answer_on_any_number_of_ranks gives one rank's answer
 def test_on_block_within_2_percent(on_block_sequence):
     """Elastic on elastic, the finest mesh: a and p0 within 2% (-1.0% and +1.7% measured);
     the errors of a, p0 and the pressure's L2 error fall from mesh to mesh (in the default
@@ -165,12 +165,20 @@ def test_curved_mesh_puts_the_edge_nodes_on_the_sphere():
 
 
 @pytest.fixture(scope="module")
-def p2_on_block_sequence():
+def p2_on_block():
+    """P2 on the curved mesh, the half ball on the elastic block, a / h ~ 2 (12,500
+    unknowns)."""
+    return solve(degree=2, h_contact=0.05)
+
+
+@pytest.fixture(scope="module")
+def p2_on_block_sequence(p2_on_block):
     """P2 on the curved mesh, the half ball on the elastic block: a / h ~ 2 and 3
     (12,500 and 17,000 unknowns)."""
-    return [solve(degree=2, h_contact=h) for h in (0.05, 0.035)]
+    return [p2_on_block, solve(degree=2, h_contact=0.035)]
 
 
+@pytest.mark.serial  # 2 ranks: test_p2_same_answer_on_any_number_of_ranks
 def test_p2_on_block_within_2_percent(p2_on_block_sequence):
     """Elastic on elastic with P2: a and p0 within 2% on both meshes (a -1.6%, -0.2%; p0
     +0.6%, -0.3% measured; P1 needs a / h ~ 8 and the edge ring, 17,000 unknowns, for -1.1%
@@ -211,17 +219,18 @@ def test_p2_errors_fall_over_four_meshes(p2_on_block_sequence):
     assert np.all(errors[-1, :2] < errors[:-1, :2].min(axis=0)), errors
 
 
-def test_p2_same_answer_on_any_number_of_ranks(p2_on_block_sequence):
+@across_ranks
+def test_p2_same_answer_on_any_number_of_ranks(p2_on_block):
     """P2 on the curved mesh, the elastic pair (6-node master facets), a / h ~ 2: all ranks
     give the answer of one rank to solver tolerance."""
-    problem, e = p2_on_block_sequence[0]
-    alone = e if problem.comm.size == 1 else solve(MPI.COMM_SELF, degree=2, h_contact=0.05)[1]
+    e = p2_on_block[1]
+    alone = solve(MPI.COMM_SELF, degree=2, h_contact=0.05)[1]
     for key in ("P", "a_error", "p0_error", "pressure_l2_error", "p0_node_error"):
         assert abs(e[key] - alone[key]) < 1e-8 * max(1.0, abs(alone[key])), (key, e, alone)
     assert abs(e["p0_error"]) < 0.05, e
 
 
-def test_p2_curved_master(p2_on_block_sequence):
+def test_p2_curved_master(p2_on_block):
     """The roles swapped, P2, h = 0.05: the block's flat top is the slave and the curved
     6-node facets of the ball are the master facets the search must find. The contact
     force is that of the ball as the slave (0.1% measured), a and p0 are within 2.5% of
@@ -237,7 +246,7 @@ def test_p2_curved_master(p2_on_block_sequence):
     problem.solve(num_steps=2)
     hertz.symmetry_factor = -4.0  # the force on the block, the slave, points down
     e = hertz_3d_errors(problem, hertz)
-    ball_as_slave = p2_on_block_sequence[0][1]
+    ball_as_slave = p2_on_block[1]
     assert abs(e["P"] / ball_as_slave["P"] - 1.0) < 0.005, (e["P"], ball_as_slave["P"])
     assert abs(e["a_error"]) < 0.025 and abs(e["p0_error"]) < 0.025, e
     assert max(s.newton_iterations for s in problem.history.steps) <= 6

@@ -12,6 +12,7 @@ also runs on 2 ranks, against the same run on one rank.
 
 import numpy as np
 import pytest
+from conftest import across_ranks
 from mpi4py import MPI
 
 from contact_ufl.problem import ContactProblem
@@ -185,6 +186,7 @@ def _slide_start(comm) -> ContactProblem:
 
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size == 1, reason="compares a distributed solve")
+@across_ranks
 def test_slide_start_on_any_number_of_ranks():
     """Pressing and the first slide steps with friction: the distributed solve equals the
     solve on one rank (each rank redoes it alone) to solver tolerance, step by step."""

@@ -8,7 +8,7 @@ import dolfinx.fem.petsc
 import numpy as np
 import pytest
 import ufl
-from conftest import assert_taylor_slopes
+from conftest import across_ranks, assert_taylor_slopes
 from mpi4py import MPI
 from test_hertz import hertz_errors
 
@@ -187,6 +187,7 @@ def _slid_block(comm):
     return problem, circle
 
 
+@across_ranks
 def test_same_result_on_any_number_of_ranks():
     """The frictional circle pressed and slid over the block: the same obstacle reaction and
     Newton iterations on this communicator as on one rank."""

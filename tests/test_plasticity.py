@@ -152,6 +152,7 @@ def _indent_and_lift(yield_stress, comm=MPI.COMM_WORLD):
     return problem, peak, -lowest_displacement(problem, "block_contact")
 
 
+@pytest.mark.serial  # 2 ranks: test_indentation_on_any_number_of_ranks
 def test_indentation_leaves_an_imprint():
     """A stiff cylinder pressed 0.02 into a perfectly plastic block (sigma_y = 0.01 E) and
     lifted off: the peak contact pressure is capped below the plane-strain indentation

@@ -1,12 +1,14 @@
 """Properties (c) and (e) of the formulation, and independence of the number of ranks."""
 
 import numpy as np
-from conftest import solve_hertz
+import pytest
+from conftest import across_ranks, solve_hertz
 from mpi4py import MPI
 
 from contact_ufl.results import body_resultants, contact_samples, traction_mismatch
 
 
+@pytest.mark.serial  # 2 ranks: test_same_result_on_any_number_of_ranks
 def test_multipliers_are_the_tractions(hertz_sequence):
     """(c): lambda_N nu equals the bulk traction Pi N, up to an error that falls with h."""
     errors = np.array([traction_mismatch(p) for p, _ in hertz_sequence])
@@ -14,6 +16,7 @@ def test_multipliers_are_the_tractions(hertz_sequence):
     assert np.all(np.diff(errors) < 0), errors
 
 
+@pytest.mark.serial  # 2 ranks: test_same_result_on_any_number_of_ranks
 def test_action_equals_reaction(hertz_moderate):
     """(e): the contact forces on the two bodies are opposite to round-off. This holds by
     construction (the master virtual displacement is interpolated with shape functions
@@ -25,6 +28,7 @@ def test_action_equals_reaction(hertz_moderate):
     assert np.linalg.norm(slave + master) < 1e-13 * np.linalg.norm(slave)
 
 
+@across_ranks
 def test_same_result_on_any_number_of_ranks():
     """The distributed solve equals a solve on one rank (each rank redoes it alone)."""
     world, _ = solve_hertz(0.01)

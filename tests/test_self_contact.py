@@ -5,7 +5,7 @@ import basix.ufl
 import dolfinx
 import numpy as np
 import pytest
-from conftest import assert_taylor_slopes
+from conftest import across_ranks, assert_taylor_slopes
 from mpi4py import MPI
 from scipy.spatial import ConvexHull
 
@@ -319,6 +319,7 @@ def closed_slot():
     return _solved(MPI.COMM_WORLD)
 
 
+@pytest.mark.serial  # 2 ranks: test_slot_same_result_on_any_number_of_ranks
 def test_slot_closes_on_itself(closed_slot):
     """The slot pressed shut: Newton converges quadratically (a single pass: the lower face
     is the slave, the upper face its master), the block is in equilibrium, the contact
@@ -343,6 +344,7 @@ def test_slot_closes_on_itself(closed_slot):
     np.testing.assert_allclose(t_N[image], t_N, rtol=0, atol=1e-9 * t_N.max())
 
 
+@pytest.mark.serial  # 2 ranks: test_slot_same_result_on_any_number_of_ranks
 def test_slot_self_contact_equals_the_two_surface_pair(closed_slot):
     """The same slot with the classical pair (lower face slave, upper face master): the same
     contact up to the multiplier space. The self-contact slave surface also holds the side
@@ -364,6 +366,7 @@ def test_slot_self_contact_equals_the_two_surface_pair(closed_slot):
     assert difference.max() < 0.02 * t_classical.max()
 
 
+@across_ranks
 def test_slot_same_result_on_any_number_of_ranks(closed_slot):
     """One rank and this communicator's ranks: the same reaction and Newton iterations."""
     _assert_same_run(_solved(MPI.COMM_SELF), closed_slot, lambda p: p.reaction(2), 1e-10)
@@ -489,6 +492,7 @@ def _displacement(problem: ContactProblem) -> tuple[np.ndarray, np.ndarray]:
     return tuple(np.concatenate([g[k] for g in gathered]) for k in range(2))
 
 
+@pytest.mark.serial  # 2 ranks: test_ring_same_result_on_any_number_of_ranks
 def test_ring_hole_closes_on_itself(squeezed_ring):
     """The plates' forces balance each other and the cut; the self-contact forces cancel on
     the ring (property (e)) while its slave side alone carries most of the plates' force;
@@ -514,6 +518,7 @@ def test_ring_hole_closes_on_itself(squeezed_ring):
     assert asymmetry < 2e-4 * np.abs(U).max()
 
 
+@across_ranks
 def test_ring_same_result_on_any_number_of_ranks(squeezed_ring):
     alone = _ring_problem(MPI.COMM_SELF)
     _assert_same_run(alone, squeezed_ring, lambda p: p.contact_force(2), 1e-9)
