@@ -58,7 +58,7 @@ docs: $(VENV)/.docs-installed
 
 # the `docs` extra (sphinx, myst-nb, furo, jupytext, ipykernel), unless already there
 $(VENV)/.docs-installed: $(VENV)/.installed pyproject.toml
-	@$(PY) -c 'import sphinx, myst_nb, furo, jupytext, ipykernel' 2>/dev/null \
+	@$(PY) -c 'import importlib, sphinx, myst_nb, furo, jupytext, ipykernel; importlib.import_module("sphinx-mathjax-offline")' 2>/dev/null \
 	  || $(PY) -m pip install -q -e '.[docs]' \
 	  || { echo "error: the documentation tools are missing and could not be installed:"; \
 	       echo "       run \`$(PY) -m pip install -e '.[docs]'\` where PyPI can be reached"; exit 1; }

@@ -57,6 +57,8 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    # a copy of MathJax in _static: the pages show their formulas without the network
+    "sphinx-mathjax-offline",
 ]
 root_doc = "index"
 # every .py under docs/ would be read as a notebook: only those of tutorial/ are

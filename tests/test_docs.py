@@ -15,7 +15,7 @@ from mpi4py import MPI
 import contact_ufl as cu
 
 DOCS = Path(__file__).parents[1] / "docs"
-TOOLS = ("sphinx", "myst_nb", "furo", "jupytext")
+TOOLS = ("sphinx", "myst_nb", "furo", "jupytext", "sphinx-mathjax-offline")
 MISSING = [name for name in TOOLS if importlib.util.find_spec(name) is None]
 
 pytestmark = [
@@ -54,8 +54,17 @@ def test_docs_build_without_warnings(build):
     result, out = build
     assert result.returncode == 0, f"sphinx-build -W failed:\n{result.stderr[-6000:]}"
     assert (out / "index.html").exists()
-    for page in ("api", "developer", "tutorial/hertz", "guide/index"):
+    for page in ("api", "developer", "tutorial/hertz", "guide/index", "theory", "benchmarks"):
         assert (out / f"{page}.html").exists(), page
+
+
+def test_formulas_need_no_network(build):
+    """The pages load MathJax from the site's own _static folder, not from the web."""
+    _, out = build
+    theory = (out / "theory.html").read_text()
+    assert "_static/mathjax/tex-chtml.js" in theory
+    assert "cdn.jsdelivr" not in theory
+    assert (out / "_static" / "mathjax" / "tex-chtml.js").stat().st_size > 100_000
 
 
 def test_every_public_name_has_an_api_entry(build):
