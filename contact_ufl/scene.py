@@ -307,6 +307,9 @@ class Domain:
                 f"{where}{type(item).__name__}: facet tag {item.tag} does not exist "
                 f"(facet tags: {sorted(facet_values)})",
             )
+        for bc in self.dirichlet:
+            what = f"{where}Dirichlet {self._describe(bc.tag, tdim - 1)}"
+            _validate_dirichlet(comm, bc, gdim, what)
         for load in self.loads:
             collective_check(
                 comm,
@@ -322,6 +325,11 @@ class Domain:
                     f"(cell tags: {sorted(cell_values)})",
                 )
             _validate_load(comm, load, gdim, where)
+
+    def _describe(self, tag: int, dim: int) -> str:
+        """A tag by its physical group's name where the domain has one (``'top' (tag 3)``)."""
+        names = [n for n, (d, t) in self.groups.items() if t == tag and d in (dim, -1)]
+        return f"{names[0]!r} (tag {tag})" if names else f"on tag {tag}"
 
     def _check_dimensions(self, where: str) -> None:
         """Solids on a mesh of full dimension, membranes (strings) on a surface (curve)
@@ -661,6 +669,32 @@ def _validate_load(comm: MPI.Comm, load: Load, gdim: int, where: str) -> None:
             f"{where}FollowerForce on facet tag {load.tag}: direction must be a nonzero "
             f"vector of dimension {gdim}, got {tuple(d0.tolist())}",
         )
+
+
+def _validate_dirichlet(comm: MPI.Comm, bc: Dirichlet, gdim: int, what: str) -> None:
+    """Check a prescribed displacement against the mesh's dimension when the scene is made
+    (on every rank): one component within ``gdim``, a scalar for it; else a scalar (every
+    component) or a vector of ``gdim`` finite components."""
+    if bc.component is not None:
+        collective_check(
+            comm,
+            isinstance(bc.component, int | np.integer) and 0 <= bc.component < gdim,
+            f"{what}: component must be one of {list(range(gdim))} in {gdim}D, got "
+            f"{bc.component!r}",
+        )
+    try:
+        value = evaluate(bc.value, 0.0)
+    except Exception as error:  # a callable that fails at t = 0, or no numbers
+        value, problem = None, f"its value at t = 0 cannot be evaluated ({error})"
+    else:
+        shapes = [()] if bc.component is not None else [(), (gdim,)]
+        problem = None
+        if value.shape not in shapes:
+            wanted = "a scalar" if bc.component is not None else f"a scalar or {gdim} components"
+            problem = f"the value must be {wanted} in {gdim}D, got shape {value.shape}"
+        elif not np.all(np.isfinite(value)):
+            problem = f"the value at t = 0 is not finite: {value.tolist()}"
+    collective_check(comm, problem is None, f"{what}: {problem}")
 
 
 def _kind(dim: int, tdim: int) -> str:

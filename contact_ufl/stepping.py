@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from contact_ufl.errors import ConvergenceError
+from contact_ufl.errors import ContactInputError, ConvergenceError
 
 if TYPE_CHECKING:
     from contact_ufl.newton import NewtonSolver
@@ -143,6 +143,15 @@ class LoadStepper:
         :attr:`history`
         """
         problem, solver = self.problem, self.solver
+        if not (isinstance(num_steps, int | np.integer) and num_steps >= 1):
+            raise ContactInputError(f"num_steps must be a whole number >= 1, got {num_steps!r}")
+        if not t_end > problem.t + 1e-12 * max(1.0, abs(problem.t)):
+            raise ContactInputError(
+                f"t_end = {t_end!r} does not advance the pseudo-time beyond t = {problem.t:.6g}: "
+                "a solve goes forward in t; to unload, give the loads and prescribed values as "
+                "functions of t that go back (e.g. lambda t: d * min(t, 2 - t)) and solve to a "
+                "later t_end (see the user guide, Supports, loads and pseudo-time)"
+            )
         dt0 = (t_end - problem.t) / num_steps
         dt, streak = dt0, 0
         while problem.t < t_end - 1e-12 * abs(t_end):

@@ -2,13 +2,18 @@
 
 import dataclasses
 
+import dolfinx
+import numpy as np
 import pytest
+from conftest import symmetric_square
+from mpi4py import MPI
 
 from contact_ufl.errors import ContactInputError
 from contact_ufl.loads import Dirichlet
 from contact_ufl.materials import NeoHookean
 from contact_ufl.problem import ContactProblem
-from contact_ufl.scene import Body
+from contact_ufl.scene import Body, Scene
+from contact_ufl.verification.geometries import tag_single_body
 from contact_ufl.verification.scenes import curved_pair
 
 
@@ -73,3 +78,47 @@ def test_higher_order_displacement_is_rejected(scene):
     """Degree 3 is not supported (degree 2 is: tests/test_quadratic.py)."""
     with pytest.raises(ContactInputError, match="degree-3 displacement.*degree-2 displacement"):
         ContactProblem(scene, degree=3, verbose=False)
+
+
+@pytest.mark.parametrize(
+    "dirichlet, message",
+    [
+        (
+            Dirichlet("cylinder_top", (0.0, 0.0, 0.0)),
+            r"'cylinder_top' \(tag \d+\): the value must be a scalar or 2 components in 2D, "
+            r"got shape \(3,\)",
+        ),
+        (Dirichlet("cylinder_top", (0.0, 0.0), component=1), "must be a scalar in 2D"),
+        (Dirichlet("cylinder_top", 0.0, component=2), r"component must be one of \[0, 1\]"),
+        (Dirichlet("cylinder_top", lambda t: (float("nan"), 0.0)), "is not finite"),
+    ],
+)
+def test_dirichlet_value_is_checked_against_the_dimension(scene, dirichlet, message):
+    """A prescribed displacement of the wrong shape for the mesh, or not finite, is refused
+    when the problem is made, naming its physical group."""
+    with pytest.raises(ContactInputError, match=message):
+        ContactProblem(dataclasses.replace(scene, dirichlet=[dirichlet]), verbose=False)
+
+
+def test_a_2d_dirichlet_value_in_3d_is_refused():
+    mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, 2, 2, 2)
+    cells, facets = tag_single_body(mesh, [lambda x: np.isclose(x[2], 0.0)])
+    scene = Scene(mesh, cells, facets, [Body(1, NeoHookean(1.0, 0.3))])
+    bad = dataclasses.replace(scene, dirichlet=[Dirichlet(1, (0.0, 0.0))])
+    with pytest.raises(ContactInputError, match=r"scalar or 3 components in 3D, got shape \(2,\)"):
+        ContactProblem(bad, verbose=False)
+
+
+def test_a_solve_that_does_not_advance_is_refused():
+    """solve(t_end=...) at or before the current pseudo-time, or with no steps, is refused
+    with a message saying how to unload; the problem stays usable."""
+    pulled = Dirichlet(4, lambda t: 0.01 * t, component=1)
+    problem = ContactProblem(symmetric_square(NeoHookean(1.0, 0.3), [], dirichlet=[pulled]))
+    problem.solve(num_steps=1, t_end=0.5)
+    for t_end in (0.5, 0.25):
+        with pytest.raises(ContactInputError, match="does not advance the pseudo-time beyond"):
+            problem.solve(num_steps=1, t_end=t_end)
+    with pytest.raises(ContactInputError, match="num_steps must be a whole number >= 1"):
+        problem.solve(num_steps=0, t_end=1.0)
+    problem.solve(num_steps=1, t_end=1.0)
+    assert problem.t == pytest.approx(1.0)
