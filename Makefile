@@ -80,5 +80,15 @@ benchmarks: install
 benchmark-report: install
 	$(PY) benchmarks/report.py
 
+# docs/verification.md and docs/verification.json, generated from the records of the tests
+# (the `verification` fixture, in the JUnit XML of a run of the serial suite); the page is
+# written also when a test fails (it says which), and the target then fails too
+.PHONY: verification-report
+verification-report: install
+	@mkdir -p build
+	timeout $(PYTEST_TIMEOUT) $(PYTEST) $(XDIST) --junitxml=build/verification.xml tests; \
+	  status=$$?; $(PY) tests/verification_report.py --from-junit build/verification.xml \
+	  && exit $$status
+
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache docs/_build docs/tutorial

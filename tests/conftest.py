@@ -1,10 +1,15 @@
 """Shared fixtures: solved verification problems, built once per session."""
 
 import gc
+import json
+import math
+from collections.abc import Sequence
+from numbers import Real
 
 import numpy as np
 import pytest
 from mpi4py import MPI
+from verification_report import KINDS, PROPERTY
 
 from contact_ufl.problem import ContactProblem
 from contact_ufl.taylor import taylor_test
@@ -92,3 +97,73 @@ def _free_finished_problems():
     when finished problems linger in reference cycles until a later collection."""
     yield
     gc.collect()
+
+
+def _number(x) -> bool:
+    return isinstance(x, Real) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _numbers(x) -> bool:
+    """A finite number, or a non-empty sequence of them."""
+    if isinstance(x, Sequence | np.ndarray) and not isinstance(x, str):
+        return len(x) > 0 and all(_number(v) for v in np.asarray(x, dtype=object).ravel())
+    return _number(x)
+
+
+def _plain(x):
+    """``x`` as JSON can hold it: numbers as floats, arrays and tuples as lists."""
+    if isinstance(x, str):
+        return x
+    if isinstance(x, Sequence | np.ndarray):
+        return [float(v) for v in np.asarray(x, dtype=float).ravel()]
+    return float(x)
+
+
+@pytest.fixture
+def verification(request, record_property):
+    """Record a checked quantity of the test for the verification report.
+
+    The record is a user property ``verification`` of the test (a JSON object of the fields
+    below and the test's node id), which ``pytest --junitxml`` writes to the test's
+    ``testcase`` element; ``tests/verification_report.py`` makes ``docs/verification.md`` of
+    them. It asserts nothing: the test keeps its own asserts, and the record reports the
+    value the test asserts on and the tolerance the test enforces.
+
+    Returns
+    -------
+    callable
+        ``verification(case, quantity, measured, reference, tolerance, source,
+        kind="verification")``: ``case`` names the problem and ``quantity`` what is
+        compared (non-empty strings); ``measured`` is the value asserted on (a finite number
+        or a sequence of them); ``reference`` what it is compared to (numbers or a text);
+        ``tolerance`` the test's bound (a number or a text such as ``"|error| < 0.01"``);
+        ``source`` where the reference comes from; ``kind`` one of
+        :data:`verification_report.KINDS`. A wrong argument raises ``TypeError`` or
+        ``ValueError``.
+    """
+
+    def record(case, quantity, measured, reference, tolerance, source, kind="verification"):
+        for name, value in (("case", case), ("quantity", quantity), ("source", source)):
+            if not isinstance(value, str) or not value.strip():
+                raise TypeError(f"verification: {name} must be a non-empty string, not {value!r}")
+        if kind not in KINDS:
+            raise ValueError(f"verification: kind must be one of {sorted(KINDS)}, not {kind!r}")
+        if not _numbers(measured):
+            raise TypeError(f"verification: measured must be finite numbers, not {measured!r}")
+        if not (isinstance(reference, str) and reference.strip()) and not _numbers(reference):
+            raise TypeError(f"verification: reference must be numbers or text, not {reference!r}")
+        if not (isinstance(tolerance, str) and tolerance.strip()) and not _number(tolerance):
+            raise TypeError(f"verification: tolerance must be a number or text, not {tolerance!r}")
+        fields = {
+            "case": case,
+            "quantity": quantity,
+            "measured": _plain(measured),
+            "reference": _plain(reference),
+            "tolerance": _plain(tolerance),
+            "source": source,
+            "kind": kind,
+            "nodeid": request.node.nodeid,
+        }
+        record_property(PROPERTY, json.dumps(fields, sort_keys=True))
+
+    return record

@@ -4,6 +4,8 @@ import pytest
 
 from contact_ufl.verification.runs import cattaneo_mindlin_run
 
+JOHNSON = "Johnson, Contact Mechanics (1985), 7.1: closed form"
+
 
 @pytest.fixture(scope="module")
 def levels():
@@ -15,13 +17,24 @@ def levels():
     return records
 
 
-def test_stick_zone_half_width(levels):
+def test_stick_zone_half_width(levels, verification):
     assert [r["Q_over_muP"] for r in levels] == sorted(r["Q_over_muP"] for r in levels)
     assert 0.1 < levels[0]["Q_over_muP"] and levels[-1]["Q_over_muP"] < 0.9
+    for r in levels:
+        case = f"Cattaneo-Mindlin 2D, a/h ~ 20, Q / (mu P) = {r['Q_over_muP']:.2f}"
+        quantity = "relative error of the stick-zone half-width c"
+        reference = "c = a sqrt(1 - Q / (mu P))"
+        error = r["stick_zone_error"]
+        verification(case, quantity, error, reference, "|error| < 0.05", JOHNSON)
     for r in levels:
         assert abs(r["stick_zone_error"]) < 0.05, r
 
 
-def test_shear_traction_profile(levels):
+def test_shear_traction_profile(levels, verification):
+    for r in levels:
+        case = f"Cattaneo-Mindlin 2D, a/h ~ 20, Q / (mu P) = {r['Q_over_muP']:.2f}"
+        quantity = "RMS shear-traction error in |x| < 0.8 a, over mu p0"
+        reference = "the stick and slip shear tractions"
+        verification(case, quantity, r["shear_error"], reference, "< 0.1", JOHNSON)
     for r in levels:
         assert r["shear_error"] < 0.1, r

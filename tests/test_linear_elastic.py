@@ -7,7 +7,7 @@ import pytest
 import ufl
 from conftest import symmetric_square
 from mpi4py import MPI
-from test_hertz import hertz_errors
+from test_hertz import hertz_errors, record_hertz_errors
 
 import contact_ufl as cu
 from contact_ufl.loads import DeadTraction
@@ -30,7 +30,7 @@ def evaluate(expr, d):
 
 
 @pytest.mark.parametrize("d", [2, 3])
-def test_stress_is_hooke(d):
+def test_stress_is_hooke(d, verification):
     """On a homogeneous displacement gradient (with a rotation part) the stress is Hooke's
     tensor, both as given and as the derivative of the energy, to round-off."""
     rng = np.random.default_rng(d)
@@ -38,12 +38,24 @@ def test_stress_is_hooke(d):
     material = LinearElastic(E=2.5, nu=0.3)
     F = ufl.as_matrix((np.eye(d) + G).tolist())
     exact = hooke(2.5, 0.3, G)
-    assert np.allclose(evaluate(material.first_piola(F), d), exact, rtol=0, atol=1e-14)
+    given = evaluate(material.first_piola(F), d)
+    case = f"linear elasticity {d}D, a random homogeneous displacement gradient"
+    source = "Hooke's law, closed form"
+    reference = "lambda tr(eps) I + 2 mu eps"
+    quantity = "largest |stress - Hooke's|, stress as given"
+    verification(case, quantity, np.abs(given - exact).max(), reference, "< 1e-14", source)
+    assert np.allclose(given, exact, rtol=0, atol=1e-14)
     Fv = ufl.variable(F)
     derived = evaluate(ufl.diff(material.strain_energy(Fv), Fv), d)
+    quantity = "largest |stress - Hooke's|, stress as d psi / dF"
+    verification(case, quantity, np.abs(derived - exact).max(), reference, "< 1e-14", source)
     assert np.allclose(derived, exact, rtol=0, atol=1e-14)
     eps = 0.5 * (G + G.T)
     psi = 0.5 * material.lmbda * np.trace(eps) ** 2 + material.mu * np.sum(eps * eps)
+    quantity = "relative error of the strain energy"
+    error = float(material.strain_energy(F)) / psi - 1.0
+    reference = "lambda tr(eps)^2 / 2 + mu eps:eps"
+    verification(case, quantity, error, reference, "|error| <= 1e-14", source)
     assert float(material.strain_energy(F)) == pytest.approx(psi, rel=1e-14)
 
 
@@ -53,7 +65,7 @@ def test_exported():
         LinearElastic(1.0, 0.5)
 
 
-def test_uniaxial_dead_traction_plane_strain():
+def test_uniaxial_dead_traction_plane_strain(verification):
     """A block stretched by a dead traction t, free laterally: the plane-strain closed form
     eps_11 = (1 - nu^2) t / E, eps_22 = -nu (1 + nu) t / E, in one Newton iteration."""
     E, nu, t = 1.0, 0.3, 0.08
@@ -66,6 +78,13 @@ def test_uniaxial_dead_traction_plane_strain():
         np.max(u[:, 0][np.isclose(x[:, 0], 1.0)], initial=-np.inf), MPI.MAX
     )
     e22 = problem.comm.allreduce(np.min(u[:, 1][np.isclose(x[:, 1], 1.0)], initial=np.inf), MPI.MIN)
+    case = "plane-strain block under a uniaxial dead traction, linear elastic"
+    source = "plane-strain uniaxial stress, closed form"
+    for quantity, measured, exact, reference in (
+        ("relative error of eps_11", e11, (1 - nu**2) * t / E, "(1 - nu^2) t / E"),
+        ("relative error of eps_22", e22, -nu * (1 + nu) * t / E, "-nu (1 + nu) t / E"),
+    ):
+        verification(case, quantity, measured / exact - 1.0, reference, "|error| <= 1e-10", source)
     assert e11 == pytest.approx((1 - nu**2) * t / E, rel=1e-10)
     assert e22 == pytest.approx(-nu * (1 + nu) * t / E, rel=1e-10)
     assert history.steps[-1].newton_iterations == 1  # a linear bulk
@@ -84,7 +103,7 @@ def linear_hertz(h_contact=0.005, depth=0.005, steps=4):
     return problem, hertz, history
 
 
-def test_hertz_linear_elastic():
+def test_hertz_linear_elastic(verification):
     """2D Hertz at a/h = 10 with linear-elastic bodies: a and p0 within 1%, and at most 10
     Newton iterations per load step (issue 12's target).
 
@@ -94,6 +113,8 @@ def test_hertz_linear_elastic():
     """
     problem, hertz, history = linear_hertz()
     a_err, p0_err, profile_err, exact = hertz_errors(problem, hertz)
+    case = "Hertz 2D, linear elastic, 4 load steps, a/h = 10"
+    record_hertz_errors(verification, case, a_err, p0_err, profile_err)
     assert exact.a / hertz.h_contact > 8
     assert abs(a_err) < 0.01
     assert abs(p0_err) < 0.01

@@ -12,23 +12,41 @@ from mpi4py import MPI
 
 from contact_ufl.verification.taylor_cases import curved_case
 
+TAYLOR = "Taylor's theorem: the remainder of an exact derivative is O(h^2)"
+
+
+def record_slopes(verification, case, result, slope=2.0, source=TAYLOR):
+    """Record the slopes of the first-order remainder that assert_taylor_slopes checked
+    (within 0.01 of ``slope``)."""
+    quantity = "slopes of the Taylor remainder |R1(h)|"
+    verification(case, quantity, result.slopes, slope, "|slope - reference| < 0.01", source)
+
 
 @pytest.mark.parametrize("dim", [2, 3])
-def test_taylor_second_order(dim):
+def test_taylor_second_order(dim, verification):
     problem, dz, steps = curved_case(dim)
     assert problem.active_points() > 10
-    assert_taylor_slopes(problem, dz, steps, zeroth=True)
+    result = assert_taylor_slopes(problem, dz, steps, zeroth=True)
+    case = f"Taylor test {dim}D, curved surfaces, frictionless"
+    record_slopes(verification, case, result)
+    zeroth = np.diff(np.log(result.zeroth)) / np.diff(np.log(result.h))
+    source = "Taylor's theorem: the zeroth-order remainder is O(h)"
+    quantity = "slopes of the remainder |R0(h)|"
+    verification(case, quantity, zeroth, 1.0, "|slope - 1| < 0.05", source)
 
 
-def test_taylor_detects_a_frozen_projection():
+def test_taylor_detects_a_frozen_projection(verification):
     """Dropping the variation of the projected point leaves a first-order remainder."""
     problem, dz, steps = curved_case(2)
     problem.contacts[0].kinematics.frozen_projection = True
-    assert_taylor_slopes(problem, dz, steps, slope=1.0, unchanged=False)
+    result = assert_taylor_slopes(problem, dz, steps, slope=1.0, unchanged=False)
+    case = "Taylor test 2D, projection's variation dropped (a wrong tangent, on purpose)"
+    source = "Taylor's theorem: an inexact derivative leaves an O(h) remainder"
+    record_slopes(verification, case, result, slope=1.0, source=source)
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.05])
-def test_taylor_smoothed_master_normal(mu):
+def test_taylor_smoothed_master_normal(mu, verification):
     """The smoothed normal depends on the neighbours of the master segment: its tangent,
     chained through their gathered dofs, is still exact (second order)."""
     problem, dz, steps = curved_case(2, mu=mu, master_normal="smoothed")
@@ -37,12 +55,13 @@ def test_taylor_smoothed_master_normal(mu):
     facet = curved_case(2, mu=mu)[0].contacts[0]
     change = np.abs(facet.projection.normal - c.projection.normal).max(initial=0.0)
     assert problem.comm.allreduce(change, op=MPI.MAX) > 1e-6  # another normal indeed
-    assert_taylor_slopes(problem, dz, steps)
+    result = assert_taylor_slopes(problem, dz, steps)
+    record_slopes(verification, f"Taylor test 2D, smoothed master normal, mu = {mu:g}", result)
 
 
 @pytest.mark.parametrize("cell, nn", [("tetrahedron", 3), ("hexahedron", 4)])
 @pytest.mark.parametrize("mu", [0.0, 0.05])
-def test_taylor_smoothed_master_normal_3d(cell, nn, mu):
+def test_taylor_smoothed_master_normal_3d(cell, nn, mu, verification):
     """In 3D the smoothed normal depends on the fans of the master facet's nodes (triangles
     of tetrahedra, bilinear quadrilaterals of hexahedra), gathered with the facet's nodes:
     the tangent is still exact, frictionless and in slip."""
@@ -53,4 +72,6 @@ def test_taylor_smoothed_master_normal_3d(cell, nn, mu):
     if cell == "hexahedron" and problem.comm.size > 1:  # fans of nodes on two ranks
         master = problem.contacts[0].master
         assert problem.comm.allreduce(master.num_facets, op=MPI.MIN) > 0
-    assert_taylor_slopes(problem, dz, steps)
+    result = assert_taylor_slopes(problem, dz, steps)
+    case = f"Taylor test 3D, {cell}, smoothed master normal, mu = {mu:g}"
+    record_slopes(verification, case, result)
