@@ -158,8 +158,12 @@ class LoadStepper:
             t_prev, t_new = problem.t, min(problem.t + dt, t_end)
             saved = [f.x.array.copy() for f in problem.unknowns]
             start = time.perf_counter()
-            problem.begin_step()
-            ok, its, reason = solver.solve_step(t_new)
+            try:
+                problem.begin_step()
+                ok, its, reason = solver.solve_step(t_new)
+            except BaseException:  # an error or Ctrl-C inside the step: back to t_prev
+                self._restore(saved, t_prev)
+                raise
             if not ok:
                 why = solver.diagnose()
                 self._restore(saved, t_prev)

@@ -364,8 +364,9 @@ def test_a_non_finite_iterate_is_a_failed_try():
 
 def test_an_error_in_a_callback_is_raised_and_leaves_the_problem_usable(monkeypatch):
     """An exception inside the residual callback (here from the contact update) is raised
-    as itself from the solve, not turned into failed tries; the next solve works (the
-    SNES's vectors are not left locked)."""
+    as itself from the solve, not turned into failed tries; the step is undone (the time
+    and unknowns of the last converged step) and the next solve works (the SNES's vectors
+    are not left locked)."""
     problem = ContactProblem(scenes.hertz_2d(h_contact=0.05, depth=0.01).scene, verbose=False)
     solver = problem.solver
     update = solver._update_contact
@@ -376,8 +377,11 @@ def test_an_error_in_a_callback_is_raised_and_leaves_the_problem_usable(monkeypa
     monkeypatch.setattr(solver, "_update_contact", broken)
     with pytest.raises(RuntimeError, match="a bug in the contact update"):
         problem.solve(num_steps=1)
+    assert problem.t == 0.0  # the failed step is undone
     monkeypatch.setattr(solver, "_update_contact", update)
     problem.solve(num_steps=1)
+    assert problem.t == 1.0 and len(problem.history.steps) == 1
+    assert problem.contact_force()[1] != 0.0
     assert problem.t == pytest.approx(1.0) and not problem.history.cutbacks
 
 
