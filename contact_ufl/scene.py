@@ -685,7 +685,7 @@ def _validate_dirichlet(comm: MPI.Comm, bc: Dirichlet, gdim: int, what: str) -> 
     try:
         value = evaluate(bc.value, 0.0)
     except Exception as error:  # a callable that fails at t = 0, or no numbers
-        value, problem = None, f"its value at t = 0 cannot be evaluated ({error})"
+        problem = f"its value at t = 0 cannot be evaluated ({error})"
     else:
         shapes = [()] if bc.component is not None else [(), (gdim,)]
         problem = None
