@@ -40,7 +40,7 @@ from contact_ufl import (
 )
 from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSphere
 from contact_ufl.control import VolumeControl
-from contact_ufl.errors import ContactInputError, ConvergenceError
+from contact_ufl.errors import ContactInputError, ConvergenceError, NonUniqueSolutionWarning
 from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerForce, FollowerPressure
 from contact_ufl.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff
 from contact_ufl.membranes import (
@@ -82,6 +82,7 @@ __all__ = [
     "NeoHookean",
     "NewtonSolver",
     "NewtonTimings",
+    "NonUniqueSolutionWarning",
     "ResultWriter",
     "RigidCylinder",
     "RigidPlane",

@@ -9,6 +9,11 @@ class ContactInputError(ValueError):
     """Bad input: wrong tags, empty or non-facing surfaces, invalid parameters."""
 
 
+class NonUniqueSolutionWarning(UserWarning):
+    """The scene leaves a body a rigid motion that nothing holds: the answer along it is
+    arbitrary (it may differ between runs and numbers of ranks)."""
+
+
 class ConvergenceError(RuntimeError):
     """A load step could not be converged, even after cutting it back."""
 

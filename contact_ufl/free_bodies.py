@@ -59,6 +59,8 @@ class Piece:
         ``centre`` scaled by ``size``); the same on every rank.
     centre, size
         Centroid of the piece's nodes, and their largest distance from it.
+    bodies
+        Names (or cell tags) of the bodies of the piece.
     """
 
     mesh: int
@@ -67,6 +69,7 @@ class Piece:
     modes: np.ndarray
     centre: np.ndarray
     size: float
+    bodies: tuple[str, ...] = ()
 
     @property
     def rotates(self) -> bool:
@@ -96,17 +99,20 @@ def _indicator(index_map, blocks: np.ndarray) -> np.ndarray:
     return marks.array > 0.0
 
 
-def _merged(index_map, blocks: list[np.ndarray], comm: MPI.Comm) -> list[np.ndarray]:
+def _merged(index_map, blocks: list[np.ndarray], comm: MPI.Comm) -> list[tuple]:
     """The unions of the node sets ``blocks`` (local nodes of cells) that share a node,
-    as the local nodes (owned and ghost) of each union, also where the cells that share
-    it lie on different ranks (collective)."""
+    as (the indices of the merged sets, the local nodes (owned and ghost) of the union),
+    also where the cells that share it lie on different ranks (collective)."""
     held = np.array([_indicator(index_map, b) for b in blocks])
     owned = held[:, : index_map.size_local].astype(int)
     shared = (comm.allreduce(owned @ owned.T, MPI.SUM) > 0) | np.eye(len(blocks), dtype=bool)
     label = np.arange(len(blocks))
     for _ in blocks:  # the smallest label reachable: a few bodies per mesh
         label = np.array([label[row].min() for row in shared])
-    return [np.flatnonzero(held[label == m].any(axis=0)) for m in np.unique(label)]
+    return [
+        (np.flatnonzero(label == m), np.flatnonzero(held[label == m].any(axis=0)))
+        for m in np.unique(label)
+    ]
 
 
 def rigid_modes(x: np.ndarray, centre: np.ndarray, size: float) -> np.ndarray:
@@ -149,12 +155,17 @@ def pieces(problem: ContactProblem) -> list[Piece]:
     for k, bulk in enumerate(problem.bulks):
         dofs = bulk.V.dofmap.list
         blocks = [keysets.unique(dofs[bulk.domain.cell_tags.find(b.tag)]) for b in bulk.bodies]
-        for nodes in _merged(bulk.V.dofmap.index_map, blocks, problem.comm):
+        for members, nodes in _merged(bulk.V.dofmap.index_map, blocks, problem.comm):
             held = bulk.prescribed_components[nodes].any(axis=0).astype(int)
             free = problem.comm.allreduce(held, MPI.SUM) == 0
             modes, centre, size = _free_modes(bulk, nodes, problem.comm)
-            out.append(Piece(k, nodes, free, modes, centre, size))
+            names = tuple(_body_name(bulk.bodies[b]) for b in members)
+            out.append(Piece(k, nodes, free, modes, centre, size, names))
     return out
+
+
+def _body_name(body) -> str:
+    return repr(body.name) if body.name else f"of cell tag {body.tag}"
 
 
 def _on_piece(bulk: Bulk, tag: int, piece: Piece, comm: MPI.Comm) -> bool:
@@ -168,21 +179,78 @@ def _on_piece(bulk: Bulk, tag: int, piece: Piece, comm: MPI.Comm) -> bool:
     return comm.allreduce(here, MPI.LOR)
 
 
+def _sides_on(problem: ContactProblem, piece: Piece, pair) -> tuple[bool, bool]:
+    """Whether the slave and the master surface of ``pair`` have a node on ``piece``
+    (collective; a rigid obstacle is on no piece)."""
+    bulk = problem.bulks[piece.mesh]
+    slave = (pair.slave_domain or 0) == piece.mesh and _on_piece(
+        bulk, pair.slave, piece, problem.comm
+    )
+    master = (
+        not pair.on_obstacle
+        and (pair.master_domain or 0) == piece.mesh
+        and _on_piece(bulk, pair.master, piece, problem.comm)
+    )
+    return slave, master
+
+
 def pairs_on(problem: ContactProblem, piece: Piece) -> list[int]:
     """Indices of the contact pairs with a side (slave or master surface) on ``piece``."""
-    out = []
-    for index, c in enumerate(problem.contacts):
-        pair = c.pair
-        sides = [(pair.slave_domain, pair.slave)]
-        if not pair.on_obstacle:
-            sides.append((pair.master_domain, pair.master))
-        bulks = problem.bulks
-        if any(
-            (domain or 0) == piece.mesh and _on_piece(bulks[piece.mesh], tag, piece, problem.comm)
-            for domain, tag in sides
-        ):
-            out.append(index)
-    return out
+    return [k for k, c in enumerate(problem.contacts) if any(_sides_on(problem, piece, c.pair))]
+
+
+def unheld_modes(problem: ContactProblem, piece: Piece, on: list[int]) -> np.ndarray:
+    """The free modes of ``piece`` that its frictionless contact pairs ``on`` do not hold,
+    as orthonormal coefficients ``(k, m)`` like :attr:`Piece.modes` (collective).
+
+    A frictionless contact pushes only along the master normal, so it holds a rigid mode
+    only where the mode moves a point near contact along that normal. Near contact means
+    paired by the last search within one slave facet size of the pair's closest distance;
+    a mode is not held where the mean square of its normal component there is below
+    ``1e-6`` (modes of unit size: translations, and rotations over the piece's size). A
+    pair with friction may hold every mode (stick), and one with both surfaces on the
+    piece (self-contact) holds none: a rigid motion moves both alike.
+    """
+    comm = problem.comm
+    if not len(piece.modes):
+        return piece.modes
+    gram = np.zeros((len(piece.modes),) * 2)
+    points = 0
+    for k in on:
+        c = problem.contacts[k]
+        if c.friction is not None:
+            return piece.modes[:0]
+        if all(_sides_on(problem, piece, c.pair)):
+            continue
+        p = c.projection
+        paired = p.facet >= 0
+        nearest = comm.allreduce(p.distance[paired].min(initial=np.inf), MPI.MIN)
+        near = paired & (p.distance <= nearest + c.slave.facet_size)
+        modes = rigid_modes(p.y[near], piece.centre, max(piece.size, 1e-300))
+        values = np.einsum("ni,nim->nm", p.normal[near], modes) @ piece.modes.T
+        gram += values.T @ values
+        points += int(near.sum())
+    gram = comm.allreduce(gram, MPI.SUM)
+    points = comm.allreduce(points, MPI.SUM)
+    if points == 0:
+        return piece.modes[:0]  # nothing near contact to judge by: the first step will tell
+    values, vectors = np.linalg.eigh(gram / points)
+    return vectors[:, values < 1e-6].T @ piece.modes
+
+
+def describe_mode(piece: Piece, mode: np.ndarray) -> str:
+    """A rigid mode in words: ``"translation along x"``, ``"rotation about (0, 1)"``."""
+    gdim = len(piece.free)
+    t, w = mode[:gdim], mode[gdim:] / max(piece.size, 1e-300)
+    if np.linalg.norm(mode[gdim:]) < 1e-6 * np.linalg.norm(mode):
+        axis = np.abs(t).argmax()
+        if abs(t[axis]) > (1.0 - 1e-6) * np.linalg.norm(t):
+            return f"translation along {'xyz'[axis]}"
+        return "translation along (" + ", ".join(f"{v:.3g}" for v in t / np.linalg.norm(t)) + ")"
+    if gdim == 2:
+        point = piece.centre + np.array([-t[1], t[0]]) / w[0]
+        return "rotation about (" + ", ".join(f"{v:.3g}" for v in point) + ")"
+    return "rotation about the axis (" + ", ".join(f"{v:.3g}" for v in w / np.linalg.norm(w)) + ")"
 
 
 def net_free_load(problem: ContactProblem, residual: np.ndarray, piece: Piece) -> float:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import operator
+import warnings
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -23,11 +24,12 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from contact_ufl import jit, keysets
+from contact_ufl import free_bodies, jit, keysets
 from contact_ufl.bulk import Bulk
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.control import VolumeConstraint, VolumeControl
+from contact_ufl.errors import NonUniqueSolutionWarning, collective_check
 from contact_ufl.layout import StackedLayout
 from contact_ufl.mpi import global_bounds, global_diameter
 from contact_ufl.scene import Domain, Scene
@@ -35,6 +37,18 @@ from contact_ufl.scene import Domain, Scene
 if TYPE_CHECKING:
     from contact_ufl.newton import NewtonSolver
     from contact_ufl.stepping import History, LoadStepper, StepRecord
+
+
+def _support_hint(piece, modes: np.ndarray) -> str:
+    """What would hold the rigid ``modes`` of ``piece``: a support per free direction."""
+    gdim = len(piece.free)
+    axes = [i for i in range(gdim) if np.abs(modes[:, i]).max() > 1e-6]
+    turns = np.abs(modes[:, gdim:]).max(initial=0.0) > 1e-6
+    parts = [f"Dirichlet(<a facet group of it>, 0.0, component={i})" for i in axes]
+    advice = "Hold it with " + " and ".join(parts) if parts else "Hold it with a support"
+    if turns:
+        advice += " on a line or two points (a single point lets it turn)"
+    return advice + ", or give the contact friction."
 
 
 def softer_modulus(parts: list[Domain], pair: ContactPair) -> float:
@@ -185,6 +199,7 @@ class ContactProblem:
         ]
         self._build_forms()
         self._build_dirichlet()
+        self._check_rigid_modes()
         self._solver: NewtonSolver | None = None
         self._stepper: LoadStepper | None = None
         self._closed = False
@@ -323,6 +338,52 @@ class ContactProblem:
         self.dirichlet_rows = np.concatenate(rows).astype(np.int64)
         displacements = sum(len(b.dirichlet_dofs) for b in self.bulks)
         self.held_multipliers = len(self.dirichlet_rows) - displacements
+
+    def _check_rigid_modes(self) -> None:
+        """Refuse a body that nothing holds (no support, no contact pair), and warn of one
+        whose free rigid modes only a frictionless contact could hold but whose contact
+        normals near contact do not (:mod:`contact_ufl.free_bodies`): its solution is not
+        unique along them (collective)."""
+        loose = [
+            (piece, free_bodies.pairs_on(self, piece))
+            for piece in free_bodies.pieces(self)
+            if len(piece.modes)
+        ]
+        for piece, on in loose:
+            modes = "; ".join(free_bodies.describe_mode(piece, m) for m in piece.modes)
+            collective_check(
+                self.comm,
+                bool(on),
+                f"the body {' + '.join(piece.bodies)} is held by no support and no contact "
+                f"pair: nothing holds its rigid motion ({modes}), so the problem has no unique "
+                "solution; add a Dirichlet support (or a contact pair) on it",
+            )
+        loose = [(piece, on) for piece, on in loose if on]
+        if not loose:
+            return
+        for c in self.contacts:  # the closest points at the start, for the normals
+            c.update(self.layout)
+        for piece, on in loose:
+            unheld = free_bodies.unheld_modes(self, piece, on)
+            if not len(unheld):
+                continue
+            modes = "; ".join(free_bodies.describe_mode(piece, m) for m in unheld)
+            surfaces = ", ".join(self._surface_name(self.contacts[k].pair) for k in on)
+            hint = _support_hint(piece, unheld)
+            warnings.warn(
+                f"the solution is not unique: the body {' + '.join(piece.bodies)} has a rigid "
+                f"motion ({modes}) that no support holds and that its frictionless contact "
+                f"(slave surface(s) {surfaces}) does not resist, the contact normals being "
+                "perpendicular to it; the answer along it is arbitrary (it may differ between "
+                f"runs and numbers of ranks). {hint}",
+                NonUniqueSolutionWarning,
+                stacklevel=3,
+            )
+
+    def _surface_name(self, pair: ContactPair) -> str:
+        """The slave surface of ``pair`` by its physical group's name where it has one."""
+        domain = self.bulks[pair.slave_domain or 0].domain
+        return domain._describe(pair.slave, domain.mesh.topology.dim - (not domain.membrane))
 
     def block_rows(self, k: int) -> slice:
         """Local (owned) range of the displacement of mesh ``k`` in a vector of the

@@ -1,6 +1,7 @@
 """Bad input gets a clear error naming the problem, on every rank (no MPI hang)."""
 
 import dataclasses
+import warnings
 
 import dolfinx
 import numpy as np
@@ -8,13 +9,15 @@ import pytest
 from conftest import symmetric_square
 from mpi4py import MPI
 
-from contact_ufl.errors import ContactInputError
-from contact_ufl.loads import Dirichlet
+from contact_ufl.contact import ContactPair
+from contact_ufl.errors import ContactInputError, NonUniqueSolutionWarning
+from contact_ufl.loads import DeadTraction, Dirichlet
 from contact_ufl.materials import NeoHookean
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Scene
+from contact_ufl.verification import geometries
 from contact_ufl.verification.geometries import tag_single_body
-from contact_ufl.verification.scenes import curved_pair
+from contact_ufl.verification.scenes import E_STEEL, curved_pair
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +52,9 @@ def test_slave_not_facing_master(scene):
     """The flat top of the half disc faces away from the block."""
     pair = scene.contacts[0]
     swapped = with_pair(scene, slave=pair.master, master=pair.slave)
-    ContactProblem(swapped, verbose=False)  # swapped roles face each other: fine
+    with warnings.catch_warnings():  # the pair has no supports (a scene for Taylor tests)
+        warnings.simplefilter("ignore", NonUniqueSolutionWarning)
+        ContactProblem(swapped, verbose=False)  # swapped roles face each other: fine
     with pytest.raises(ContactInputError, match="never faces"):
         ContactProblem(with_pair(scene, slave=scene.tags["cylinder_top"]), verbose=False)
 
@@ -122,3 +127,45 @@ def test_a_solve_that_does_not_advance_is_refused():
         problem.solve(num_steps=0, t_end=1.0)
     problem.solve(num_steps=1, t_end=1.0)
     assert problem.t == pytest.approx(1.0)
+
+
+def disc_on_block(supports, contacts=True):
+    """The Hertz half disc pushed down by a force onto a block, held by ``supports`` (the
+    block's bottom always)."""
+    mesh = geometries.hertz_2d(h_contact=0.05, h_far=0.2, gap=0.0, axis=True)
+    steel = NeoHookean(E_STEEL, 0.3)
+    return Scene.from_mesh_data(
+        mesh,
+        bodies=[Body("cylinder", steel), Body("block", steel)],
+        contacts=[ContactPair("cylinder_contact", "block_contact")] if contacts else [],
+        dirichlet=[Dirichlet("block_bottom", (0.0, 0.0)), *supports],
+        loads=[DeadTraction("cylinder_top", lambda t: (0.0, -1e-3 * E_STEEL * t))],
+    )
+
+
+def test_a_body_slid_freely_over_a_flat_master_warns():
+    """A disc pushed onto a flat block with no support along x and no friction can slide
+    along x at no cost: the problem warns when it is made, naming the body, the motion, the
+    surface and the support that would hold it; the disc's axis held along x silences it."""
+    with pytest.warns(NonUniqueSolutionWarning) as caught:
+        ContactProblem(disc_on_block([]), verbose=False)
+    (message,) = [str(w.message) for w in caught]
+    for words in ("'cylinder'", "translation along x", "'cylinder_contact'", "component=0"):
+        assert words in message, message
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ContactProblem(disc_on_block([Dirichlet("cylinder_axis", 0.0, component=0)]))
+
+
+def test_friction_holds_the_slide():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scene = disc_on_block([])
+        pair = dataclasses.replace(scene.contacts[0], mu=0.3)
+        ContactProblem(dataclasses.replace(scene, contacts=[pair]), verbose=False)
+
+
+def test_a_body_held_by_nothing_is_refused():
+    """With no contact pair, nothing holds the pushed disc: refused, naming its motions."""
+    with pytest.raises(ContactInputError, match=r"'cylinder' is held by no support and no con"):
+        ContactProblem(disc_on_block([], contacts=False), verbose=False)

@@ -64,44 +64,61 @@ def bending_stiffness_plane_strain(E: float, nu: float, h: float) -> float:
     return E / (1.0 - nu**2) * h**3 / 12.0
 
 
-def _elastica_from_tip(k: float, tip_angle: float, follower: bool) -> np.ndarray:
-    """Integrate the elastica from the free end ``s = 1`` back to the clamp ``s = 0``.
+def _elastica_tip(k: float, psi0: float, psiL: float) -> tuple[float, float]:
+    """Chord of the elastica ``psi'' + k sin(psi) = 0`` on ``0 <= s <= 1`` from ``psi0`` to
+    the turning point ``psiL`` (``psi'(1) = 0``), ``psi = pi/2 - theta'`` the tangent angle
+    measured from the load's line: its components ``(dx', dy')`` across and along that
+    line, by the closed forms of :func:`cantilever_elastica`."""
+    from scipy.special import ellipe, ellipeinc
 
-    Unknowns ``(theta, theta', x, y)`` along the arc length ``s`` (unit length); the
-    curvature equation is ``theta'' = k cos(theta - theta_tip)`` for a force perpendicular
-    to the tip tangent and ``theta'' = k cos(theta)`` for a dead force in ``-y``; at the tip
-    ``theta = tip_angle``, ``theta' = 0`` (no moment), position ``(0, 0)``. Returns the state
-    at ``s = 0``.
-    """
-    from scipy.integrate import solve_ivp
-
-    shift = tip_angle if follower else 0.0
-
-    def rhs(s, z):
-        return [z[1], k * np.cos(z[0] - shift), np.cos(z[0]), np.sin(z[0])]
-
-    sol = solve_ivp(rhs, (1.0, 0.0), [tip_angle, 0.0, 0.0, 0.0], rtol=1e-12, atol=1e-14)
-    return sol.y[:, -1]
+    m = np.sin(0.5 * psiL) ** 2
+    eta0 = np.arcsin(np.clip(np.sin(0.5 * psi0) / np.sqrt(m), -1.0, 1.0))
+    dx = np.sqrt(2.0 * (np.cos(psi0) - np.cos(psiL)) / k)
+    dy = 2.0 * (ellipe(m) - ellipeinc(eta0, m)) / np.sqrt(k) - 1.0
+    return float(dx), float(dy)
 
 
 def cantilever_elastica(k: float, follower: bool) -> tuple[float, float, float]:
-    """Tip of an inextensible, shear-rigid cantilever (Euler elastica) under a tip force.
+    """Tip of an inextensible, shear-rigid cantilever (Euler elastica) under a tip force, in
+    closed form (elliptic integrals).
 
     The beam of length ``L`` lies along ``+x``, clamped at ``x = 0``; the force of magnitude
     ``P`` at ``x = L`` points initially in ``-y``. ``follower=True``: the force stays
     perpendicular to the deformed tip tangent (follower load); ``False``: it stays in ``-y``
-    (dead load). With the moment ``M = EI theta'`` the equilibrium of the part beyond ``s``
-    gives ``theta'' = k cos(theta - theta_L)`` (follower) or ``k cos(theta)`` (dead), ``k =
-    P L^2 / EI``, ``theta(0) = 0``, ``theta'(L) = 0``. Integrated from the tip, where the state
-    is known up to the tip angle ``theta_L``: for the follower load the clamp condition only
-    rotates the solution (``theta_L = -phi(0)`` of the problem with ``theta_L = 0``); for the
-    dead load ``theta_L`` is found by bisection.
+    (dead load). Lengths over ``L``, ``k = P L^2 / EI``.
+
+    Derivation. In equilibrium the follower force is a fixed force, ``P (sin a_L, -cos a_L)``
+    with ``a_L`` the final tip angle: the beam has the shape of a cantilever under that dead
+    force. In a frame turned so that this force points in ``-y'``, the moment of the part
+    beyond ``s``, ``EI theta' = M``, ``M' = P cos(theta')``, gives with ``psi = pi/2 -
+    theta'`` the pendulum ``psi'' + k sin(psi) = 0``; the free tip, ``psi'(1) = 0``, is its
+    turning point ``psi_L``, and ``psi'^2 = 2 k (cos psi - cos psi_L)``. With ``sin(psi / 2)
+    = p sin(eta)``, ``p = sin(psi_L / 2)``, ``m = p^2``, the length is ``sqrt(k) = K(m) -
+    F(eta_0 | m)`` (``eta = pi/2`` at the tip, ``eta_0`` at the clamp's ``psi_0``), and the
+    chord has ``dx' = int sin(psi) ds = psi'(0) / k = sqrt(2 (cos psi_0 - cos psi_L) / k)``
+    (from ``sin psi = -psi'' / k``) across the load and ``dy' = int cos(psi) ds = int (1 - 2
+    m sin^2 eta) ds = 2 (E(m) - E(eta_0 | m)) / sqrt(k) - 1`` along it (``F``, ``E``:
+    incomplete elliptic integrals of the first and second kind, ``K``, ``E``: complete).
+
+    * Dead force (Bisshopp & Drucker, "Large deflection of cantilever beams", Q. Appl. Math.
+      3, 272-275, 1945): the frame is the global one, ``psi_0 = pi/2`` at the clamp and the
+      unknown amplitude ``psi_L = pi/2 - theta_L`` solves ``K(m) - F(eta_0 | m) = sqrt(k)``,
+      ``sin(eta_0) = sin(pi/4) / p``.
+    * Follower force: the force is perpendicular to the tip, ``psi_L = pi/2``: ``m = 1/2``
+      for every load, and the clamp's angle in the turned frame, ``psi_0 = pi/2 + theta_L``,
+      solves ``F(eta_0 | 1/2) = K(1/2) - sqrt(k)``, ``sin(psi_0 / 2) = sin(eta_0) /
+      sqrt(2)``; the chord is turned back by ``theta_L``. (The classical follower-load
+      benchmark, e.g. Argyris & Symeonidis, Comput. Methods Appl. Mech. Eng. 26, 75-123,
+      1981.)
+
+    Each case is one scalar equation, solved by bisection (``brentq``).
 
     Parameters
     ----------
     k
         Load parameter ``P L^2 / EI`` (``EI`` per unit width in plane strain, see
-        :func:`bending_stiffness_plane_strain`).
+        :func:`bending_stiffness_plane_strain`); ``0 < k < 4 K(1/2)^2 = 13.75`` for the
+        follower force (a tip rotation below pi).
     follower
         Follower (perpendicular to the deformed axis) or dead (fixed ``-y``) force.
 
@@ -112,37 +129,34 @@ def cantilever_elastica(k: float, follower: bool) -> tuple[float, float, float]:
         rotation (radians, negative: clockwise).
     """
     from scipy.optimize import brentq
+    from scipy.special import ellipk, ellipkinc
 
+    root_k = np.sqrt(k)
     if follower:
-        phi0 = _elastica_from_tip(k, 0.0, True)
-        tip = -phi0[0]
-    else:
-        tip = brentq(
-            lambda a: _elastica_from_tip(k, a, False)[0], -0.5 * np.pi + 1e-12, 0.0, xtol=1e-15
+        K = ellipk(0.5)
+        if not 0.0 < root_k < 2.0 * K:
+            raise ValueError(f"k = {k} is not in (0, 4 K(1/2)^2) = (0, {4.0 * K**2:.4f})")
+        eta0 = brentq(
+            lambda eta: ellipkinc(eta, 0.5) - (K - root_k), -0.5 * np.pi, 0.5 * np.pi, xtol=1e-15
         )
-    _, _, x0, y0 = _elastica_from_tip(k, tip, follower)
-    # positions relative to the tip; the clamp is at angle 0 in the global frame
-    return float(-x0 - 1.0), float(-y0), float(tip)
+        psi0, psiL = 2.0 * np.arcsin(np.sin(eta0) / np.sqrt(2.0)), 0.5 * np.pi
+        theta_L = psi0 - 0.5 * np.pi
+    else:
+        if not 0.0 < root_k < np.inf:
+            raise ValueError(f"k = {k} must be positive and finite")
+        psi0 = 0.5 * np.pi
 
+        def length(psiL: float) -> float:
+            m = np.sin(0.5 * psiL) ** 2
+            return ellipk(m) - ellipkinc(np.arcsin(np.sin(0.25 * np.pi) / np.sqrt(m)), m) - root_k
 
-#: Tip displacements ``(u/L, v/L)`` of the cantilever elastica under a tip force ``P``
-#: initially in ``-y``, by load parameter ``k = P L^2 / EI``. Follower force perpendicular to
-#: the deformed axis: the follower-load elastica (the classical benchmark of e.g. Argyris &
-#: Symeonidis, "Nonlinear finite element analysis of elastic systems under nonconservative
-#: loading - natural formulation. Part I", Comput. Methods Appl. Mech. Eng. 26, 75-123,
-#: 1981), values to five digits of :func:`cantilever_elastica`.
-ELASTICA_FOLLOWER_TIP: dict[float, tuple[float, float]] = {
-    1.0: (-0.06435, -0.32064),
-    2.0: (-0.23264, -0.57384),
-}
-
-#: Same for a dead tip force fixed in ``-y``: Bisshopp & Drucker, "Large deflection of
-#: cantilever beams", Q. Appl. Math. 3, 272-275 (1945) (reproduced by
-#: :func:`cantilever_elastica`).
-ELASTICA_DEAD_TIP: dict[float, tuple[float, float]] = {
-    1.0: (-0.05643, -0.30172),
-    2.0: (-0.16064, -0.49346),
-}
+        psiL = brentq(length, 0.5 * np.pi * (1.0 + 1e-14), np.pi * (1.0 - 1e-14), xtol=1e-15)
+        theta_L = 0.5 * np.pi - psiL
+    dx, dy = _elastica_tip(k, psi0, psiL)
+    # turn the chord back into the global frame, where the clamp's tangent is along x
+    turn = theta_L if follower else 0.0
+    c, s = np.cos(turn), np.sin(turn)
+    return float(c * dx - s * dy - 1.0), float(s * dx + c * dy), float(theta_L)
 
 
 def neo_hookean_pressure_stretch(mu: float, lmbda: float, p: float, follower: bool) -> float:
