@@ -1080,7 +1080,7 @@ class NewtonSolver:
                 continue
             point = piece.turning_point()
             about = "" if point is None else " about (" + ", ".join(f"{v:.3g}" for v in point) + ")"
-            pairs = ", ".join(str(self.problem.contacts[k].pair.slave) for k in on)
+            pairs = ", ".join(self.problem.contacts[k].pair.surface("slave") for k in on)
             hints.append(
                 f"; the body with the contact pair(s) of slave surface {pairs} is free to turn"
                 f"{about}: no support holds that rotation, only the contact, which a "
@@ -1135,7 +1135,7 @@ class NewtonSolver:
         normal and has the facet one (a solid master of a degree-1 displacement; the same on
         every rank: the pairs are)."""
         faceted = [
-            str(c.pair.master)
+            c.pair.surface("master")
             for c in self.problem.contacts
             if not c.pair.on_obstacle
             and c.pair.master_normal == "facet"
@@ -1145,7 +1145,7 @@ class NewtonSolver:
         if not faceted:
             return ""
         return (
-            f"; the master surface (tag {', '.join(faceted)}) has the facet normal, which jumps "
+            f"; the master surface {', '.join(faceted)} has the facet normal, which jumps "
             'at every facet edge: master_normal="smoothed" in its ContactPair removes those '
             "jumps (continuous normal from facet to facet)"
         )

@@ -368,7 +368,7 @@ class ContactProblem:
             if not len(unheld):
                 continue
             modes = "; ".join(free_bodies.describe_mode(piece, m) for m in unheld)
-            surfaces = ", ".join(self._surface_name(self.contacts[k].pair) for k in on)
+            surfaces = ", ".join(self.contacts[k].pair.surface("slave") for k in on)
             hint = _support_hint(piece, unheld)
             warnings.warn(
                 f"the solution is not unique: the body {' + '.join(piece.bodies)} has a rigid "
@@ -379,11 +379,6 @@ class ContactProblem:
                 NonUniqueSolutionWarning,
                 stacklevel=3,
             )
-
-    def _surface_name(self, pair: ContactPair) -> str:
-        """The slave surface of ``pair`` by its physical group's name where it has one."""
-        domain = self.bulks[pair.slave_domain or 0].domain
-        return domain._describe(pair.slave, domain.mesh.topology.dim - (not domain.membrane))
 
     def block_rows(self, k: int) -> slice:
         """Local (owned) range of the displacement of mesh ``k`` in a vector of the

@@ -331,6 +331,13 @@ class Domain:
         names = [n for n, (d, t) in self.groups.items() if t == tag and d in (dim, -1)]
         return f"{names[0]!r} (tag {tag})" if names else f"on tag {tag}"
 
+    def _surface_label(self, tag: int) -> str:
+        """A contact surface (facets of a solid, cells of a membrane) by its group's name
+        and tag, or ``""`` where it has no name."""
+        dim = self.mesh.topology.dim - (not self.membrane)
+        names = [n for n, (d, t) in self.groups.items() if t == tag and d in (dim, -1)]
+        return f"{names[0]!r} (tag {tag})" if names else ""
+
     def _check_dimensions(self, where: str) -> None:
         """Solids on a mesh of full dimension, membranes (strings) on a surface (curve)
         mesh: a clear error on every rank for a mismatch."""
@@ -565,14 +572,16 @@ class Scene:
         contacts = []
         for k, pair in enumerate(self.contacts):
             changes: dict[str, Any] = {}
-            for side in ("slave", "master"):
+            labels = ["", ""]
+            for n, side in enumerate(("slave", "master")):
                 key = getattr(pair, side)
                 if not isinstance(key, RigidObstacle):
                     domain = getattr(pair, f"{side}_domain")
                     what = f"contact pair {k}, {side} surface"
                     d, tag = self.locate(key, "surface", domain, what)
                     changes[side], changes[f"{side}_domain"] = tag, d
-            contacts.append(dataclasses.replace(pair, **changes))
+                    labels[n] = self.parts[d]._surface_label(tag)
+            contacts.append(dataclasses.replace(pair, **changes, labels=tuple(labels)))
         self.contacts = contacts
 
     def validate(self) -> None:

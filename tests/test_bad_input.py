@@ -55,8 +55,10 @@ def test_slave_not_facing_master(scene):
     with warnings.catch_warnings():  # the pair has no supports (a scene for Taylor tests)
         warnings.simplefilter("ignore", NonUniqueSolutionWarning)
         ContactProblem(swapped, verbose=False)  # swapped roles face each other: fine
-    with pytest.raises(ContactInputError, match="never faces"):
-        ContactProblem(with_pair(scene, slave=scene.tags["cylinder_top"]), verbose=False)
+    with pytest.raises(ContactInputError, match="never faces") as error:
+        ContactProblem(with_pair(scene, slave="cylinder_top"), verbose=False)
+    # the message names the surfaces by their physical groups
+    assert "slave surface 'cylinder_top' (tag" in str(error.value), error.value
 
 
 def test_empty_body_tag(scene):

@@ -57,7 +57,7 @@ def check_multiplier_degree(comm: MPI.Comm, pair: ContactPair, degree: int) -> N
             comm,
             degree == 2,
             f"multiplier_degree={pair.multiplier_degree!r} (P1-iso-P2) of the pair with slave "
-            f"surface (tag {pair.slave}) needs a degree-2 displacement (got degree {degree}): "
+            f"surface {pair.surface('slave')} needs a degree-2 displacement (got degree {degree}): "
             "use multiplier_degree=1 with a degree-1 displacement",
         )
         return
@@ -134,8 +134,9 @@ class ContactInterface:
             collective_check(
                 comm,
                 master_degree == degree,
-                f"the slave body (tag {pair.slave}) has a degree-{degree} displacement and the "
-                f"master body (tag {pair.master}) a degree-{master_degree} one: a contact pair "
+                f"the slave surface {pair.surface('slave')} has a degree-{degree} displacement "
+                f"and the master surface {pair.surface('master')} a degree-{master_degree} "
+                "one: a contact pair "
                 "needs one displacement degree on both sides",
             )
         qdeg = pair.quadrature_degree or 2 * degree + 1
@@ -205,17 +206,18 @@ class ContactInterface:
         collective_check(
             comm,
             not (pair.self_contact and (self.master.two_sided or self.slave.membrane)),
-            f"self-contact of a membrane (tag {pair.slave}) is not implemented: its two sides "
-            "would both have to be searched",
+            f"self-contact of a membrane ({pair.surface('slave')}) is not implemented: its "
+            "two sides would both have to be searched",
         )
         search = ClosestPointSearch(
             self.slave, self.master, radius, self.touching, pair.self_contact
         )
         kinematics = MeshKinematics(self.u, self.slave, self.master, search)
         kinematics.check_facing(
-            f"slave surface (tag {pair.slave}) of the pair with master surface (tag {pair.master})"
+            f"slave surface {pair.surface('slave')} of the pair with master surface "
+            f"{pair.surface('master')}"
             if not pair.self_contact
-            else f"the self-contact surface (tag {pair.slave})"
+            else f"the self-contact surface {pair.surface('slave')}"
         )
         return kinematics
 
@@ -229,7 +231,7 @@ class ContactInterface:
         radius = pair.search_radius or 0.25 * size
         kinematics = ObstacleKinematics(self.u, self.slave, obstacle, radius)
         kinematics.check_facing(
-            f"slave surface (tag {pair.slave}) of the pair with a {type(obstacle).__name__}"
+            f"slave surface {pair.surface('slave')} of the pair with a {type(obstacle).__name__}"
         )
         return kinematics
 
@@ -482,7 +484,7 @@ def check_degrees(
         "implemented)",
     )
     geometry_degree = mesh.geometry.cmaps[0].degree
-    tag = pair.slave if side == "slave" else pair.master
+    tag = pair.surface(side)
     supported = (
         "contact supports a degree-1 displacement on a degree-1 geometry, or a degree-2 "
         "displacement on a degree-1 or degree-2 geometry"
@@ -490,7 +492,7 @@ def check_degrees(
     collective_check(
         comm,
         (degree, geometry_degree) in SUPPORTED_DEGREES,
-        f"the {side} body (tag {tag}) has a degree-{degree} displacement on a "
+        f"the {side} surface {tag} has a degree-{degree} displacement on a "
         f"degree-{geometry_degree} geometry: {supported}",
     )
     if degree == 1:
@@ -499,13 +501,13 @@ def check_degrees(
     collective_check(
         comm,
         surface_tags.dim == tdim - 1,
-        f"the {side} surface (tag {tag}) is a membrane's: membranes in contact need a "
+        f"the {side} surface {tag} is a membrane's: membranes in contact need a "
         "degree-1 displacement",
     )
     collective_check(
         comm,
         side == "slave" or pair.master_normal == "facet",
-        f'master_normal="{pair.master_normal}" of the pair with master surface (tag {tag}) '
+        f'master_normal="{pair.master_normal}" of the pair with master surface {tag} '
         "needs a degree-1 displacement: with degree 2 the master normal is that of the "
         'quadratic facet (master_normal="facet")',
     )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from mpi4py import MPI
 
@@ -118,6 +118,17 @@ class ContactPair:
     master_domain: int | str | None = None
     multiplier_degree: int | str = 1
     geometric_traction: str = "bracket"
+    #: how messages name the slave and the master surface (set by the scene: the physical
+    #: group's name and its tag, where the surface has a name)
+    labels: tuple[str, str] = field(default=("", ""), repr=False, compare=False)
+
+    def surface(self, side: str) -> str:
+        """The ``"slave"`` or ``"master"`` surface in words for a message:
+        ``'top' (tag 3)`` where its group has a name, else ``tag 3`` (or the obstacle)."""
+        key = getattr(self, side)
+        if isinstance(key, RigidObstacle):
+            return f"the {type(key).__name__}"
+        return self.labels[side == "master"] or f"tag {key}"
 
     @property
     def frictional(self) -> bool:
