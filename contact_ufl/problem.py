@@ -31,7 +31,7 @@ from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.control import VolumeConstraint, VolumeControl
 from contact_ufl.errors import NonUniqueSolutionWarning, collective_check
 from contact_ufl.layout import StackedLayout
-from contact_ufl.mpi import global_bounds, global_diameter
+from contact_ufl.mpi import collective, global_bounds, global_diameter
 from contact_ufl.scene import Domain, Scene
 
 if TYPE_CHECKING:
@@ -494,6 +494,7 @@ class ContactProblem:
         return self.stepper.solve(num_steps, t_end, max_cutbacks, callback)
 
     # -- results --------------------------------------------------------------------
+    @collective
     def reaction(
         self, tag: int | str | Sequence[int | str], domain: int | str | None = None
     ) -> np.ndarray:
@@ -518,6 +519,7 @@ class ContactProblem:
             local += values[keysets.unique(np.concatenate(blocks))].sum(axis=0)
         return self.comm.allreduce(local, MPI.SUM)
 
+    @collective
     def obstacle_reaction(self, obstacle: RigidObstacle) -> np.ndarray:
         """Resultant force of a rigid obstacle on the bodies at the current state: its
         reaction, reported like a support's (:meth:`reaction` is the force of a support on
@@ -535,12 +537,14 @@ class ContactProblem:
             raise ValueError(f"no contact pair of this problem has the master {obstacle}")
         return sum((c.integrate("traction") for c in pairs), np.zeros(self.gdim))
 
+    @collective
     def load_resultant(self) -> np.ndarray:
         """Resultant of all applied loads (dead and follower) at the current state."""
         loads = [b.load_resultant() for b in self.bulks]
         loads += [control.load_resultant() for control in self.controls]
         return sum(loads, np.zeros(self.gdim))
 
+    @collective
     def contact_residual(self) -> PETSc.Vec:
         """The contact terms alone of the residual at the current state, as a vector of the
         unknowns (master parts gathered through the chain rule of :attr:`solver`)."""
@@ -550,12 +554,14 @@ class ContactProblem:
             )
         return self.solver.assemble(self._contact_residual_form)
 
+    @collective
     def contact_force(self, k: int | None = None) -> np.ndarray:
         """Resultant contact force on the slave body, ``int (t_N nu - P(q)) dS_o`` (all pairs;
         the frictional part only with friction)."""
         pairs = self.contacts if k is None else [self.contacts[k]]
         return sum((c.integrate("traction") for c in pairs), np.zeros(self.gdim))
 
+    @collective
     def stored_energy(self) -> float:
         """Elastic energy ``sum_b int psi_b(F) dV`` of all bodies (reference volume), for
         hyperelastic bodies (an elastoplastic one raises)."""
@@ -567,6 +573,7 @@ class ContactProblem:
             )
         return sum(b.stored_energy() for b in self.bulks)
 
+    @collective
     def active_points(self) -> int:
         """Number of slave quadrature points in contact (all pairs)."""
         return int(self.comm.allreduce(sum(c.active().sum() for c in self.contacts), MPI.SUM))

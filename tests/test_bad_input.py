@@ -1,6 +1,7 @@
 """Bad input gets a clear error naming the problem, on every rank (no MPI hang)."""
 
 import dataclasses
+import time
 import warnings
 
 import dolfinx
@@ -9,10 +10,12 @@ import pytest
 from conftest import symmetric_square
 from mpi4py import MPI
 
+from contact_ufl import mpi
 from contact_ufl.contact import ContactPair
 from contact_ufl.errors import ContactInputError, NonUniqueSolutionWarning
 from contact_ufl.loads import DeadTraction, Dirichlet
 from contact_ufl.materials import NeoHookean
+from contact_ufl.mpi import CollectiveCallError
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Scene
 from contact_ufl.verification import geometries
@@ -171,3 +174,31 @@ def test_a_body_held_by_nothing_is_refused():
     """With no contact pair, nothing holds the pushed disc: refused, naming its motions."""
     with pytest.raises(ContactInputError, match=r"'cylinder' is held by no support and no con"):
         ContactProblem(disc_on_block([], contacts=False), verbose=False)
+
+
+two_ranks = pytest.mark.skipif(MPI.COMM_WORLD.size < 2, reason="needs several ranks")
+
+
+@two_ranks
+def test_a_collective_call_on_one_rank_raises_instead_of_hanging(monkeypatch):
+    """problem.load_resultant() inside `if rank == 0:` raises on rank 0, naming the call,
+    after the collective timeout (here 1 s) instead of waiting forever."""
+    problem = ContactProblem(symmetric_square(NeoHookean(1.0, 0.3), []), verbose=False)
+    comm = problem.comm
+    if comm.rank == 0:
+        with pytest.raises(CollectiveCallError, match="ContactProblem.load_resultant is coll"):
+            monkeypatch.setattr(mpi, "COLLECTIVE_TIMEOUT", 1.0)
+            problem.load_resultant()
+    else:
+        time.sleep(2.0)
+        comm.Ibarrier().Wait()  # meets rank 0's barrier given up on: the ranks are in step
+    comm.barrier()
+    assert np.all(np.isfinite(problem.load_resultant()))  # every rank: fine
+
+
+@two_ranks
+def test_different_collective_calls_at_once_raise_on_every_rank():
+    problem = ContactProblem(symmetric_square(NeoHookean(1.0, 0.3), []), verbose=False)
+    call = problem.load_resultant if problem.comm.rank == 0 else problem.stored_energy
+    with pytest.raises(CollectiveCallError, match="different collective calls"):
+        call()
