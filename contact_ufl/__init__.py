@@ -41,7 +41,14 @@ from contact_ufl import (
 from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSphere
 from contact_ufl.control import VolumeControl
 from contact_ufl.errors import ContactInputError, ConvergenceError, NonUniqueSolutionWarning
-from contact_ufl.loads import BodyForce, DeadTraction, Dirichlet, FollowerForce, FollowerPressure
+from contact_ufl.loads import (
+    BodyForce,
+    DeadTraction,
+    Dirichlet,
+    FollowerForce,
+    FollowerPressure,
+    RigidMotion,
+)
 from contact_ufl.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff
 from contact_ufl.membranes import (
     MembraneCompressibleNeoHookean,
@@ -85,6 +92,7 @@ __all__ = [
     "NonUniqueSolutionWarning",
     "ResultWriter",
     "RigidCylinder",
+    "RigidMotion",
     "RigidPlane",
     "RigidSphere",
     "SaintVenantKirchhoff",

@@ -160,15 +160,18 @@ class Bulk:
     # -- supports -----------------------------------------------------------------------
     def _locate_dirichlet(self) -> None:
         fdim, gdim = self.V.mesh.topology.dim - 1, self.V.mesh.geometry.dim
-        self._bc_dofs, self._bc_values = [], []
+        self._bc_dofs, self._bc_values, self._bc_points = [], [], []
         owned = self.V.dofmap.index_map.size_local * gdim
+        nodes = self.V.tabulate_dof_coordinates()[:, :gdim]
         for bc in self.domain.dirichlet:
             facets = self.domain.facet_tags.find(bc.tag)
             comps = range(gdim) if bc.component is None else [bc.component]
             for i in comps:
-                blocks = dolfinx.fem.locate_dofs_topological(self.V.sub(i), fdim, facets)
-                self._bc_dofs.append(blocks[blocks < owned])
+                dofs = dolfinx.fem.locate_dofs_topological(self.V.sub(i), fdim, facets)
+                dofs = dofs[dofs < owned]  # unrolled: node * gdim + i
+                self._bc_dofs.append(dofs)
                 self._bc_values.append((bc, i))
+                self._bc_points.append(nodes[dofs // gdim])
         self.dirichlet_dofs = (
             np.concatenate(self._bc_dofs).astype(np.int64)
             if self._bc_dofs
@@ -186,10 +189,14 @@ class Bulk:
     def prescribed(self, t: float) -> np.ndarray:
         """The prescribed displacements ``g(t)`` of :attr:`dirichlet_dofs`."""
         values = []
-        for dofs, (bc, i) in zip(self._bc_dofs, self._bc_values, strict=True):
+        for x, (bc, i) in zip(self._bc_points, self._bc_values, strict=True):
+            if bc.varies_along_facets:
+                value = bc.values_at(t, x)
+                values.append(value if bc.component is not None else value[:, i])
+                continue
             value = evaluate(bc.value, t)
             value = value if bc.component is not None or value.ndim == 0 else value[i]
-            values.append(np.full(len(dofs), float(value)))
+            values.append(np.full(len(x), float(value)))
         return np.concatenate(values) if values else np.zeros(0)
 
     def facet_dofs(self, tag: int) -> np.ndarray:

@@ -1,7 +1,9 @@
 """Prescribed loads and displacements, scaled by the pseudo-time (load factor) t.
 
 Values are given either as constants or as callables of the pseudo-time ``t``; they are
-refreshed into DOLFINx constants at every load step, so forms are compiled once.
+refreshed into DOLFINx constants at every load step, so forms are compiled once. A
+prescribed displacement may also vary along its facets: a callable of ``(t, x)``, such as a
+:class:`RigidMotion` (a hub turned, a ball rolled).
 
 Dead loads (:class:`DeadTraction`, :class:`BodyForce`) keep their direction and magnitude per
 unit reference area or volume. Follower loads (:class:`FollowerPressure`,
@@ -12,6 +14,7 @@ residual) contains their load stiffness, which is not symmetric.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -40,14 +43,98 @@ class Dirichlet:
     tag
         Facet tag, or the name of its physical group.
     value
-        Displacement vector (or, with ``component``, one component), or a callable of ``t``.
+        Displacement vector (or, with ``component``, one component), or a callable of ``t``
+        returning one; or a callable of ``(t, x)``, ``x`` the reference coordinates
+        ``(n, gdim)`` of the facets' nodes, returning their displacements ``(n, gdim)``
+        (``(n,)`` with ``component``), such as a :class:`RigidMotion`.
     component
         Constrain only this component.
     """
 
     tag: int | str
-    value: Value
+    value: Value | Callable[[float, np.ndarray], np.ndarray]
     component: int | None = None
+
+    @property
+    def varies_along_facets(self) -> bool:
+        """Whether the value is a callable of ``(t, x)`` (two positional parameters)."""
+        return takes_position(self.value)
+
+    def values_at(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The prescribed displacements at the points ``x (n, gdim)`` at pseudo-time ``t``:
+        ``(n, gdim)``, or ``(n,)`` with :attr:`component`."""
+        n, gdim = x.shape
+        shape = (n,) if self.component is not None else (n, gdim)
+        if self.varies_along_facets:
+            value = np.asarray(self.value(t, x), dtype=float)
+            if value.shape != shape:
+                raise ValueError(f"value(t, x) must return shape {shape}, got {value.shape}")
+            return value
+        value = evaluate(self.value, t)
+        if self.component is None and value.ndim == 1:
+            return np.broadcast_to(value, shape)
+        return np.broadcast_to(value, shape if value.ndim == 0 else value.shape)
+
+
+def takes_position(value) -> bool:
+    """Whether ``value`` is a callable of ``(t, x)``: two positional parameters."""
+    if not callable(value):
+        return False
+    try:
+        parameters = inspect.signature(value).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    positional = [
+        p
+        for p in parameters
+        if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) and p.default is p.empty
+    ]
+    return len(positional) == 2
+
+
+def _is_translation(value, gdim: int) -> bool:
+    """Whether a motion's value is a translation (``gdim`` numbers), not a pair."""
+    try:
+        return np.asarray(value, dtype=float).shape == (gdim,)
+    except (TypeError, ValueError):  # a (translation, rotation) pair
+        return False
+
+
+@dataclass(frozen=True)
+class RigidMotion:
+    """A rigid motion of a support's facets, for :class:`Dirichlet`'s ``value``: the
+    displacement ``u(x) = c(t) + (Q(t) - I)(x - centre)`` of a translation ``c`` and a
+    rotation ``Q`` about ``centre``.
+
+    Parameters
+    ----------
+    motion
+        A callable of ``t`` returning a translation ``c(t)`` or a pair ``(c(t), Q(t))`` with
+        ``Q`` a rotation matrix: the motion of the rigid obstacles
+        (:mod:`contact_ufl.contact.obstacles`).
+    centre
+        The point the rotation is about (reference coordinates).
+
+    Examples
+    --------
+    A hub turned by half a radian about the origin::
+
+        def turn(t):
+            a = 0.5 * t
+            return (0.0, 0.0), [[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]
+
+        Dirichlet("hub", RigidMotion(turn, centre=(0.0, 0.0)))
+    """
+
+    motion: Callable
+    centre: Sequence[float]
+
+    def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
+        gdim = x.shape[1]
+        value = self.motion(t)
+        c, Q = (value, np.eye(gdim)) if _is_translation(value, gdim) else value
+        c, Q = np.asarray(c, dtype=float), np.asarray(Q, dtype=float)
+        return c + (x - np.asarray(self.centre, dtype=float)) @ (Q - np.eye(gdim)).T
 
 
 @dataclass(frozen=True)

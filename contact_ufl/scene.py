@@ -691,6 +691,16 @@ def _validate_dirichlet(comm: MPI.Comm, bc: Dirichlet, gdim: int, what: str) -> 
             f"{what}: component must be one of {list(range(gdim))} in {gdim}D, got "
             f"{bc.component!r}",
         )
+    if bc.varies_along_facets:
+        x = np.zeros((2, gdim))  # two points at the origin: the shape of the answer
+        try:
+            value = bc.values_at(0.0, x)
+        except Exception as error:  # a callable that fails, or of the wrong shape
+            problem = f"its value(t, x) at t = 0 cannot be evaluated ({error})"
+        else:
+            problem = None if np.all(np.isfinite(value)) else "value(0, x) is not finite"
+        collective_check(comm, problem is None, f"{what}: {problem}")
+        return
     try:
         value = evaluate(bc.value, 0.0)
     except Exception as error:  # a callable that fails at t = 0, or no numbers
