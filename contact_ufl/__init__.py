@@ -43,6 +43,7 @@ from contact_ufl.control import VolumeControl
 from contact_ufl.errors import ContactInputError, ConvergenceError, NonUniqueSolutionWarning
 from contact_ufl.loads import (
     BodyForce,
+    DeadForce,
     DeadTraction,
     Dirichlet,
     FollowerForce,
@@ -73,6 +74,7 @@ __all__ = [
     "ContactPair",
     "ContactProblem",
     "ConvergenceError",
+    "DeadForce",
     "DeadTraction",
     "Dirichlet",
     "Domain",

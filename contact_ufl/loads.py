@@ -160,12 +160,47 @@ class DeadTraction(_DeadLoad):
         Facet tag of the loaded surface, or the name of its physical group.
     value
         Traction vector ``T`` (force per unit reference area), or a callable of ``t``. A
-        resultant ``P`` spread over a reference area ``A0`` is ``T = P / A0``.
+        resultant ``P`` spread over the reference area ``A0`` is :class:`DeadForce`.
 
     Notes
     -----
     Its external virtual work is ``int T . v dS_o``.
     """
+
+
+@dataclass(frozen=True)
+class DeadForce(_DeadLoad):
+    """A resultant force of fixed direction spread uniformly over the reference area of the
+    facets ``tag``: the dead traction ``T = P / A0``, ``A0 = int_{tag} dS_o``.
+
+    Parameters
+    ----------
+    tag
+        Facet tag of the loaded surface, or the name of its physical group.
+    value
+        The resultant force vector ``P`` (force units; per unit thickness in plane strain),
+        or a callable of ``t``.
+
+    Notes
+    -----
+    Its external virtual work is ``int (P / A0) . v dS_o``, its resultant exactly ``P``;
+    ``A0`` is assembled once when the problem is made (collectively).
+    """
+
+    def virtual_work(self, u, v, measure, constant):
+        """External virtual work ``int (P / A0) . v dS_o`` (``constant`` holds ``P``)."""
+        mesh = u.function_space.mesh
+        area = reference_area(measure, mesh, self.tag)
+        if not area > 0.0:
+            raise ContactInputError(f"DeadForce: facet tag {self.tag} has zero reference area")
+        return ufl.dot(constant, v) * dolfinx.fem.Constant(mesh, 1.0 / area) * measure(self.tag)
+
+
+def reference_area(measure: ufl.Measure, mesh: dolfinx.mesh.Mesh, tag: int) -> float:
+    """``A0 = int_{tag} d(measure)``, summed over all ranks (collective)."""
+    one = dolfinx.fem.Constant(mesh, 1.0)
+    local = dolfinx.fem.assemble_scalar(jit.form(one * measure(tag)))
+    return mesh.comm.allreduce(local, MPI.SUM)
 
 
 @dataclass(frozen=True)
@@ -263,9 +298,7 @@ class FollowerForce:
 
     def reference_area(self, ds: ufl.Measure, mesh: dolfinx.mesh.Mesh) -> float:
         """``A0 = int_{tag} dS_o``, summed over all ranks."""
-        one = dolfinx.fem.Constant(mesh, 1.0)
-        local = dolfinx.fem.assemble_scalar(jit.form(one * ds(self.tag)))
-        return mesh.comm.allreduce(local, MPI.SUM)
+        return reference_area(ds, mesh, self.tag)
 
     def traction(
         self, u: dolfinx.fem.Function, magnitude: ufl.core.expr.Expr
@@ -295,7 +328,7 @@ class FollowerForce:
 
 
 #: Loads applied on tagged facets (all but :class:`BodyForce`, whose tag is a cell tag).
-SurfaceLoad = DeadTraction | FollowerPressure | FollowerForce
+SurfaceLoad = DeadTraction | DeadForce | FollowerPressure | FollowerForce
 #: Any load of a scene.
 Load = SurfaceLoad | BodyForce
 

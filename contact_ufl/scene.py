@@ -661,7 +661,19 @@ def _is_tag(key: Any) -> bool:
 
 
 def _validate_load(comm: MPI.Comm, load: Load, gdim: int, where: str) -> None:
-    """Check a follower load's value and direction (on every rank)."""
+    """Check a load's value (a vector of the mesh's dimension for a dead load, a scalar
+    magnitude for a follower load) and a follower force's direction (on every rank)."""
+    if not isinstance(load, FollowerPressure | FollowerForce | VolumeControl):
+        try:
+            shape = evaluate(load.value, 0.0).shape
+        except Exception as error:  # a callable that fails at t = 0, or no numbers
+            shape = f"none: its value at t = 0 cannot be evaluated ({error})"
+        collective_check(
+            comm,
+            shape == (gdim,),
+            f"{where}{type(load).__name__} on tag {load.tag}: the value is a vector of "
+            f"{gdim} components in {gdim}D, got shape {shape}",
+        )
     if isinstance(load, FollowerPressure | FollowerForce):
         shape = evaluate(load.value, 0.0).shape
         collective_check(

@@ -1,16 +1,17 @@
 """Prescribed displacements that vary along the facets (a callable of ``(t, x)``, a
-:class:`~contact_ufl.loads.RigidMotion`), verified against exact solutions of finite
-elasticity: a homogeneous deformation prescribed on the whole boundary of a hyperelastic
-body is its solution (no body force: the stress is uniform, so divergence free), and a rigid
-rotation leaves it unstressed (objectivity)."""
+:class:`~contact_ufl.loads.RigidMotion`) and a total force (:class:`~contact_ufl.loads.DeadForce`),
+verified against exact solutions: a homogeneous deformation prescribed on the whole boundary
+of a hyperelastic body is its solution (no body force: the stress is uniform, so divergence
+free), a rigid rotation leaves it unstressed (objectivity), and a force on a side of a square
+on rollers stretches it uniformly."""
 
 import numpy as np
 import pytest
-from conftest import tagged_unit_square
+from conftest import symmetric_square, tagged_unit_square
 
 from contact_ufl.errors import ContactInputError
-from contact_ufl.loads import Dirichlet, RigidMotion
-from contact_ufl.materials import NeoHookean
+from contact_ufl.loads import DeadForce, Dirichlet, RigidMotion
+from contact_ufl.materials import LinearElastic, NeoHookean
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Scene
 
@@ -89,3 +90,46 @@ def test_a_rigid_rotation_of_the_boundary_turns_the_body_unstressed(verification
 def test_a_value_of_t_and_x_is_checked_when_the_problem_is_made(value, message):
     with pytest.raises(ContactInputError, match=message):
         ContactProblem(square_held_by(value), verbose=False)
+
+
+def test_a_dead_force_is_spread_over_the_reference_area(verification):
+    """A total force P on the right side of the unit square (a DeadForce, per unit
+    thickness), held by rollers on the left and bottom: uniaxial stress P / 1 in plane
+    strain, so the right side moves by u_x = P (1 - nu^2) / E (linear elasticity, exact for
+    the homogeneous field on any mesh); the resultant of the load is P."""
+    E, nu, P = 1.0, 0.3, 1e-3
+    problem = ContactProblem(
+        symmetric_square(LinearElastic(E, nu), [DeadForce(2, lambda t: (P * t, 0.0))], n=3),
+        verbose=False,
+    )
+    problem.solve(num_steps=1)
+    x = problem.V.tabulate_dof_coordinates()[:, 0]
+    u_x = problem.u.x.array.reshape(-1, 2)[np.isclose(x, 1.0), 0]
+    exact = P * (1.0 - nu**2) / E
+    error = np.abs(u_x / exact - 1.0).max()
+    verification(
+        "unit square, linear elastic, total force P on a side",
+        "largest relative error of u_x on the loaded side",
+        error,
+        "u_x = P (1 - nu^2) / E: uniaxial stress in plane strain",
+        "< 1e-9",
+        "closed form (homogeneous field)",
+    )
+    assert error < 1e-9
+    resultant = problem.load_resultant()
+    verification(
+        "unit square, linear elastic, total force P on a side",
+        "load resultant over P",
+        resultant[0] / P,
+        1.0,
+        "|x - 1| < 1e-12",
+        "the load's definition (T = P / A0)",
+        kind="consistency",
+    )
+    assert resultant == pytest.approx([P, 0.0], rel=1e-12, abs=1e-15)
+
+
+@pytest.mark.parametrize("value", [(1.0, 2.0, 3.0), lambda t: 1.0])
+def test_a_dead_load_of_the_wrong_shape_is_refused(value):
+    with pytest.raises(ContactInputError, match=r"DeadForce on tag 2: the value is a vector of 2"):
+        ContactProblem(symmetric_square(MATERIAL, [DeadForce(2, value)]), verbose=False)
