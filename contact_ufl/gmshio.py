@@ -43,6 +43,9 @@ Groups = dict[str, tuple[int, int]]
 
 #: Environment variable naming the default partition (``bodies`` or ``graph``).
 PARTITION_VARIABLE = "CONTACT_UFL_PARTITION"
+#: The environment variable that makes :func:`gmsh_session` pass gmsh's messages to the
+#: terminal (``1``) rather than silence them (the default), to see a mesher at work.
+GMSH_VERBOSE_VARIABLE = "CONTACT_UFL_GMSH_VERBOSE"
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,11 +85,14 @@ class MeshData:
 
 
 @contextmanager
-def gmsh_session(name: str, options: dict[str, float] | None = None) -> Iterator[None]:
+def gmsh_session(
+    name: str, options: dict[str, float] | None = None, verbose: bool | None = None
+) -> Iterator[None]:
     """Work in a fresh gmsh model, and clean up afterwards.
 
     Initialises gmsh unless it is initialised already (then finalises it on exit), silences the
-    terminal, adds a model ``name`` and makes it current, and sets the numeric ``options``.
+    terminal unless ``verbose``, adds a model ``name`` and makes it current, and sets the
+    numeric ``options``.
     On exit the model is removed; if gmsh was initialised by the caller, the options and the
     previous current model are restored.
 
@@ -96,6 +102,9 @@ def gmsh_session(name: str, options: dict[str, float] | None = None) -> Iterator
         Name of the gmsh model.
     options
         Numeric gmsh options, e.g. ``{"Mesh.Algorithm": 6}``.
+    verbose
+        Pass gmsh's messages to the terminal (default: whether the environment variable
+        :data:`GMSH_VERBOSE_VARIABLE` is ``1``), e.g. to see where a mesher hangs.
 
     Yields
     ------
@@ -105,7 +114,9 @@ def gmsh_session(name: str, options: dict[str, float] | None = None) -> Iterator
     initialised_here = not gmsh.isInitialized()
     if initialised_here:
         gmsh.initialize(interruptible=False)
-    all_options = {"General.Terminal": 0.0, **(options or {})}
+    if verbose is None:
+        verbose = os.environ.get(GMSH_VERBOSE_VARIABLE, "0") not in ("", "0")
+    all_options = {"General.Terminal": float(bool(verbose)), **(options or {})}
     saved = {key: gmsh.option.getNumber(key) for key in all_options}
     previous = gmsh.model.getCurrent() if not initialised_here else None
     try:

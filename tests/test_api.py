@@ -87,3 +87,13 @@ def test_a_scene_written_with_names_only():
     assert force[1] > 0.0
     top = problem.reaction("upper_top")
     assert abs(top[1] + force[1]) < 1e-8 * force[1]
+
+
+@pytest.mark.serial  # gmsh runs on this rank alone
+@pytest.mark.parametrize("verbose", [False, True])
+def test_gmsh_messages_are_passed_on_request(capfd, verbose):
+    """gmsh_session silences gmsh by default and passes its messages with verbose=True."""
+    with gmsh_session("talk", verbose=verbose):
+        two_squares()
+    out = capfd.readouterr()
+    assert ("Meshing" in out.out + out.err) == verbose
