@@ -205,7 +205,8 @@ def unheld_modes(problem: ContactProblem, piece: Piece, on: list[int]) -> np.nda
 
     A frictionless contact pushes only along the master normal, so it holds a rigid mode
     only where the mode moves a point near contact along that normal. Near contact means
-    paired by the last search within one slave facet size of the pair's closest distance;
+    paired in the reference configuration within one slave facet size of the pair's
+    closest distance;
     a mode is not held where the mean square of its normal component there is below
     ``1e-6`` (modes of unit size: translations, and rotations over the piece's size). A
     pair with friction may hold every mode (stick), and one with both surfaces on the
@@ -222,7 +223,7 @@ def unheld_modes(problem: ContactProblem, piece: Piece, on: list[int]) -> np.nda
             return piece.modes[:0]
         if all(_sides_on(problem, piece, c.pair)):
             continue
-        p = c.projection
+        p = c.reference
         paired = p.facet >= 0
         nearest = comm.allreduce(p.distance[paired].min(initial=np.inf), MPI.MIN)
         near = paired & (p.distance <= nearest + c.slave.facet_size)

@@ -200,6 +200,7 @@ class ContactProblem:
         self._build_forms()
         self._build_dirichlet()
         self._check_rigid_modes()
+        self._report_overlaps()
         self._solver: NewtonSolver | None = None
         self._stepper: LoadStepper | None = None
         self._closed = False
@@ -339,6 +340,23 @@ class ContactProblem:
         displacements = sum(len(b.dirichlet_dofs) for b in self.bulks)
         self.held_multipliers = len(self.dirichlet_rows) - displacements
 
+    def _report_overlaps(self) -> None:
+        """Say (rank 0, when verbose) which pairs overlap at the start: a press fit, which
+        the first step resolves unless the pair ramps it in (``overlap_ramp``)."""
+        for c in self.contacts:
+            overlap = c.initial_overlap
+            if overlap > c.touching and self.verbose and self.comm.rank == 0:
+                how = (
+                    "resolved in the first load step (ContactPair.overlap_ramp ramps it in)"
+                    if c.pair.overlap_ramp is None
+                    else f"ramped in until t = {c.pair.overlap_ramp:g}"
+                )
+                print(
+                    f"contact pair of slave surface {c.pair.surface('slave')}: the surfaces "
+                    f"overlap by up to {overlap:.4g} at the start (a press fit), {how}",
+                    flush=True,
+                )
+
     def _check_rigid_modes(self) -> None:
         """Refuse a body that nothing holds (no support, no contact pair), and warn of one
         whose free rigid modes only a frictionless contact could hold but whose contact
@@ -358,12 +376,7 @@ class ContactProblem:
                 f"pair: nothing holds its rigid motion ({modes}), so the problem has no unique "
                 "solution; add a Dirichlet support (or a contact pair) on it",
             )
-        loose = [(piece, on) for piece, on in loose if on]
-        if not loose:
-            return
-        for c in self.contacts:  # the closest points at the start, for the normals
-            c.update(self.layout)
-        for piece, on in loose:
+        for piece, on in [(piece, on) for piece, on in loose if on]:
             unheld = free_bodies.unheld_modes(self, piece, on)
             if not len(unheld):
                 continue

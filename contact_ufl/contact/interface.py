@@ -161,7 +161,19 @@ class ContactInterface:
             )
         eps_N = pair.eps_N if pair.eps_N is not None else default_eps(self.slave, modulus)
         self.normal = NormalLaw(self.slave, eps_N, self.touching)
-        self.t_N = self.normal.traction(self.kinematics.gap, self.kinematics.mask)
+        #: the initial overlap of each slave point (a positive reference gap), and the gap
+        #: the laws see: less the part of it not yet ramped in (``ContactPair.overlap_ramp``)
+        self.overlap = np.where(self.reference.facet >= 0, np.maximum(self.reference.gap, 0), 0)
+        if self.master_two_sided:
+            self.overlap[:] = 0.0  # either side of a membrane master may face: no inside
+        self.gap = self.kinematics.gap
+        self._remaining = None
+        if pair.overlap_ramp is not None:
+            self._remaining = dolfinx.fem.Constant(mesh, 1.0)
+            overlap = dolfinx.fem.Function(self.slave.point_space(()))
+            self.slave.set_at_points(overlap, self.overlap)
+            self.gap = self.gap - overlap * self._remaining
+        self.t_N = self.normal.traction(self.gap, self.kinematics.mask)
         #: the Coulomb law, or ``None`` for a frictionless pair
         self.friction = (
             CoulombLaw(
@@ -169,7 +181,7 @@ class ContactInterface:
                 self.t_N,
                 pair.mu,
                 pair.eps_T or eps_N,
-                self.normal.in_contact_condition(self.kinematics.gap, self.kinematics.mask),
+                self.normal.in_contact_condition(self.gap, self.kinematics.mask),
                 self.touching,
             )
             if pair.frictional
@@ -213,7 +225,7 @@ class ContactInterface:
             self.slave, self.master, radius, self.touching, pair.self_contact
         )
         kinematics = MeshKinematics(self.u, self.slave, self.master, search)
-        kinematics.check_facing(
+        self.reference = kinematics.check_facing(
             f"slave surface {pair.surface('slave')} of the pair with master surface "
             f"{pair.surface('master')}"
             if not pair.self_contact
@@ -230,7 +242,7 @@ class ContactInterface:
         self.touching = 1e-12 * size
         radius = pair.search_radius or 0.25 * size
         kinematics = ObstacleKinematics(self.u, self.slave, obstacle, radius)
-        kinematics.check_facing(
+        self.reference = kinematics.check_facing(
             f"slave surface {pair.surface('slave')} of the pair with a {type(obstacle).__name__}"
         )
         return kinematics
@@ -293,6 +305,10 @@ class ContactInterface:
         order), the stacked index of the (master) displacement unknown it gathers, or -1.
         """
         gathers = self.kinematics.update(layout)
+        if self._remaining is not None:  # the laws' gap: the overlap not yet ramped in off
+            proj = self.kinematics.projection
+            shift = self.overlap * float(self._remaining.value)
+            proj.gap = np.where(proj.facet >= 0, proj.gap - shift, proj.gap)
         self._set_geometric_shift()
         gathers += self.friction.gathers() if self.friction else []
         return gathers if self.pair.on_obstacle else self._engaged_only(gathers)
@@ -373,8 +389,22 @@ class ContactInterface:
 
     # -- pseudo-time and the step protocol ------------------------------------------------
     def set_time(self, t: float) -> None:
-        """Set the pseudo-time of the master side (the pose of a rigid obstacle)."""
+        """Set the pseudo-time of the master side (the pose of a rigid obstacle) and of the
+        initial overlap's ramp."""
         self.kinematics.set_time(t)
+        if self._remaining is not None:
+            self._remaining.value = max(0.0, 1.0 - t / self.pair.overlap_ramp)
+
+    @property
+    def master_two_sided(self) -> bool:
+        """Whether the master is a membrane (either side may face a slave point)."""
+        return not self.pair.on_obstacle and self.master.two_sided
+
+    @property
+    def initial_overlap(self) -> float:
+        """The largest overlap of the two surfaces in the reference configuration (a press
+        fit; 0 where they do not overlap), over all ranks (collective)."""
+        return float(self.V.mesh.comm.allreduce(self.overlap.max(initial=0.0), MPI.MAX))
 
     def update_history(self, T, x, block_slice) -> None:
         """Refresh the data that needs the chain operator (the slip reference)."""

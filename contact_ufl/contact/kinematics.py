@@ -28,7 +28,7 @@ import numpy as np
 import ufl
 
 from contact_ufl.contact.master import MeshMaster
-from contact_ufl.contact.projection import shape_functions
+from contact_ufl.contact.projection import Projection, shape_functions
 from contact_ufl.contact.search import ClosestPointSearch, Pairing
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.layout import StackedLayout
@@ -358,10 +358,10 @@ class MeshKinematics:
     def set_time(self, t: float) -> None:
         """Nothing: a meshed master moves with the displacement."""
 
-    def check_facing(self, description: str) -> None:
-        """Raise (on every rank) if no slave point faces the master surface (see
-        :meth:`.ClosestPointSearch.check_facing`)."""
-        self.search.check_facing(description)
+    def check_facing(self, description: str) -> Projection:
+        """Raise (on every rank) if no slave point faces the master surface; the closest
+        points of the reference configuration (see :meth:`.ClosestPointSearch.check_facing`)."""
+        return self.search.check_facing(description)
 
     def slip_reference(self) -> MeshSlipReference:
         """The slip reference of the Coulomb law on this master side."""

@@ -361,7 +361,10 @@ class ObstacleKinematics:
     def closest_points(self, x: np.ndarray) -> Projection:
         """The closest points of the points ``x`` ``(n, gdim)`` on the moved surface; points
         farther than the search radius, or with no unique closest point, are unpaired."""
-        nu, gap, valid = self.obstacle.closest(x, *self.pose)
+        return self._projection(x, *self.obstacle.closest(x, *self.pose))
+
+    def _projection(self, x: np.ndarray, nu, gap, valid) -> Projection:
+        """The closest points ``x + gap nu``, paired where ``valid`` within the radius."""
         paired = valid & (np.abs(gap) <= self.radius)
         n, fdim = len(x), self.gdim - 1
         return Projection(
@@ -390,13 +393,16 @@ class ObstacleKinematics:
         <contact_ufl.contact.kinematics.MeshKinematics.pattern_gathers>`)."""
         return []
 
-    def check_facing(self, description: str) -> None:
+    def check_facing(self, description: str) -> Projection:
         """Raise (on every rank) if no slave point faces the obstacle in the reference
-        configuration at its pose at t = 0: outside it, with opposed outward normals."""
+        configuration at its pose at t = 0: outside it, with opposed outward normals.
+
+        Returns the closest points there, paired where a slave point faces the obstacle
+        within the search radius, outside or inside it (an overlap is a positive gap)."""
         x = self.slave.X.reshape(-1, self.gdim)
         nu, gap, valid = self.obstacle.closest(x, *self.obstacle.pose(0.0, self.gdim))
         normals = np.repeat(self.slave.normals, self.slave.num_points, axis=0)
-        outside = gap <= 1e-8 * (1.0 + np.abs(gap))
+        outside = (gap <= 1e-8 * (1.0 + np.abs(gap))) | (np.abs(gap) <= self.radius)
         opposed = np.einsum("pd,pd->p", nu, normals) < 0.0
         if self.slave.membrane:  # either side of a membrane may face the obstacle
             opposed = True
@@ -407,6 +413,7 @@ class ObstacleKinematics:
             f"{description} never faces its obstacle: no slave point lies outside it with "
             "its outward normal towards it (wrong tag, or an obstacle on the wrong side?)",
         )
+        return self._projection(x, nu, gap, valid & opposed)
 
     def slip_reference(self) -> ObstacleSlipReference:
         """The slip reference of the Coulomb law on this master side."""

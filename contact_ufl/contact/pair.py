@@ -102,6 +102,14 @@ class ContactPair:
         nears 1 (the 3D Hertz with ``eps_N = E / h`` and a step's depth near a master
         element), and the next iterate crushes the master's facets; there ``"multiplier"``
         converges with full Newton steps to the same solution (see :doc:`/guide/robustness`).
+    overlap_ramp
+        Where the surfaces overlap in the reference configuration (a press fit, see
+        :attr:`ContactInterface.initial_overlap
+        <contact_ufl.contact.interface.ContactInterface.initial_overlap>`): ``None``
+        (default) resolves the whole overlap in the first load step; a pseudo-time ``t_r``
+        ramps it in linearly, the gap the laws see being ``g - (1 - t / t_r) g0`` until
+        ``t_r``, ``g0`` the initial overlap of each slave point (see
+        :doc:`/guide/contact`).
     """
 
     slave: int | str
@@ -118,6 +126,7 @@ class ContactPair:
     master_domain: int | str | None = None
     multiplier_degree: int | str = 1
     geometric_traction: str = "bracket"
+    overlap_ramp: float | None = None
     #: how messages name the slave and the master surface (set by the scene: the physical
     #: group's name and its tag, where the surface has a name)
     labels: tuple[str, str] = field(default=("", ""), repr=False, compare=False)
@@ -195,6 +204,8 @@ class ContactPair:
             check_positive(comm, eps_T=self.eps_T)
         if self.search_radius is not None:
             check_positive(comm, search_radius=self.search_radius)
+        if self.overlap_ramp is not None:
+            check_positive(comm, overlap_ramp=self.overlap_ramp)
         collective_check(
             comm,
             int(self.quadrature_subdivisions) >= 1,

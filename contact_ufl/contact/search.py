@@ -218,18 +218,24 @@ class ClosestPointSearch:
                                              self.master.nn, self.gdim)  # fmt: skip
         return self._candidates
 
-    def check_facing(self, description: str) -> None:
+    def check_facing(self, description: str) -> Projection:
         """Raise (on every rank) if no slave point faces the master surface in the reference
-        configuration; ``description`` names the pair in the message."""
+        configuration; ``description`` names the pair in the message.
+
+        Returns the closest points of the reference configuration, paired (``facet >= 0``)
+        where a slave point faces the master within the search radius, on either side of it
+        (an initial overlap is a positive gap)."""
         x = self.slave.X.reshape(-1, self.gdim)
         keys = self.master.keys.astype(np.int64)
         nodes, keys = self.exchange(self.master.X_nodes, x, keys)
         normals = np.repeat(self.slave.normals, self.slave.num_points, axis=0)
         rule = self._self_contact(keys, normals)
         proj = closest_points(x, nodes, np.inf, self_contact=rule)
-        # a slave point faces the master when it lies on the outer side of the master facet
-        # and the two outward normals oppose each other
+        # a slave point faces the master when it lies on the outer side of the master facet,
+        # or inside it within the search radius (a press fit), and the two outward normals
+        # oppose each other
         outside = np.einsum("pd,pd->p", proj.normal, x - proj.y) >= -1e-8 * (1 + proj.distance)
+        outside |= proj.distance <= self.radius
         opposed = np.einsum("pd,pd->p", proj.normal, normals) < 0.0
         if self.master.two_sided:  # a membrane master: either side may face the point
             outside = opposed = True
@@ -249,6 +255,9 @@ class ClosestPointSearch:
                 "outer side of the master facets (wrong tags or swapped bodies?)"
             )
         collective_check(self.comm, total > 0, message)
+        near = (proj.facet >= 0) & opposed & (proj.distance <= self.radius)
+        proj.facet = np.where(near, proj.facet, -1)
+        return proj
 
     def _self_contact(self, keys: np.ndarray, normals: np.ndarray) -> SelfContact | None:
         """The admissibility rule of a self-contact search (``None`` for other pairs): the
