@@ -50,7 +50,12 @@ from contact_ufl.loads import (
     FollowerPressure,
     RigidMotion,
 )
-from contact_ufl.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff
+from contact_ufl.materials import (
+    LinearElastic,
+    NearlyIncompressibleWarning,
+    NeoHookean,
+    SaintVenantKirchhoff,
+)
 from contact_ufl.membranes import (
     MembraneCompressibleNeoHookean,
     MembraneNeoHookean,
@@ -88,6 +93,7 @@ __all__ = [
     "MembraneNeoHookean",
     "MembraneSVK",
     "MeshData",
+    "NearlyIncompressibleWarning",
     "NeoHookean",
     "NewtonSolver",
     "NewtonTimings",

@@ -8,9 +8,31 @@ with the dimension ``d`` of ``F`` so that they equal the 3D energy in plane stra
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import ufl
+
+#: Poisson's ratio above which a solid is nearly incompressible (see :func:`lame_parameters`)
+NEARLY_INCOMPRESSIBLE = 0.45
+
+
+class NearlyIncompressibleWarning(UserWarning):
+    """A solid with Poisson's ratio near 1/2: displacement-only elements lock."""
+
+
+def warn_if_nearly_incompressible(nu: float) -> None:
+    """Warn for ``nu > NEARLY_INCOMPRESSIBLE``: the package's elements are displacement only
+    (no mixed pressure), which lock as ``nu -> 1/2``."""
+    if nu > NEARLY_INCOMPRESSIBLE:
+        warnings.warn(
+            f"Poisson's ratio nu = {nu} is nearly incompressible: displacement-only elements "
+            "lock (the body is too stiff and its pressure oscillates), P1 most; this package "
+            "has no mixed (u, p) formulation. Use degree=2 and check the answer on a finer "
+            "mesh, or a smaller nu where the body's compressibility does not matter",
+            NearlyIncompressibleWarning,
+            stacklevel=4,
+        )
 
 
 def lame_parameters(E: float, nu: float) -> tuple[float, float]:
@@ -41,6 +63,7 @@ class Hyperelastic:
 
     def __post_init__(self) -> None:
         lame_parameters(self.E, self.nu)
+        warn_if_nearly_incompressible(self.nu)
 
     @property
     def mu(self) -> float:

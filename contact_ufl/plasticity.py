@@ -36,7 +36,7 @@ from petsc4py import PETSc
 
 from contact_ufl import jit
 from contact_ufl.loads import deformation_gradient
-from contact_ufl.materials import lame_parameters
+from contact_ufl.materials import lame_parameters, warn_if_nearly_incompressible
 
 
 @dataclass(frozen=True)
@@ -60,6 +60,7 @@ class J2Plasticity:
 
     def __post_init__(self) -> None:
         lame_parameters(self.E, self.nu)
+        warn_if_nearly_incompressible(self.nu)
         if not self.yield_stress > 0.0:
             raise ValueError(f"the yield stress must be positive, got {self.yield_stress}")
         if not self.hardening >= 0.0:

@@ -14,7 +14,7 @@ from contact_ufl import mpi
 from contact_ufl.contact import ContactPair
 from contact_ufl.errors import ContactInputError, NonUniqueSolutionWarning
 from contact_ufl.loads import DeadTraction, Dirichlet
-from contact_ufl.materials import NeoHookean
+from contact_ufl.materials import NearlyIncompressibleWarning, NeoHookean
 from contact_ufl.mpi import CollectiveCallError
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Scene
@@ -82,6 +82,14 @@ def test_dirichlet_on_missing_tag(scene):
 def test_bad_material(E, nu, message):
     with pytest.raises(ValueError, match=message):
         NeoHookean(E, nu)
+
+
+def test_a_nearly_incompressible_solid_warns_of_locking():
+    with pytest.warns(NearlyIncompressibleWarning, match="nu = 0.499 is nearly incompressible"):
+        NeoHookean(1.0, 0.499)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        NeoHookean(1.0, 0.45)
 
 
 def test_higher_order_displacement_is_rejected(scene):
