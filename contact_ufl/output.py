@@ -1,7 +1,8 @@
-"""Output: VTX files for ParaView, and off-screen pictures with pyvista.
+"""Output: VTX files for ParaView, a time series of the contact surfaces that ParaView and
+pyvista open (``.pvd``), and off-screen pictures with pyvista.
 
-Every picture is written as a PNG file; inside a Jupyter (IPython) kernel it is also shown
-inline, by rank 0 only.
+Every picture is written as a PNG file by rank 0 only; inside a Jupyter (IPython) kernel it
+is also shown inline.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import os
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
+from xml.sax.saxutils import quoteattr
 
 import dolfinx
 import numpy as np
@@ -22,9 +24,12 @@ os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 
 class ResultWriter:
-    """Write the displacement and the multipliers of every load step to VTX (ADIOS2) files.
+    """Write the displacement and the multipliers of every load step to VTX (ADIOS2) files,
+    and the contact surfaces to ``.pvd`` time series (collective).
 
     Files are flushed at every step, so results already written survive a later failure.
+    ParaView opens both kinds; pyvista (and VTK without ADIOS2) reads only the ``.pvd``
+    series.
 
     Parameters
     ----------
@@ -35,9 +40,12 @@ class ResultWriter:
         per mesh ``k``), ``contact_<k>.bp`` (the multipliers of pair ``k``) and, for each
         elastoplastic body, ``plastic_strain_<tag>.bp`` (the cell means of its equivalent
         plastic strain) are written there.
+    contact_surfaces
+        Also write ``contact_surface_<k>.pvd`` for each pair ``k``: its slave points at
+        every step (:class:`ContactSurfaceWriter`).
     """
 
-    def __init__(self, problem, folder: str | Path):
+    def __init__(self, problem, folder: str | Path, contact_surfaces: bool = True):
         folder = Path(folder)
         if problem.comm.rank == 0:
             folder.mkdir(parents=True, exist_ok=True)
@@ -60,6 +68,10 @@ class ResultWriter:
         for tag, h in ((tag, h) for b in bulks for tag, h in b.histories.items()):
             path = folder / f"plastic_strain_{tag}.bp"
             self.writers.append(dolfinx.io.VTXWriter(comm, path, [h.plastic_strain]))
+        self.surfaces = [
+            ContactSurfaceWriter(problem, folder / f"contact_surface_{k}.pvd", k)
+            for k in range(len(problem.contacts) if contact_surfaces else 0)
+        ]
 
     def write(self, t: float) -> None:
         """Write the current state at pseudo-time ``t``."""
@@ -67,11 +79,89 @@ class ResultWriter:
             h.update_plastic_strain()
         for w in self.writers:
             w.write(t)
+        for w in self.surfaces:
+            w.write(t)
 
     def close(self) -> None:
         """Close the files."""
         for w in self.writers:
             w.close()
+        for w in self.surfaces:
+            w.close()
+
+    def __call__(self, problem, record) -> None:
+        """Use as the ``callback`` of :meth:`ContactProblem.solve`."""
+        self.write(record.t)
+
+
+class ContactSurfaceWriter:
+    """Write the slave surface of a contact pair at every load step as a ``.pvd`` time
+    series: one ``.vtu`` file a step, which ParaView and pyvista open (collective).
+
+    Each step's file holds the surface of :func:`gathered_contact_surface` (the slave
+    quadrature points at their current positions, joined facet by facet) with its point
+    data: ``lambda_N``, ``pressure``, ``gap`` (NaN where no master facet was found),
+    ``in_contact`` (1 or 0), ``t_N``, ``traction``, ``t_T``, the reference positions ``X``,
+    with friction ``stick`` (1 or 0) and, in 2D, ``arc_length`` and ``arc_length_current``
+    (see :class:`~contact_ufl.results.ContactSamples`). The points of all ranks are gathered
+    and rank 0 writes the files, once; the ``.pvd`` file is rewritten at every step, so it
+    lists the steps written so far.
+
+    Parameters
+    ----------
+    problem
+        The contact problem.
+    path
+        The ``.pvd`` file; the step files go into the folder of that name without its
+        suffix, beside it.
+    pair
+        The contact pair.
+
+    Examples
+    --------
+    Read it back with pyvista (``read()`` gives a one-block ``MultiBlock``)::
+
+        reader = pyvista.get_reader("output/contact_surface_0.pvd")
+        for t in reader.time_values:
+            reader.set_active_time_value(t)
+            surface = reader.read()[0]
+    """
+
+    def __init__(self, problem, path: str | Path, pair: int = 0):
+        if not 0 <= pair < len(problem.contacts):
+            raise ValueError(f"no contact pair {pair}: the problem has {len(problem.contacts)}")
+        self.problem, self.pair = problem, pair
+        self.path = Path(path).with_suffix(".pvd")
+        self.folder = self.path.with_suffix("")
+        self.steps: list[tuple[float, str]] = []
+        if problem.comm.rank == 0:
+            self.folder.mkdir(parents=True, exist_ok=True)
+        problem.comm.barrier()
+
+    def write(self, t: float) -> None:
+        """Write the current state of the surface at pseudo-time ``t`` (collective)."""
+        surface = gathered_contact_surface(self.problem, self.pair)
+        name = f"{self.folder.name}/step_{len(self.steps):05d}.vtu"
+        self.steps.append((float(t), name))
+        if surface is None:
+            return
+        pv = _pyvista()
+        pv.UnstructuredGrid(surface).save(self.path.parent / name)
+        entries = "".join(
+            f'    <DataSet timestep="{t!r}" part="0" file={quoteattr(file)}/>\n'
+            for t, file in self.steps
+        )
+        text = (
+            '<?xml version="1.0"?>\n<VTKFile type="Collection" version="1.0">\n'
+            f"  <Collection>\n{entries}  </Collection>\n</VTKFile>\n"
+        )
+        partial = self.path.with_name(self.path.name + ".part")
+        partial.write_text(text)
+        partial.replace(self.path)  # a reader never sees half a file
+
+    def close(self) -> None:
+        """Nothing to close: every file is complete once written (for symmetry with
+        :class:`ResultWriter`)."""
 
     def __call__(self, problem, record) -> None:
         """Use as the ``callback`` of :meth:`ContactProblem.solve`."""
@@ -175,16 +265,38 @@ def _direction(view: str | tuple[float, float, float]) -> tuple[float, ...]:
     return direction
 
 
+def _default_view(view: str | tuple[float, float, float] | None, gdim: int):
+    """The camera ``view``, or by default the plane view ``"xy"`` of a 2D scene and
+    ``"iso"`` for a 3D one; validated (:func:`_direction`)."""
+    if view is None:
+        view = "xy" if gdim == 2 else "iso"
+    _direction(view)
+    return view
+
+
 def _view(plotter, view: str | tuple[float, float, float]) -> None:
     """Camera: ``"iso"`` (3D view from the front, above and to the right), ``"xz"`` (the
-    x-z plane seen from -y: the plane of bending of the beams), ``"xy"`` (seen from +z),
-    or a direction ``(x, y, z)`` to look from (with +z up). The plane views are parallel
-    projections: the angles in that plane are true."""
-    up = (0.0, 1.0, 0.0) if view == "xy" else (0.0, 0.0, 1.0)
-    plotter.view_vector(_direction(view), viewup=up)
+    x-z plane seen from -y: the plane of bending of the beams), ``"xy"`` (seen from +z, the
+    plane of a 2D scene: pyvista's ``view_xy``), or a direction ``(x, y, z)`` to look from
+    (with +z up). The plane views are parallel projections: the angles in that plane are
+    true."""
+    if view == "xy":
+        plotter.view_xy()
+    else:
+        plotter.view_vector(_direction(view), viewup=(0.0, 0.0, 1.0))
     if view in ("xz", "xy"):
         plotter.enable_parallel_projection()
     plotter.reset_camera()
+
+
+def _focus(plotter, point) -> None:
+    """Move the camera so that it looks at ``point``, in the same direction (pyvista's
+    ``set_focus`` turns it instead, which tilts a plane view out of its plane)."""
+    camera = plotter.camera
+    shift = np.asarray(point, dtype=float) - np.asarray(camera.focal_point)
+    position = np.asarray(camera.position) + shift
+    camera.focal_point = tuple(np.asarray(camera.focal_point) + shift)
+    camera.position = tuple(position)
 
 
 def in_jupyter_kernel() -> bool:
@@ -225,10 +337,13 @@ def _screenshot(plotter, path: str | Path, title: str) -> None:
     _save(plotter, path)
 
 
-def plot_reference(problem, path: str | Path, view: str = "iso", title: str = "") -> None:
+def plot_reference(
+    problem, path: str | Path, view: str | tuple[float, float, float] | None = None, title: str = ""
+) -> None:
     """The reference configuration: the mesh of every body, coloured by body (collective;
-    rank 0 writes the picture)."""
-    _direction(view)  # bad input fails on every rank
+    rank 0 writes the picture). ``view``: the camera (see :func:`_view`); by default the
+    plane view ``"xy"`` of a 2D scene, ``"iso"`` in 3D."""
+    view = _default_view(view, problem.gdim)  # bad input fails on every rank
     grid = gathered_grid(problem, deformed=False)
     if grid is None:
         return
@@ -258,19 +373,29 @@ def gathered_contact_surface(problem, pair: int = 0) -> pyvista.PolyData | None:
     Its points are the slave quadrature points at their current positions; the
     quadrature points of each facet are joined into triangles (segments in 2D). Point
     data: ``"t_N"`` (the normal traction ``<lambda_N + eps_N g>``, 0 where open),
-    ``"traction"`` (the contact traction on the slave body, nominal) and ``"t_T"`` (its
-    tangential part, the frictional traction; 0 without friction). Collective.
+    ``"traction"`` (the contact traction on the slave body, nominal), ``"t_T"`` (its
+    tangential part, the frictional traction; 0 without friction), and the samples of
+    :func:`~contact_ufl.results.contact_samples`: ``"lambda_N"``, ``"pressure"``, ``"gap"``
+    (NaN where no master facet was found), ``"in_contact"`` (1 where in contact, else 0),
+    ``"X"`` (reference positions), with friction ``"stick"`` (1 or 0) and in 2D
+    ``"arc_length"`` and ``"arc_length_current"``. Collective.
     """
+    from contact_ufl.results import contact_samples
+
+    samples = contact_samples(problem, pair)
     c = problem.contacts[pair]
     gdim = c.gdim
     n = c.slave.X.shape[0] * c.slave.X.shape[1]
     x, t = np.zeros((n, 3)), np.zeros((n, 3))
     x[:, :gdim] = c.slave.positions(c.u).reshape(-1, gdim)
-    t_N = c.normal_traction_at_points()
-    t[:, :gdim] = c.traction_at_points()
+    t_N = np.zeros(n)
     t_T = t.copy()
-    t_T[:, :gdim] -= t_N[:, None] * c.projection.normal.reshape(-1, gdim)
-    t_T[t_N <= 0.0] = 0.0
+    if c.projection is not None:  # else not searched yet: no traction
+        t_N = c.normal_traction_at_points()
+        t[:, :gdim] = c.traction_at_points()
+        t_T = t.copy()
+        t_T[:, :gdim] -= t_N[:, None] * c.projection.normal.reshape(-1, gdim)
+        t_T[t_N <= 0.0] = 0.0
     parts = problem.comm.gather((x, t_N, t, t_T), root=0)
     if problem.comm.rank != 0:
         return None
@@ -285,7 +410,29 @@ def gathered_contact_surface(problem, pair: int = 0) -> pyvista.PolyData | None:
     surface.point_data["t_N"] = t_N
     surface.point_data["traction"] = t
     surface.point_data["t_T"] = t_T
+    for name, values in _sample_fields(samples).items():
+        surface.point_data[name] = values
     return surface
+
+
+def _sample_fields(samples) -> dict[str, np.ndarray]:
+    """The contact samples as point data of a VTK file: vectors with 3 components, flags as
+    0 or 1 (``uint8``), no infinite values (an unpaired point's gap is NaN)."""
+    X = np.zeros((len(samples.x), 3))
+    X[:, : samples.x.shape[1]] = samples.X
+    fields = {
+        "lambda_N": samples.lambda_N,
+        "pressure": samples.pressure,
+        "gap": np.where(np.isfinite(samples.gap), samples.gap, np.nan),
+        "in_contact": samples.in_contact.astype(np.uint8),
+        "X": X,
+    }
+    if samples.stick is not None:
+        fields["stick"] = samples.stick.astype(np.uint8)
+    if samples.arc_length is not None:
+        fields["arc_length"] = samples.arc_length
+        fields["arc_length_current"] = samples.arc_length_current
+    return fields
 
 
 def _arrows(
@@ -303,30 +450,34 @@ def _arrows(
 def plot_contact_state(
     problem,
     path: str | Path,
-    view: str | tuple[float, float, float] = "iso",
+    view: str | tuple[float, float, float] | None = None,
     title: str = "",
     scale: float = 0.08,
     saturate: float = 100.0,
     zoom: float = 1.0,
+    pair: int = 0,
 ) -> None:
-    """The deformed bodies and the contact state of the first pair (collective; rank 0
-    writes the picture).
+    """The deformed bodies and the contact state of a pair (collective; rank 0 writes the
+    picture).
 
     The bodies are drawn translucent; the slave surface is grey where open and coloured by
     the normal traction ``t_N`` (at a converged state the multiplier lambda_N) where in
-    contact. In the ``"xz"`` view (the surface seen edge-on) the slave points in contact
-    carry the contact tractions on the slave body as arrows coloured by ``t_N``. With
-    friction, the frictional tractions ``t_T`` are black arrows, in every view.
+    contact. In the ``"xz"`` view of a 3D scene and the ``"xy"`` view of a 2D one (the
+    surface seen edge-on) the slave points in contact carry the contact tractions on the
+    slave body as arrows coloured by ``t_N``. With friction, the frictional tractions
+    ``t_T`` are black arrows, in every view.
 
     Parameters
     ----------
     problem
         The contact problem, at a converged state.
     path, view, title
-        The PNG file, the camera (see :func:`_view`) and a title.
+        The PNG file, the camera (see :func:`_view`; by default the plane view ``"xy"`` of a
+        2D scene, ``"iso"`` in 3D) and a title.
     scale
         Length of the longest arrows (those at or above the saturation value), relative to
-        the scene's size; the frictional arrows are half as long.
+        the scene's size (in 2D, to the size shown: divided by ``zoom``); the frictional
+        arrows are half as long.
     saturate
         Percentile of the positive ``t_N`` taken as the top of the colour range (from 0):
         below 100, larger values (a peak at a corner) get the top colour, and the colour
@@ -334,12 +485,14 @@ def plot_contact_state(
         that percentile of the traction's, or the frictional traction's, magnitudes).
     zoom
         Camera zoom towards the part of the slave surface in contact.
+    pair
+        The contact pair.
     """
-    _direction(view)  # bad input fails on every rank, before the collective gathers
+    view = _default_view(view, problem.gdim)  # bad input fails on every rank, first
     if not 0.0 < saturate <= 100.0:
         raise ValueError(f"saturate is a percentile in (0, 100], got {saturate}")
     grid = gathered_grid(problem)
-    surface = gathered_contact_surface(problem)
+    surface = gathered_contact_surface(problem, pair)
     if grid is None:
         return
     pv = _pyvista()
@@ -347,7 +500,8 @@ def plot_contact_state(
     plotter.add_mesh(grid, color="lightgrey", show_edges=True, opacity=0.2)
     in_contact = surface["t_N"] > 0.0
     patch = surface.extract_points(in_contact, adjacent_cells=True)
-    plotter.add_mesh(surface, color="darkgrey")
+    lines = {"line_width": 4} if problem.gdim == 2 else {}  # a 2D surface is a curve
+    plotter.add_mesh(surface, color="darkgrey", **lines)
     contact = surface.extract_points(in_contact, adjacent_cells=False, include_cells=False)
     if contact.n_points == 0:
         _view(plotter, view)
@@ -363,35 +517,100 @@ def plot_contact_state(
         "scalar_bar_args": {"title": label},
     }
     if patch.n_cells:
-        plotter.add_mesh(patch, **colours)
+        plotter.add_mesh(patch, **colours, **lines)
     length = scale * float(np.linalg.norm(np.ptp(grid.points, axis=0)))
-    if view == "xz":
+    if problem.gdim == 2:
+        length /= zoom  # the 2D view zooms in the plane of the arrows: keep their size
+    if view == ("xy" if problem.gdim == 2 else "xz"):
         arrows = _arrows(contact, "traction", length, saturate)
         plotter.add_mesh(arrows, **(colours | {"show_scalar_bar": not patch.n_cells}))
         plotter.add_points(contact, render_points_as_spheres=True, point_size=8, **colours)
     if np.any(contact["t_T"]):
         plotter.add_mesh(_arrows(contact, "t_T", 0.5 * length, saturate), color="black")
     _view(plotter, view)
-    plotter.set_focus(contact.center)
+    _focus(plotter, contact.center)
     plotter.camera.zoom(zoom)
     _screenshot(plotter, path, title)
 
 
+_ALONG_LABELS = {
+    "x": "x",
+    "arc length": "arc length (reference)",
+    "current arc length": "arc length (current)",
+}
+
+
 def plot_pressure_profile(
-    x: np.ndarray,
-    pressure: np.ndarray,
-    path: str | Path,
+    x,
+    pressure=None,
+    path: str | Path | None = None,
     exact: tuple[np.ndarray, np.ndarray] | None = None,
     title: str = "contact pressure",
+    *,
+    along: str = "x",
+    span: tuple[float, float] | None = None,
+    exact_label: str = "Hertz",
+    comm: MPI.Comm | None = None,
 ) -> None:
-    """A line chart of the contact pressure along x, with an optional exact curve."""
+    """A chart of the contact pressure along the slave surface, with an optional exact
+    curve. Rank 0 writes the picture. Two forms:
+
+    ``plot_pressure_profile(samples, path, along="arc length")``
+        ``samples`` from :func:`~contact_ufl.results.contact_samples` (which gathers them,
+        the same on every rank: call this on every rank or on rank 0 only; rank 0 of
+        ``comm``, by default ``MPI.COMM_WORLD``, writes). The Cauchy pressure against
+        ``along``: ``"x"`` (the current x), ``"arc length"`` (along the reference slave
+        curve) or ``"current arc length"`` (along the deformed one; both 2D only: see
+        :class:`~contact_ufl.results.ContactSamples`); the points in contact in blue, the
+        open ones in grey. ``span`` bounds the abscissa (default: the contact zone widened
+        by half its length on either side, or all points if none is in contact).
+    ``plot_pressure_profile(x, pressure, path)``
+        Arrays (``along`` is then only the axis' name). Without ``comm`` they are plotted as
+        given and only rank 0 of ``MPI.COMM_WORLD`` writes (a call on rank 0 only, or on
+        every rank with the same arrays); with ``comm`` the call is collective and each
+        rank's arrays are its part of the profile, gathered to rank 0 of ``comm``.
+
+    ``exact`` is ``(abscissa, pressure)`` on the same abscissa, drawn as a line labelled
+    ``exact_label``.
+    """
+    from contact_ufl.results import ALONG, ContactSamples
+
+    if along not in ALONG:
+        raise ValueError(f"along must be one of {list(ALONG)}, got {along!r}")
+    if isinstance(x, ContactSamples):
+        if path is None:  # plot_pressure_profile(samples, path)
+            path, pressure = pressure, None
+        if pressure is not None or path is None:
+            raise TypeError("plot_pressure_profile(samples, path, ...): no pressure array")
+        samples = x
+        x, pressure = samples.abscissa(along), samples.pressure
+        touching, label = samples.in_contact, "in contact"
+        if span is None and touching.any():
+            low, high = x[touching].min(), x[touching].max()
+            span = (low - 0.5 * (high - low), high + 0.5 * (high - low))
+    else:
+        if path is None:
+            raise TypeError("plot_pressure_profile(x, pressure, path, ...): no path")
+        x, pressure = np.asarray(x, dtype=float), np.asarray(pressure, dtype=float)
+        if comm is not None:
+            x = np.concatenate(comm.gather(x, root=0) or [x])
+            pressure = np.concatenate(comm.gather(pressure, root=0) or [pressure])
+        touching, label = np.ones(len(x), dtype=bool), "lambda_N (FE)"
+    if (comm or MPI.COMM_WORLD).rank != 0:
+        return
+    shown = np.ones(len(x), dtype=bool) if span is None else (x >= span[0]) & (x <= span[1])
     pv = _pyvista()
-    order = np.argsort(x)
-    chart = pv.Chart2D(x_label="x", y_label="pressure")
+    chart = pv.Chart2D(x_label=_ALONG_LABELS[along], y_label="pressure")
     chart.title = title
-    chart.scatter(x[order], pressure[order], color="tab:blue", size=6, label="lambda_N (FE)")
+    for mask, colour, name in (
+        (shown & touching, "tab:blue", label),
+        (shown & ~touching, "darkgrey", "open"),
+    ):
+        if mask.any():
+            order = np.argsort(x[mask])
+            chart.scatter(x[mask][order], pressure[mask][order], color=colour, size=6, label=name)
     if exact is not None:
-        chart.line(*exact, color="tab:red", width=2.0, label="Hertz")
+        chart.line(*exact, color="tab:red", width=2.0, label=exact_label)
     plotter = pv.Plotter(off_screen=True, window_size=(900, 600))
     plotter.add_chart(chart)
     _save(plotter, path)
@@ -403,8 +622,13 @@ def plot_curves(
     x_label: str,
     y_label: str,
     title: str = "",
+    comm: MPI.Comm | None = None,
 ) -> None:
-    """A line chart of the ``curves`` (label: ``(x, y)``)."""
+    """A line chart of the ``curves`` (label: ``(x, y)``), written by rank 0 of ``comm``
+    (default ``MPI.COMM_WORLD``) only: call it on every rank with the same curves, or on
+    rank 0."""
+    if (comm or MPI.COMM_WORLD).rank != 0:
+        return
     pv = _pyvista()
     chart = pv.Chart2D(x_label=x_label, y_label=y_label)
     chart.title = title
@@ -425,12 +649,13 @@ def plot_deformed(
     label: str = "|u|",
 ) -> None:
     """The deformed bodies coloured by the displacement magnitude, or by the cellwise
-    (DG0) ``cell_field`` with the colour bar title ``label`` (2D: seen from +z)."""
-    if problem.comm.size > 1:
-        raise NotImplementedError("pictures are drawn from a serial run")
-    pv = _pyvista()
+    (DG0) ``cell_field`` with the colour bar title ``label`` (2D: the plane view ``"xy"``,
+    see :func:`_view`). Collective: the meshes of all ranks are gathered, rank 0 writes."""
     cells = {} if cell_field is None else {label: cell_field}
     grid = gathered_grid(problem, cell_data=cells)
+    if grid is None:
+        return
+    pv = _pyvista()
     plotter = pv.Plotter(off_screen=True, window_size=(1000, 700))
     plotter.add_mesh(
         grid,
@@ -440,9 +665,9 @@ def plot_deformed(
         scalar_bar_args={"title": label},
     )
     if problem.gdim == 2:
-        plotter.view_xy()
+        _view(plotter, "xy")
     if focus is not None:
-        plotter.set_focus(focus)
+        _focus(plotter, focus)
     plotter.camera.zoom(zoom)
     _save(plotter, path)
 

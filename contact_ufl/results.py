@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -13,10 +14,16 @@ from mpi4py import MPI
 
 from contact_ufl import jit, keysets
 
+#: The abscissae of a profile along the slave surface (:meth:`ContactSamples.abscissa`).
+ALONG = ("x", "arc length", "current arc length")
+
 
 @dataclass
 class ContactSamples:
     """Contact quantities at the slave quadrature points of all ranks.
+
+    The arrays hold the points of rank 0, then those of rank 1, ... (each rank's facet by
+    facet): :meth:`ordered` sorts them along the slave surface.
 
     Attributes
     ----------
@@ -28,30 +35,231 @@ class ContactSamples:
         Cauchy contact pressure (per unit current area): ``lambda_N dA / da``.
     gap
         Proximity g (> 0 penetration; -inf where no master facet was found).
+    in_contact
+        Whether the point is in contact: the formulation's active set, where the bracket of
+        the normal traction ``t_N = <lambda_N + eps_N g>`` is positive (within the
+        round-off band of the bracket, ``eps_N`` times ``1e-12`` of the surfaces' size;
+        False where no master facet was found). Open points next to a contact edge carry a
+        small multiplier of either sign (the tail of the continuous multiplier beyond the
+        edge), so ``lambda_N > 0`` is not a test of contact.
+    stick
+        (friction) Whether the point is in contact and sticks: its trial tangential traction
+        ``q = lambda_T + eps_T s_T`` (``s_T`` the slip increment of the step) lies in the
+        Coulomb disc, ``|q| <= mu t_N`` (within the round-off band ``eps_T`` times ``1e-12``
+        of the surfaces' size), the rule of the formulation's disc projection; the points
+        in contact that do not stick slip (:attr:`slip`). ``None`` without friction.
+    X
+        Reference positions ``(n, gdim)``.
+    arc_length
+        (2D) Distance from the start of the point's curve of the slave surface, along the
+        reference (undeformed) surface: along its straight facets (exact for a degree-1
+        geometry; through the vertices of a curved, degree-2 facet). ``None`` in 3D.
+    arc_length_current
+        (2D) The same along the current (deformed) surface: each facet's length is the
+        integral of ``da/dA`` over it; a point's place on its facet is its reference place,
+        scaled (exact for a degree-1 displacement, whose facets stay straight). ``None`` in
+        3D.
+    curve
+        (2D) Index of the connected curve of the slave surface the point is on, in the order
+        of their starting points. An open curve starts at its end of smallest x (of smallest
+        y where two have the same x), a closed one at its vertex of smallest x (then y) and
+        runs counter-clockwise. A curve with a branch (a vertex of more than two facets) has
+        index -1 and NaN arc lengths. ``None`` in 3D.
     """
 
     x: np.ndarray
     lambda_N: np.ndarray
     pressure: np.ndarray
     gap: np.ndarray
+    in_contact: np.ndarray | None = None
+    stick: np.ndarray | None = None
+    X: np.ndarray | None = None
+    arc_length: np.ndarray | None = None
+    arc_length_current: np.ndarray | None = None
+    curve: np.ndarray | None = None
+
+    @property
+    def slip(self) -> np.ndarray | None:
+        """(friction) Whether the point is in contact and slips (``None`` without friction)."""
+        if self.stick is None or self.in_contact is None:
+            return None
+        return self.in_contact & ~self.stick
+
+    def abscissa(self, along: str = "x") -> np.ndarray:
+        """The points' abscissa of a profile: ``"x"``, the first coordinate of the current
+        position; ``"arc length"``, :attr:`arc_length` (reference); ``"current arc
+        length"``, :attr:`arc_length_current`."""
+        if along not in ALONG:
+            raise ValueError(f"along must be one of {list(ALONG)}, got {along!r}")
+        if along == "x":
+            return self.x[:, 0]
+        values = self.arc_length if along == "arc length" else self.arc_length_current
+        if values is None:
+            raise ValueError(f"along={along!r} needs a 2D slave surface (a curve)")
+        return values
+
+    def order(self, along: str = "arc length") -> np.ndarray:
+        """The indices that sort the points along the surface: by curve, then arc length
+        (``along`` one of :data:`ALONG`; ``"x"``: by x)."""
+        s = self.abscissa(along)
+        if along == "x":
+            return np.argsort(s, kind="stable")
+        return np.lexsort((s, self.curve))
+
+    def ordered(self, along: str = "arc length") -> ContactSamples:
+        """These samples sorted along the surface (:meth:`order`)."""
+        index = self.order(along)
+        values = {
+            f.name: None if getattr(self, f.name) is None else getattr(self, f.name)[index]
+            for f in dataclasses.fields(self)
+        }
+        return ContactSamples(**values)
 
 
 def contact_samples(problem, pair: int = 0) -> ContactSamples:
-    """Gather the contact quantities of contact pair ``pair`` on every rank."""
+    """Gather the contact quantities of contact pair ``pair`` on every rank (collective).
+
+    The in-contact flag is the formulation's active set (``lambda_N + eps_N g > 0``), the
+    stick flag (friction) its Coulomb disc (``|lambda_T + eps_T s_T| <= mu t_N``); see
+    :class:`ContactSamples`. Call it after a solve (or in a step's callback): with friction,
+    the slip is then that of the converged step. Before the first contact search (before a
+    solve) no point has a master facet: every gap is ``-inf`` and every point open.
+    """
     c = problem.contacts[pair]
     comm = problem.comm
     gdim = c.gdim
     x = c.slave.positions(c.u).reshape(-1, gdim)
     lam = c.multiplier_at_points()
     ratio = c.slave.area_ratio(c.u).ravel()
-    gap = np.where(c.projection.facet >= 0, c.projection.gap, -np.inf)
+    if c.projection is None:  # not searched yet
+        gap, active = np.full(len(lam), -np.inf), np.zeros(len(lam), dtype=bool)
+        stick = active.copy() if c.friction else None
+    else:
+        gap = np.where(c.projection.facet >= 0, c.projection.gap, -np.inf)
+        active = c.active()
+        stick = c.stick() if c.friction else None
 
     def gather(a):
         return np.concatenate(comm.allgather(a))
 
+    arcs = _arc_lengths(c, comm, ratio)
     return ContactSamples(
-        gather(x).reshape(-1, gdim), gather(lam), gather(lam / ratio), gather(gap)
+        gather(x).reshape(-1, gdim),
+        gather(lam),
+        gather(lam / ratio),
+        gather(gap),
+        in_contact=gather(active),
+        stick=None if stick is None else gather(stick),
+        X=gather(c.slave.X.reshape(-1, gdim)).reshape(-1, gdim),
+        arc_length=arcs[0],
+        arc_length_current=arcs[1],
+        curve=arcs[2],
     )
+
+
+def _arc_lengths(c, comm, ratio: np.ndarray) -> tuple[np.ndarray | None, ...]:
+    """The reference and current arc lengths and the curve index of the slave points of all
+    ranks (order of :func:`contact_samples`), or three ``None`` if the slave surface is not
+    a curve. Collective.
+
+    The facets are chained through their vertices' input (mesh file) indices, which are
+    the same on any number of ranks; a point's place on its facet is the projection of its
+    reference position onto the facet's chord.
+    """
+    slave = c.slave
+    if slave.submesh.topology.dim != 1:
+        return None, None, None
+    gdim = c.gdim
+    mesh = slave.V.mesh
+    nc, nq = slave.num_cells, slave.num_points
+    keys = slave.vertex_keys[:, :2]
+    inputs = mesh.geometry.input_global_indices
+    by_input = np.argsort(inputs)
+    nodes = by_input[np.searchsorted(inputs, keys.ravel(), sorter=by_input)]
+    ends = mesh.geometry.x[nodes, :gdim].reshape(nc, 2, gdim)
+    chord = ends[:, 1] - ends[:, 0]
+    length = np.linalg.norm(chord, axis=1)
+    X = slave.X.reshape(nc, nq, gdim)
+    place = np.einsum("cqd,cd->cq", X - ends[:, None, 0], chord) / length[:, None] ** 2
+    current = (slave.point_weights * ratio).reshape(nc, nq).sum(axis=1)
+    parts = comm.allgather((keys, ends, length, current, place))
+    keys, ends, length, current, place = (np.concatenate([p[k] for p in parts]) for k in range(5))
+    return _walk_curves(keys, ends, length, current, place)
+
+
+def _walk_curves(
+    keys: np.ndarray,
+    ends: np.ndarray,
+    length: np.ndarray,
+    current: np.ndarray,
+    place: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Chain the segments (vertex ``keys`` ``(F, 2)`` at ``ends`` ``(F, 2, gdim)``, reference
+    and current lengths, the places ``(F, nq)`` of their points from the first end, in
+    [0, 1]) into curves; the points' reference and current arc lengths and curve indices
+    (the rules of :class:`ContactSamples`), flattened facet by facet."""
+    from scipy.sparse import coo_array
+    from scipy.sparse.csgraph import connected_components
+
+    nf, nq = place.shape
+    vertices, edges = np.unique(keys.ravel(), return_inverse=True)
+    edges = edges.reshape(nf, 2)
+    coords = np.zeros((len(vertices), ends.shape[2]))
+    coords[edges.ravel()] = ends.reshape(-1, ends.shape[2])
+    degree = np.bincount(edges.ravel(), minlength=len(vertices))
+    graph = coo_array((np.ones(nf), (edges[:, 0], edges[:, 1])), shape=(len(vertices),) * 2)
+    _, component = connected_components(graph, directed=False)
+    incident: dict[int, list[int]] = {}
+    for f, (a, b) in enumerate(edges):
+        incident.setdefault(int(a), []).append(f)
+        incident.setdefault(int(b), []).append(f)
+
+    s_ref = np.full((nf, nq), np.nan)
+    s_cur = np.full((nf, nq), np.nan)
+    curve = np.full((nf, nq), -1, dtype=np.int64)
+    starts = []
+    for k in np.unique(component[edges[:, 0]]):
+        members = np.flatnonzero(component == k)
+        if degree[members].max() > 2:
+            continue  # a branch: no arc length
+        ends_ = members[degree[members] == 1]
+        candidates = ends_ if len(ends_) else members
+        start = candidates[np.lexsort(coords[candidates].T[::-1])[0]]
+        chain = _chain(int(start), edges, incident)
+        if not len(ends_) and _signed_area(coords, edges, chain) < 0.0:
+            chain = [(f, not forward) for f, forward in reversed(chain)]
+        starts.append((coords[start], chain))
+    starts.sort(key=lambda item: tuple(item[0]))
+    for index, (_, chain) in enumerate(starts):
+        facets = np.array([f for f, _ in chain])
+        forward = np.array([fw for _, fw in chain])
+        along = np.where(forward[:, None], place[facets], 1.0 - place[facets])
+        for s, lengths in ((s_ref, length), (s_cur, current)):
+            before = np.concatenate([[0.0], np.cumsum(lengths[facets])[:-1]])
+            s[facets] = before[:, None] + along * lengths[facets, None]
+        curve[facets] = index
+    return s_ref.ravel(), s_cur.ravel(), curve.ravel()
+
+
+def _chain(start: int, edges: np.ndarray, incident: dict[int, list[int]]) -> list[tuple]:
+    """The facets of a curve in order from the vertex ``start``: ``(facet, forward)``,
+    ``forward`` when the facet runs from its first end to its second."""
+    chain, vertex, previous = [], start, -1
+    while True:
+        following = [f for f in incident[vertex] if f != previous]
+        if not following or (chain and following[0] == chain[0][0]):
+            return chain  # the other end of an open curve, or back at the start
+        f = following[0]
+        forward = edges[f, 0] == vertex
+        chain.append((f, bool(forward)))
+        vertex, previous = int(edges[f, 1] if forward else edges[f, 0]), f
+
+
+def _signed_area(coords: np.ndarray, edges: np.ndarray, chain: list[tuple]) -> float:
+    """Twice the signed area enclosed by the closed chain (> 0: counter-clockwise)."""
+    first = np.array([edges[f, 0] if fw else edges[f, 1] for f, fw in chain])
+    p, q = coords[first], coords[np.roll(first, -1)]
+    return float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
 
 
 def slave_body(problem, pair: int = 0):
