@@ -472,21 +472,25 @@ def section_motion(problem, tag: int | str) -> tuple[np.ndarray, np.ndarray]:
 
 def equilibrium_error(problem, supports: list[str | int], obstacles: Sequence = ()) -> float:
     """Global equilibrium: ``|sum of support and obstacle reactions + resultant of the
-    loads|``, relative to the loads' resultant. The contact forces between bodies are
-    internal to the scene and cancel.
+    loads|``, relative to the scene's force scale, the largest of the loads' resultant and
+    each support's and obstacle's reaction (a scene driven by prescribed displacements alone
+    has no load). The contact forces between bodies are internal to the scene and cancel.
 
     ``supports`` are facet tags (or the names of their physical groups) that carry all
     prescribed displacements; ``obstacles`` the rigid obstacles of the scene's pairs (their
     reactions, :meth:`~contact_ufl.problem.ContactProblem.obstacle_reaction`, count like the
-    supports').
+    supports'). Collective.
     """
     # reaction() is the residual without the prescribed-displacement equations on the
     # support dofs, internal minus external forces: the force of the support on the body
     # (all supports at once: a node on two of them, a corner, counts once)
     reactions = problem.reaction(list(supports))
-    reactions = reactions + sum(problem.obstacle_reaction(o) for o in obstacles)
+    parts = [problem.reaction(tag) for tag in supports]
+    parts += [problem.obstacle_reaction(o) for o in obstacles]
+    reactions = reactions + sum(parts[len(supports) :], np.zeros(problem.gdim))
     load = problem.load_resultant()
-    return float(np.linalg.norm(load + reactions) / np.linalg.norm(load))
+    scale = max(np.linalg.norm(f) for f in [load, *parts])
+    return float(np.linalg.norm(load + reactions) / scale) if scale > 0.0 else 0.0
 
 
 @dataclass

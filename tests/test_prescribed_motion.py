@@ -13,6 +13,7 @@ from contact_ufl.errors import ContactInputError
 from contact_ufl.loads import DeadForce, Dirichlet, RigidMotion
 from contact_ufl.materials import LinearElastic, NeoHookean
 from contact_ufl.problem import ContactProblem
+from contact_ufl.results import equilibrium_error
 from contact_ufl.scene import Body, Scene
 
 pytestmark = pytest.mark.serial  # no contact, no parallel path of its own
@@ -51,6 +52,18 @@ def test_a_homogeneous_shear_prescribed_on_the_boundary_is_the_solution(verifica
         "closed form (uniform deformation gradient)",
     )
     assert error < 1e-10
+    # no load: the supports' reactions balance each other (relative to the largest)
+    balance = equilibrium_error(problem, SIDES)
+    verification(
+        "unit square, Neo-Hookean, simple shear gamma = 0.4 on the boundary",
+        "|sum of the reactions| over the largest",
+        balance,
+        0.0,
+        "< 1e-10",
+        "equilibrium of the converged solve",
+        kind="consistency",
+    )
+    assert balance < 1e-10
 
 
 def test_a_rigid_rotation_of_the_boundary_turns_the_body_unstressed(verification):
