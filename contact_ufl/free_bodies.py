@@ -199,9 +199,12 @@ def pairs_on(problem: ContactProblem, piece: Piece) -> list[int]:
     return [k for k, c in enumerate(problem.contacts) if any(_sides_on(problem, piece, c.pair))]
 
 
-def unheld_modes(problem: ContactProblem, piece: Piece, on: list[int]) -> np.ndarray:
-    """The free modes of ``piece`` that its frictionless contact pairs ``on`` do not hold,
-    as orthonormal coefficients ``(k, m)`` like :attr:`Piece.modes` (collective).
+def unheld_modes(
+    problem: ContactProblem, piece: Piece, on: list[int], modes: np.ndarray | None = None
+) -> np.ndarray:
+    """The free ``modes`` of ``piece`` (default: :attr:`Piece.modes`) that its frictionless
+    contact pairs ``on`` do not hold, as orthonormal coefficients ``(k, m)`` like
+    :attr:`Piece.modes` (collective).
 
     A frictionless contact pushes only along the master normal, so it holds a rigid mode
     only where the mode moves a point near contact along that normal. Near contact means
@@ -213,30 +216,31 @@ def unheld_modes(problem: ContactProblem, piece: Piece, on: list[int]) -> np.nda
     piece (self-contact) holds none: a rigid motion moves both alike.
     """
     comm = problem.comm
-    if not len(piece.modes):
-        return piece.modes
-    gram = np.zeros((len(piece.modes),) * 2)
+    modes = piece.modes if modes is None else modes
+    if not len(modes):
+        return modes
+    gram = np.zeros((len(modes),) * 2)
     points = 0
     for k in on:
         c = problem.contacts[k]
         if c.friction is not None:
-            return piece.modes[:0]
+            return modes[:0]
         if all(_sides_on(problem, piece, c.pair)):
             continue
         p = c.reference
         paired = p.facet >= 0
         nearest = comm.allreduce(p.distance[paired].min(initial=np.inf), MPI.MIN)
         near = paired & (p.distance <= nearest + c.slave.facet_size)
-        modes = rigid_modes(p.y[near], piece.centre, max(piece.size, 1e-300))
-        values = np.einsum("ni,nim->nm", p.normal[near], modes) @ piece.modes.T
+        at = rigid_modes(p.y[near], piece.centre, max(piece.size, 1e-300))
+        values = np.einsum("ni,nim->nm", p.normal[near], at) @ modes.T
         gram += values.T @ values
         points += int(near.sum())
     gram = comm.allreduce(gram, MPI.SUM)
     points = comm.allreduce(points, MPI.SUM)
     if points == 0:
-        return piece.modes[:0]  # nothing near contact to judge by: the first step will tell
+        return modes[:0]  # nothing near contact to judge by: the first step will tell
     values, vectors = np.linalg.eigh(gram / points)
-    return vectors[:, values < 1e-6].T @ piece.modes
+    return vectors[:, values < 1e-6].T @ modes
 
 
 def describe_mode(piece: Piece, mode: np.ndarray) -> str:

@@ -361,23 +361,27 @@ class ContactProblem:
         """Refuse a body that nothing holds (no support, no contact pair), and warn of one
         whose free rigid modes only a frictionless contact could hold but whose contact
         normals near contact do not (:mod:`contact_ufl.free_bodies`): its solution is not
-        unique along them (collective)."""
-        loose = [
-            (piece, free_bodies.pairs_on(self, piece))
-            for piece in free_bodies.pieces(self)
-            if len(piece.modes)
-        ]
-        for piece, on in loose:
-            modes = "; ".join(free_bodies.describe_mode(piece, m) for m in piece.modes)
+        unique along them (collective). A membrane's tension holds what its supports
+        leave free to first order (a string turning about a point of its chord), so only
+        its translations along directions no support holds count."""
+        loose = []
+        for piece in free_bodies.pieces(self):
+            modes = piece.modes
+            if self.bulks[piece.mesh].membrane:
+                modes = np.eye(modes.shape[1])[: self.gdim][piece.free]
+            if len(modes):
+                loose.append((piece, modes, free_bodies.pairs_on(self, piece)))
+        for piece, modes, on in loose:
+            words = "; ".join(free_bodies.describe_mode(piece, m) for m in modes)
             collective_check(
                 self.comm,
                 bool(on),
                 f"the body {' + '.join(piece.bodies)} is held by no support and no contact "
-                f"pair: nothing holds its rigid motion ({modes}), so the problem has no unique "
+                f"pair: nothing holds its rigid motion ({words}), so the problem has no unique "
                 "solution; add a Dirichlet support (or a contact pair) on it",
             )
-        for piece, on in [(piece, on) for piece, on in loose if on]:
-            unheld = free_bodies.unheld_modes(self, piece, on)
+        for piece, modes, on in [item for item in loose if item[2]]:
+            unheld = free_bodies.unheld_modes(self, piece, on, modes)
             if not len(unheld):
                 continue
             modes = "; ".join(free_bodies.describe_mode(piece, m) for m in unheld)
