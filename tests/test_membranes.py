@@ -7,7 +7,8 @@ pressure, on symmetry models with supports normal to the symmetry planes: a sphe
 (quadrilaterals), and a quarter ring of string in 2D (intervals, plane strain per unit
 depth: the same closed form as the tube). The stretch is the mean current radius of the
 nodes over ``R`` (the nodes start on the circle or sphere). P1 facets make the model stiffer
-than the smooth shell by ``O(h^2)``: the error falls fourfold per halving of ``h``.
+than the smooth shell by ``O(h^2)``: the error falls fourfold per halving of ``h``; on the
+finest meshes the pressure is within 0.2% of the closed form (measured 0.08% to 0.14%).
 """
 
 from __future__ import annotations
@@ -30,7 +31,15 @@ from contact_ufl.verification import membrane_meshes as meshes
 
 R, T0, MU = 1.0, 0.01, 1.0
 E_SVK, NU_SVK = 1.0, 0.3
-REL_TOL = 0.005
+#: the largest relative error of the inflation pressure against its closed form on the
+#: finest mesh of each test (measured 0.08% to 0.14%)
+REL_TOL = 2e-3
+#: a closed form of the kinematics, to round-off (measured at most 1.2e-15 on 1 or 2 ranks:
+#: the sums over the cells change with the partition)
+ROUND_OFF = 1e-14
+INFLATION = "closed form of the homogeneous inflation, p = W'(l) / (R l^2) (sphere)"
+TUBE = "closed form of the homogeneous inflation, p = W'(l) / (R l) (tube at axial stretch 1)"
+TAYLOR = "Taylor's theorem: the remainder of an exact derivative is O(h^2)"
 #: fractions of the incompressible Neo-Hookean sphere's pressure maximum (at l = 7^(1/6))
 SPHERE_P_MAX = float(analytic.sphere_inflation_neo_hookean(MU, T0, R, 7.0 ** (1.0 / 6.0)))
 SPHERE_STEPS = SPHERE_P_MAX * np.array([0.25, 0.5, 0.7, 0.85, 0.93, 0.97, 0.99])
@@ -261,7 +270,7 @@ def integral(mesh, expr) -> float:
 
 
 @pytest.mark.parametrize("name", list(BUILDERS))
-def test_homogeneous_kinematics(name):
+def test_homogeneous_kinematics(name, verification):
     """A dilation ``x = l X`` stretches every flat cell by ``l`` in the plane: ``J_s = l^2``
     (``l`` for a string), ``tr C_s = 2 l^2`` (``l^2``), ``n = n0``, and the incompressible
     thickness stretch ``1/J_s``. A rigid rotation ``Q`` leaves ``J_s = 1``, turns the normal
@@ -272,26 +281,37 @@ def test_homogeneous_kinematics(name):
     V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (gdim,)))
     u = dolfinx.fem.Function(V)
     area = integral(mesh, 1.0)
+
+    def mean(expr) -> float:
+        return integral(mesh, expr) / area
+
     l = 1.3
     u.interpolate(lambda X: (l - 1.0) * X[:gdim])
-    assert integral(mesh, mb.area_stretch(u, n0)) / area == pytest.approx(l**tdim, rel=1e-12)
-    trace = integral(mesh, ufl.tr(mb.membrane_cauchy_green(u, n0))) / area
-    assert trace == pytest.approx(tdim * l**2, rel=1e-12)
     n = mb.current_normal(u, n0)
-    assert integral(mesh, ufl.dot(n - n0, n - n0)) < 1e-24
-    l3 = integral(mesh, NH.thickness_stretch(u, n0)) / area
-    assert l3 == pytest.approx(l**-tdim, rel=1e-12)
+    errors = {
+        "mean J_s / l^d - 1, dilation": mean(mb.area_stretch(u, n0)) / l**tdim - 1.0,
+        "mean tr C_s / (d l^2) - 1, dilation": mean(ufl.tr(mb.membrane_cauchy_green(u, n0)))
+        / (tdim * l**2)
+        - 1.0,
+        "mean thickness stretch * l^d - 1, dilation": mean(NH.thickness_stretch(u, n0)) * l**tdim
+        - 1.0,
+        "RMS |n - n0|, dilation": np.sqrt(mean(ufl.dot(n - n0, n - n0))),
+    }
     c, s = np.cos(0.7), np.sin(0.7)
     Q = np.array([[c, -s], [s, c]]) if gdim == 2 else np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
     u.interpolate(lambda X: Q @ X[:gdim] - X[:gdim])
-    assert integral(mesh, mb.area_stretch(u, n0)) / area == pytest.approx(1.0, rel=1e-12)
-    Qn0 = ufl.dot(ufl.as_matrix(Q.tolist()), n0)
-    assert (
-        integral(mesh, ufl.dot(mb.current_normal(u, n0) - Qn0, mb.current_normal(u, n0) - Qn0))
-        < 1e-24
+    turned = mb.current_normal(u, n0) - ufl.dot(ufl.as_matrix(Q.tolist()), n0)
+    errors["mean J_s - 1, rotation"] = mean(mb.area_stretch(u, n0)) - 1.0
+    errors["RMS |n - Q n0|, rotation"] = np.sqrt(mean(ufl.dot(turned, turned)))
+    errors["|energy| / (E t0 A), rotation, any law"] = max(
+        abs(mean(law.strain_energy(u, n0))) / (law.E * T0) for law in (NH, SVK, CNH)
     )
-    for law in (NH, SVK, CNH):
-        assert abs(integral(mesh, law.strain_energy(u, n0))) < 1e-14 * law.E * T0 * area
+    case = f"membrane kinematics, {name}"
+    source = "the kinematics of a homogeneous dilation x = l X and of a rigid rotation"
+    for quantity, error in errors.items():
+        verification(case, quantity, abs(error), 0.0, ROUND_OFF, source)
+    for quantity, error in errors.items():
+        assert abs(error) < ROUND_OFF, quantity
 
 
 def _residual_at(r_form, u, w, h):
@@ -304,7 +324,7 @@ def _residual_at(r_form, u, w, h):
     return b
 
 
-def test_tangent_is_consistent():
+def test_tangent_is_consistent(verification):
     """The Jacobian (``ufl.derivative``, with the pressure's load stiffness) is the derivative
     of the residual: ``|r(u + h w) - r(u) - h K w|`` falls as ``h^2`` (Taylor), on reversed
     cells of a sphere octant, for each law."""
@@ -334,17 +354,37 @@ def test_tangent_is_consistent():
             rh.axpy(-h, Kw)
             remainders.append(rh.norm())
         rates = np.log2(np.array(remainders[:-1]) / remainders[1:])
-        assert np.all(rates > 1.9), (type(law).__name__, remainders)
+        case = f"membrane tangent, sphere octant, {type(law).__name__}, follower pressure"
+        quantity = "slopes of the Taylor remainder |r(u + h w) - r(u) - h K w|"
+        verification(case, quantity, rates, 2.0, "|slope - 2| < 0.01", TAYLOR)
+        assert np.all(np.abs(rates - 2.0) < 0.01), (type(law).__name__, remainders)
 
 
 # -- free inflation ----------------------------------------------------------------------------
 
 
-def test_sphere_inflation_neo_hookean():
+def record_inflation(verification, case, errors, tolerance, source=INFLATION) -> None:
+    """Record the largest relative pressure error of an inflation against its closed form."""
+    quantity = "largest |p / p_exact(l) - 1| over the steps"
+    verification(case, quantity, float(np.max(errors)), 0.0, tolerance, source)
+
+
+def record_convergence(verification, case, worst, bound, source=INFLATION) -> None:
+    """Record the ratios of the errors of successive meshes (4 for O(h^2))."""
+    ratios = np.array(worst[:-1]) / np.array(worst[1:])
+    quantity = "ratio of the largest errors per halving of h"
+    verification(case, quantity, ratios, 4.0, f"> {bound}", source)
+
+
+def test_sphere_inflation_neo_hookean(verification):
     """Incompressible Neo-Hookean sphere octant up to 99% of the pressure maximum: the
-    pressure against the stretch within 0.5% of ``2 mu t0/R (1/l - 1/l^7)``, the error falling
-    about fourfold per halving of the mesh size (O(h^2): the flat P1 facets)."""
+    pressure against the stretch within 0.2% of ``2 mu t0/R (1/l - 1/l^7)`` on 32 cells per
+    quarter arc (measured 0.14%), the error falling about fourfold per halving of the mesh
+    size (O(h^2): the flat P1 facets)."""
     worst = [sphere_errors(n, NH, nh_sphere, SPHERE_STEPS).max() for n in (8, 16, 32)]
+    case = "free inflation, Neo-Hookean sphere octant, to 99% of the pressure maximum"
+    record_inflation(verification, f"{case}, 32 cells per arc", worst[-1], REL_TOL)
+    record_convergence(verification, f"{case}, 8, 16, 32 cells per arc", worst, 3.5)
     assert worst[-1] < REL_TOL
     assert worst[0] / worst[1] > 3.5 and worst[1] / worst[2] > 3.5, worst
 
@@ -352,35 +392,48 @@ def test_sphere_inflation_neo_hookean():
 @pytest.mark.parametrize(
     "law, closed_form", [(SVK, svk_sphere), (CNH, cnh_sphere)], ids=["svk", "compressible_nh"]
 )
-def test_sphere_inflation_compressible(law, closed_form):
-    """The compressible laws with the thickness condensed, to stretch 1.4 (SVK 1.3)."""
+def test_sphere_inflation_compressible(law, closed_form, verification):
+    """The compressible laws with the thickness condensed, to stretch 1.4 (SVK 1.3), 32
+    cells per quarter arc."""
     top = 1.3 if law is SVK else 1.4
     pressures = closed_form(np.linspace(1.0, top, 5)[1:])
-    assert sphere_errors(32, law, closed_form, pressures).max() < REL_TOL
+    errors = sphere_errors(32, law, closed_form, pressures)
+    case = f"free inflation, {type(law).__name__} sphere octant, 32 cells per arc"
+    record_inflation(verification, case, errors, REL_TOL)
+    assert errors.max() < REL_TOL
 
 
-def test_tube_inflation():
+def test_tube_inflation(verification):
     """A quarter tube of quadrilaterals at axial stretch 1, Neo-Hookean to hoop stretch 2:
-    ``p = mu t0/R (1 - l^-4)`` within 0.5%, the error falling fourfold per halving; SVK on
-    triangles, ``p = t0 E (l^2 - 1) / (2 (1 - nu^2) R)``."""
+    ``p = mu t0/R (1 - l^-4)`` within 0.2% on 16 cells per quarter (measured 0.12%), the
+    error falling fourfold per halving; SVK on triangles, ``p = t0 E (l^2 - 1) / (2 (1 -
+    nu^2) R)``."""
     pressures = nh_tube(np.array([1.1, 1.3, 1.6, 2.0]))
     worst = [tube_errors(n, NH, nh_tube, pressures).max() for n in (8, 16)]
+    case = "free inflation, Neo-Hookean quarter tube (quadrilaterals), to hoop stretch 2"
+    record_inflation(verification, f"{case}, 16 cells per quarter", worst[-1], REL_TOL, TUBE)
+    record_convergence(verification, f"{case}, 8 and 16 cells per quarter", worst, 3.9, TUBE)
     assert worst[-1] < REL_TOL and worst[0] / worst[1] > 3.9, worst
     svk = tube_errors(16, SVK, svk_tube, svk_tube(np.array([1.1, 1.2, 1.3])), cell="triangle")
+    case = "free inflation, MembraneSVK quarter tube (triangles), 16 cells per quarter"
+    record_inflation(verification, case, svk, REL_TOL, TUBE)
     assert svk.max() < REL_TOL
 
 
 @pytest.mark.parametrize(
     "law, closed_form", [(NH, nh_tube), (CNH, cnh_tube)], ids=["nh", "compressible_nh"]
 )
-def test_string_ring_inflation(law, closed_form):
-    """A quarter ring of string in 2D (plane strain, per unit depth) follows the tube's
-    closed form to hoop stretch 2."""
+def test_string_ring_inflation(law, closed_form, verification):
+    """A quarter ring of string in 2D (plane strain, per unit depth, 16 cells) follows the
+    tube's closed form to hoop stretch 2."""
     pressures = closed_form(np.array([1.1, 1.3, 1.6, 2.0]))
-    assert ring_errors(16, law, closed_form, pressures, reverse=True).max() < REL_TOL
+    errors = ring_errors(16, law, closed_form, pressures, reverse=True)
+    case = f"free inflation, {type(law).__name__} quarter string ring, 16 cells"
+    record_inflation(verification, case, errors, REL_TOL, TUBE)
+    assert errors.max() < REL_TOL
 
 
-def test_inflation_independent_of_vertex_order():
+def test_inflation_independent_of_vertex_order(verification):
     """Reversing every other cell changes nothing: the same stretches to round-off."""
     axes = {k: _on_plane(k) for k in range(3)}
     stretches = [
@@ -388,4 +441,9 @@ def test_inflation_independent_of_vertex_order():
         for reverse in (False, True)
     ]
     assert np.all(stretches[0] > 1.0)
-    np.testing.assert_allclose(stretches[1], stretches[0], rtol=1e-12)
+    change = np.abs(stretches[1] / stretches[0] - 1.0).max()
+    case = "free inflation, Neo-Hookean sphere octant, 8 cells per arc"
+    quantity = "largest |l_reversed / l - 1|, every other cell reversed"
+    source = "the oriented normal: the same problem whatever the vertex order"
+    verification(case, quantity, change, 0.0, ROUND_OFF, source, kind="consistency")
+    assert change < ROUND_OFF
