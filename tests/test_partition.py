@@ -1,4 +1,4 @@
-"""The partition of a multi-body mesh: every body split over all the ranks (issue 12, item 5)."""
+"""The partition of a multi-body mesh: every body split over all the ranks."""
 
 from pathlib import Path
 
@@ -7,6 +7,7 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 import scipy.sparse
+from conftest import across_ranks
 from mpi4py import MPI
 
 from contact_ufl import gmshio
@@ -170,42 +171,78 @@ def test_unknown_partition_is_refused(monkeypatch):
         patch(2, PRESSURE)
 
 
-def solve(monkeypatch, partition: str) -> ContactProblem:
+#: The bound of the answers on all ranks (both partitions) against one rank's, relative:
+#: solved to TIGHT, they differ by the round-off of factorisations of other orderings
+#: (measured 9.0e-15 on the patch, 4.4e-15 on Hertz 3D, on 2 ranks).
+TOL_RANKS = 5e-14
+
+
+def summary(problem: ContactProblem) -> npt.NDArray[np.float64]:
+    """The contact force, the multiplier's extremes and the displacement norm (the same on
+    every rank; a rank may own no multiplier)."""
+    comm = problem.comm
+    lam = problem.contacts[0].lambda_N.x.array
+    low, high = np.min(lam, initial=np.inf), np.max(lam, initial=-np.inf)
+    u = problem.bulks[0].u.x.petsc_vec.norm()
+    extremes = comm.allreduce(low, MPI.MIN), comm.allreduce(high, MPI.MAX)
+    return np.array([*problem.contact_force(), *extremes, u])
+
+
+def record_partitions(verification, case, partitions, alone) -> float:
+    """Record the largest difference of the :func:`summary` of the runs on all ranks (each
+    partition) from the run on one rank: the force over its norm, the others relative.
+    Returns it."""
+    dim = len(alone) - 3
+    force = np.linalg.norm(alone[:dim])
+    difference = max(
+        max(
+            np.linalg.norm(ours[:dim] - alone[:dim]) / force,
+            *np.abs(ours[dim:] / alone[dim:] - 1.0),
+        )
+        for ours in partitions
+    )
+    quantity = "largest relative difference of F, min and max lambda_N, |u| (both partitions)"
+    source = "the same scene on one rank"
+    verification(case, quantity, difference, 0.0, TOL_RANKS, source, kind="consistency")
+    return difference
+
+
+def solve(monkeypatch, partition: str, comm=MPI.COMM_WORLD) -> ContactProblem:
     monkeypatch.setenv(PARTITION_VARIABLE, partition)
-    scene = patch(2, PRESSURE, quadrature_degree=3, subdivisions=4)
+    scene = patch(2, PRESSURE, quadrature_degree=3, subdivisions=4, comm=comm)
     problem = ContactProblem(scene, verbose=False, petsc_options=TIGHT)
     problem.solve(num_steps=1)
     return problem
 
 
-def test_every_rank_owns_slave_points_and_answers_are_unchanged(monkeypatch):
+@across_ranks
+def test_every_rank_owns_slave_points_and_answers_are_unchanged(monkeypatch, verification):
     """With the default partition every rank owns slave points of the patch scene (on two
     ranks DOLFINx's graph partition gives the whole slave body to one rank); the contact
-    force, the multiplier's extremes and the displacement norm are those of the graph
-    partition to solver tolerance."""
+    force, the multiplier's extremes and the displacement norm of either partition are
+    those of one rank to solver tolerance (consistency)."""
     bodies, graph = solve(monkeypatch, "bodies"), solve(monkeypatch, "graph")
     comm = bodies.comm
     points = comm.allgather(len(bodies.contacts[0].projection.facet))
     assert min(points) > 0, points
-    assert np.allclose(bodies.contact_force(), graph.contact_force(), rtol=1e-10, atol=1e-15)
-
-    def summary(problem):
-        lam = problem.contacts[0].lambda_N.x.array
-        u = problem.bulks[0].u.x.petsc_vec.norm()
-        return comm.allreduce(lam.min(), MPI.MIN), comm.allreduce(lam.max(), MPI.MAX), u
-
-    assert np.allclose(summary(bodies), summary(graph), rtol=1e-9)
+    alone = summary(solve(monkeypatch, "bodies", MPI.COMM_SELF))
+    case = f"patch 2D, quadrature degree 3, 4 subdivisions, {comm.size} ranks"
+    difference = record_partitions(verification, case, [summary(bodies), summary(graph)], alone)
+    assert difference <= TOL_RANKS
 
 
-def test_hertz_3d_slave_points_are_shared_evenly_and_answers_unchanged(monkeypatch):
+@across_ranks
+def test_hertz_3d_slave_points_are_shared_evenly_and_answers_unchanged(monkeypatch, verification):
     """3D Hertz, coarse (the graph partition and the plain bodies split both put the ball's
     whole contact cap on one of two ranks): with the default partition every rank owns an
     equal share of the slave points (within 10%), and the contact force, the multiplier's
-    extremes and the displacement norm are the graph partition's to solver tolerance."""
+    extremes and the displacement norm of either partition are those of one rank to solver
+    tolerance (consistency)."""
 
-    def solve_hertz(partition: str) -> ContactProblem:
+    def solve_hertz(partition: str, comm=MPI.COMM_WORLD) -> ContactProblem:
         monkeypatch.setenv(PARTITION_VARIABLE, partition)
-        problem = ContactProblem(hertz_3d(h_contact=0.05).scene, verbose=False, petsc_options=TIGHT)
+        scene = hertz_3d(h_contact=0.05, comm=comm).scene
+        problem = ContactProblem(scene, verbose=False, petsc_options=TIGHT)
         problem.solve(num_steps=1)
         return problem
 
@@ -213,15 +250,10 @@ def test_hertz_3d_slave_points_are_shared_evenly_and_answers_unchanged(monkeypat
     comm = bodies.comm
     points = np.array(comm.allgather(len(bodies.contacts[0].projection.facet)))
     assert points.min() >= 0.9 * points.mean() and points.max() <= 1.1 * points.mean(), points
-    assert np.allclose(bodies.contact_force(), graph.contact_force(), rtol=1e-10, atol=1e-15)
-
-    def summary(problem):  # (the graph partition leaves one rank without multipliers)
-        lam = problem.contacts[0].lambda_N.x.array
-        u = problem.bulks[0].u.x.petsc_vec.norm()
-        low, high = np.min(lam, initial=np.inf), np.max(lam, initial=-np.inf)
-        return comm.allreduce(low, MPI.MIN), comm.allreduce(high, MPI.MAX), u
-
-    assert np.allclose(summary(bodies), summary(graph), rtol=1e-10)
+    alone = summary(solve_hertz("bodies", MPI.COMM_SELF))
+    case = f"Hertz 3D, linear elastic, h_contact = 0.05, {comm.size} ranks"
+    difference = record_partitions(verification, case, [summary(bodies), summary(graph)], alone)
+    assert difference <= TOL_RANKS
 
 
 def test_scene_from_gmsh_splits_its_pairs_surfaces_evenly(tmp_path):

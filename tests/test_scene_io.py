@@ -300,28 +300,57 @@ def solved(msh):
     return problems
 
 
-def test_named_scene_solves_like_integer_tags(solved):
+#: the scene of :func:`solved`
+BLOCKS = "two blocks from a gmsh file, pressed by p = 0.01 (Neo-Hookean, one step)"
+#: The bound of the force balance of the converged solve, relative to the load: the Newton
+#: iterations end at round-off here (measured <= 6.2e-15 on 1 and 2 ranks), far below their
+#: tolerance.
+BALANCE = 1e-12
+#: The bound of the same scene solved with tags by name and by integer, relative: equal on
+#: one rank, round-off apart on two (measured 1.4e-15).
+SAME = 1e-14
+EQUILIBRIUM = "equilibrium of the converged solve (force-driven: the load passes through)"
+INTEGER_TAGS = "the same scene with integer tags"
+
+
+def test_named_scene_solves_like_integer_tags(solved, verification):
     """The same contact force, which carries the applied load (width 1) through the
-    interface."""
+    interface (consistency)."""
     named, integer = (problem.contact_force() for problem in solved)
-    assert abs(named[1] / PRESSURE - 1.0) < 1e-8
-    assert np.allclose(named, integer, rtol=1e-12, atol=1e-15)
+    error = abs(named[1] / PRESSURE - 1.0)
+    verification(BLOCKS, "|F_y / (p w) - 1|", error, 0.0, BALANCE, EQUILIBRIUM, kind="consistency")
+    assert error <= BALANCE
+    same = np.abs(named - integer).max() / np.linalg.norm(integer)
+    quantity = "max |F - F_integer tags| / |F|"
+    verification(BLOCKS, quantity, same, 0.0, SAME, INTEGER_TAGS, kind="consistency")
+    assert same <= SAME
 
 
-def test_results_helpers_take_names(solved):
+def test_results_helpers_take_names(solved, verification):
+    """The results helpers take group names and give what they give with integer tags;
+    the support's reaction balances the load, as does the sum of all reactions
+    (consistency)."""
     named, integer = solved
     support = named.reaction("lower_bottom")
-    assert abs(support[1] / PRESSURE - 1.0) < 1e-8
-    assert np.allclose(support, integer.reaction(4), rtol=1e-12, atol=1e-15)
-    error = equilibrium_error(named, ["lower_bottom", "left"])
-    assert np.isfinite(error) and error == pytest.approx(
-        equilibrium_error(integer, [4, 5]), rel=1e-10
-    )
+    error = abs(support[1] / PRESSURE - 1.0)
+    quantity = "|R_y / (p w) - 1| (lower_bottom)"
+    verification(BLOCKS, quantity, error, 0.0, BALANCE, EQUILIBRIUM, kind="consistency")
+    assert error <= BALANCE
+    reaction = integer.reaction(4)
+    assert np.abs(support - reaction).max() <= SAME * np.linalg.norm(reaction)
+    errors = [equilibrium_error(named, ["lower_bottom", "left"])]
+    errors.append(equilibrium_error(integer, [4, 5]))
+    quantity = "equilibrium_error (tags by name, by integer)"
+    verification(BLOCKS, quantity, errors, 0.0, BALANCE, EQUILIBRIUM, kind="consistency")
+    assert max(errors) <= BALANCE
     sunk = lowest_displacement(named, "upper_top")
-    assert sunk < 0.0 and sunk == pytest.approx(lowest_displacement(integer, 3), rel=1e-10)
+    assert sunk < 0.0 and sunk == pytest.approx(lowest_displacement(integer, 3), rel=SAME)
     motion, normal = section_motion(named, "upper_top")
-    assert np.allclose(motion, section_motion(integer, 3)[0], rtol=1e-12, atol=1e-15)
-    assert normal[1] > 0.99
+    moved = section_motion(integer, 3)[0]
+    assert np.abs(motion - moved).max() <= SAME * np.abs(moved).max()
+    # the top stays flat under the uniform pressure: its normal +y to the solve's tolerance
+    # (measured 1.8e-9 off)
+    assert abs(normal[0]) < 1e-8 and normal[1] > 0.0
     raises_everywhere(
         "facet tag 'upper': physical group 'upper' has dimension 2", lambda: named.reaction("upper")
     )
