@@ -29,7 +29,7 @@ from contact_ufl.bulk import Bulk
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.control import VolumeConstraint, VolumeControl
-from contact_ufl.errors import NonUniqueSolutionWarning, collective_check
+from contact_ufl.errors import NonUniqueSolutionWarning
 from contact_ufl.layout import StackedLayout
 from contact_ufl.mpi import collective, global_bounds, global_diameter
 from contact_ufl.scene import Domain, Scene
@@ -358,9 +358,9 @@ class ContactProblem:
                 )
 
     def _check_rigid_modes(self) -> None:
-        """Refuse a body that nothing holds (no support, no contact pair), and warn of one
-        whose free rigid modes only a frictionless contact could hold but whose contact
-        normals near contact do not (:mod:`contact_ufl.free_bodies`): its solution is not
+        """Warn of a body that nothing holds (no support, no contact pair), and of one whose
+        free rigid modes only a frictionless contact could hold but whose contact normals
+        near contact do not (:mod:`contact_ufl.free_bodies`): its solution is not
         unique along them (collective). A membrane's tension holds what its supports
         leave free to first order (a string turning about a point of its chord), so only
         its translations along directions no support holds count."""
@@ -372,13 +372,16 @@ class ContactProblem:
             if len(modes):
                 loose.append((piece, modes, free_bodies.pairs_on(self, piece)))
         for piece, modes, on in loose:
+            if on:
+                continue
             words = "; ".join(free_bodies.describe_mode(piece, m) for m in modes)
-            collective_check(
-                self.comm,
-                bool(on),
-                f"the body {' + '.join(piece.bodies)} is held by no support and no contact "
-                f"pair: nothing holds its rigid motion ({words}), so the problem has no unique "
-                "solution; add a Dirichlet support (or a contact pair) on it",
+            warnings.warn(
+                f"the solution is not unique: the body {' + '.join(piece.bodies)} is held by "
+                f"no support and no contact pair, so nothing holds its rigid motion ({words}): "
+                "the solver picks its displacement along it, and a load along it has no "
+                "solution. Add a Dirichlet support (or a contact pair) on it",
+                NonUniqueSolutionWarning,
+                stacklevel=3,
             )
         for piece, modes, on in [item for item in loose if item[2]]:
             unheld = free_bodies.unheld_modes(self, piece, on, modes)
