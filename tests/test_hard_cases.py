@@ -1,5 +1,5 @@
-"""The hard-case suite's runner (issue 13, item 7) on its fastest members: the records say
-what happened (steps, cut-backs, SNES reasons, why a case stopped)."""
+"""The hard-case suite's runner on its fastest members: the records say what happened
+(steps, cut-backs, SNES reasons, why a case stopped)."""
 
 import pytest
 
@@ -16,8 +16,8 @@ def test_force_driven_record():
     assert record["steps"] == 2 and record["cutbacks"] == 0
     assert record["all_converged"] and not record["failures"]
     assert all(r.startswith("CONVERGED") for r in record["step_reasons"])
-    assert 1 <= record["newton_mean"] <= record["newton_max"] <= 50
-    assert record["wall_s"] > 0.0
+    # at most 9 Newton iterations per step (6 measured; test_force_driven.py counts them)
+    assert 1 <= record["newton_mean"] <= record["newton_max"] <= 9
 
 
 def test_deep_indentation_record():
@@ -54,7 +54,8 @@ def _converged_without_cutbacks(record: dict, steps: int) -> None:
 
 
 def test_self_contact_ring_record():
-    """The ring squeezed until its hole closes on itself: every step converges, no cut-back."""
+    """The ring squeezed until its hole closes on itself: every step converges, no cut-back
+    (at most 25 Newton iterations per step; 14 measured)."""
     record = hard_cases.run_case(hard_cases.self_contact_ring())
     _converged_without_cutbacks(record, 10)
     assert 1 <= record["newton_mean"] <= record["newton_max"] <= 25
@@ -62,13 +63,13 @@ def test_self_contact_ring_record():
 
 def test_volume_control_record():
     """The balloon under volume control, through its pressure maximum: every step
-    converges, no cut-back."""
+    converges, no cut-back (at most 10 Newton iterations per step; 7 measured)."""
     record = hard_cases.run_case(hard_cases.limit_point_volume_control())
     _converged_without_cutbacks(record, 12)
     assert 1 <= record["newton_mean"] <= record["newton_max"] <= 10
 
 
-def test_load_control_record_is_an_expected_limit_point_stop():
+def test_load_control_record_is_an_expected_limit_point_stop(verification):
     """The balloon under a pressure 2% above its maximum stops below the maximum, as
     expected: every failed try, and the stop, diagnosed as a limit point (no inverted
     element, no change of contact state)."""
@@ -77,6 +78,15 @@ def test_load_control_record_is_an_expected_limit_point_stop():
     assert record["expected_stop"] == "limit point" and not record["all_converged"]
     assert "limit point" in record["diagnosis"] and "limit point" in record["error"]
     assert "did not converge" in record["error"] and "after 3 cut-backs" in record["error"]
+    verification(
+        "hard case limit_point_load_control: Neo-Hookean balloon, pressure to 1.02 p_max",
+        "largest converged pressure over the closed-form maximum p_max",
+        record["t_reached"] * 1.02,
+        1.0,
+        "< 1",
+        "closed form: p = 2 mu t0 / R (1/l - 1/l^7) of the inflated sphere has no "
+        "equilibrium above its maximum",
+    )
     assert 0.0 < record["t_reached"] * 1.02 < 1.0  # stopped below the maximum
     assert record["cutbacks"] == len(record["failures"]) >= 4
     assert all("limit point" in f["why"] for f in record["failures"])
@@ -107,7 +117,7 @@ def test_case_lists():
 
 
 def test_large_sliding_3d_cases_exist():
-    """The 3D ironing (issue 13, item 2) is a case of the suite, no longer a planned one."""
+    """The 3D ironing is a case of the suite, no longer a planned one."""
     names = {case.name for case in hard_cases.cases(quick=True)}
     assert {"3d_large_sliding_mu0", "3d_large_sliding_mu0.3"} <= names
     assert not any(name.startswith("3d_large_sliding") for name in hard_cases.NOT_IMPLEMENTED)

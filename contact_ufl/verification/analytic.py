@@ -66,9 +66,9 @@ def bending_stiffness_plane_strain(E: float, nu: float, h: float) -> float:
 
 def _elastica_tip(k: float, psi0: float, psiL: float) -> tuple[float, float]:
     """Chord of the elastica ``psi'' + k sin(psi) = 0`` on ``0 <= s <= 1`` from ``psi0`` to
-    the turning point ``psiL`` (``psi'(1) = 0``), ``psi = pi/2 - theta'`` the tangent angle
-    measured from the load's line: its components ``(dx', dy')`` across and along that
-    line, by the closed forms of :func:`cantilever_elastica`."""
+    the turning point ``psiL`` (``psi'(1) = 0``), ``psi = pi/2 - phi`` with ``phi`` the
+    tangent's angle in the frame of the load: its components ``(dx', dy')`` across and along
+    the load's line, by the closed forms of :func:`cantilever_elastica`."""
     from scipy.special import ellipe, ellipeinc
 
     m = np.sin(0.5 * psiL) ** 2
@@ -87,29 +87,31 @@ def cantilever_elastica(k: float, follower: bool) -> tuple[float, float, float]:
     perpendicular to the deformed tip tangent (follower load); ``False``: it stays in ``-y``
     (dead load). Lengths over ``L``, ``k = P L^2 / EI``.
 
-    Derivation. In equilibrium the follower force is a fixed force, ``P (sin a_L, -cos a_L)``
-    with ``a_L`` the final tip angle: the beam has the shape of a cantilever under that dead
-    force. In a frame turned so that this force points in ``-y'``, the moment of the part
-    beyond ``s``, ``EI theta' = M``, ``M' = P cos(theta')``, gives with ``psi = pi/2 -
-    theta'`` the pendulum ``psi'' + k sin(psi) = 0``; the free tip, ``psi'(1) = 0``, is its
-    turning point ``psi_L``, and ``psi'^2 = 2 k (cos psi - cos psi_L)``. With ``sin(psi / 2)
-    = p sin(eta)``, ``p = sin(psi_L / 2)``, ``m = p^2``, the length is ``sqrt(k) = K(m) -
-    F(eta_0 | m)`` (``eta = pi/2`` at the tip, ``eta_0`` at the clamp's ``psi_0``), and the
-    chord has ``dx' = int sin(psi) ds = psi'(0) / k = sqrt(2 (cos psi_0 - cos psi_L) / k)``
-    (from ``sin psi = -psi'' / k``) across the load and ``dy' = int cos(psi) ds = int (1 - 2
-    m sin^2 eta) ds = 2 (E(m) - E(eta_0 | m)) / sqrt(k) - 1`` along it (``F``, ``E``:
-    incomplete elliptic integrals of the first and second kind, ``K``, ``E``: complete).
+    Derivation. In equilibrium the follower force is a fixed force, ``P (sin theta_L, -cos
+    theta_L)`` with ``theta_L`` the final tip angle: the beam has the shape of a cantilever
+    under that dead force. In a frame turned so that this force points in ``-y'``, with
+    ``phi(s)`` the tangent's angle there, the bending moment is that of the tip force about
+    the point at ``s``, ``EI phi' = M = -P (x'_L - x')``, so ``M' = P cos(phi)``; with ``psi
+    = pi/2 - phi`` this is the pendulum ``psi'' + k sin(psi) = 0``; the free tip, ``psi'(1)
+    = 0``, is its turning point ``psi_L``, and ``psi'^2 = 2 k (cos psi - cos psi_L)``. With
+    ``sin(psi / 2) = p sin(eta)``, ``p = sin(psi_L / 2)``, ``m = p^2``, the length is
+    ``sqrt(k) = K(m) - F(eta_0 | m)`` (``eta = pi/2`` at the tip, ``eta_0`` at the clamp's
+    ``psi_0``), and the chord has ``dx' = int sin(psi) ds = psi'(0) / k = sqrt(2 (cos psi_0
+    - cos psi_L) / k)`` (from ``sin psi = -psi'' / k``) across the load and ``dy' = int
+    cos(psi) ds = int (1 - 2 m sin^2 eta) ds = 2 (E(m) - E(eta_0 | m)) / sqrt(k) - 1``
+    along it (``F``, ``E``: incomplete elliptic integrals of the first and second kind,
+    ``K``, ``E``: complete).
 
     * Dead force (Bisshopp & Drucker, "Large deflection of cantilever beams", Q. Appl. Math.
       3, 272-275, 1945): the frame is the global one, ``psi_0 = pi/2`` at the clamp and the
       unknown amplitude ``psi_L = pi/2 - theta_L`` solves ``K(m) - F(eta_0 | m) = sqrt(k)``,
       ``sin(eta_0) = sin(pi/4) / p``.
     * Follower force: the force is perpendicular to the tip, ``psi_L = pi/2``: ``m = 1/2``
-      for every load, and the clamp's angle in the turned frame, ``psi_0 = pi/2 + theta_L``,
-      solves ``F(eta_0 | 1/2) = K(1/2) - sqrt(k)``, ``sin(psi_0 / 2) = sin(eta_0) /
-      sqrt(2)``; the chord is turned back by ``theta_L``. (The classical follower-load
-      benchmark, e.g. Argyris & Symeonidis, Comput. Methods Appl. Mech. Eng. 26, 75-123,
-      1981.)
+      for every load, and the clamp's angle in the turned frame, ``phi_0 = -theta_L``
+      (``psi_0 = pi/2 + theta_L``), solves ``F(eta_0 | 1/2) = K(1/2) - sqrt(k)`` with
+      ``sin(psi_0 / 2) = sin(eta_0) / sqrt(2)``; the chord is turned back by ``theta_L``.
+      (The classical follower-load benchmark, e.g. Argyris & Symeonidis, Comput. Methods
+      Appl. Mech. Eng. 26, 75-123, 1981.)
 
     Each case is one scalar equation, solved by bisection (``brentq``).
 
