@@ -9,16 +9,21 @@ from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
 JOHNSON = "Johnson, Contact Mechanics (1985), 4.2: closed form at the computed force"
 PROFILE = "p(x) = p0 sqrt(1 - x^2 / a^2)"
 SIGNORINI = "the contact law: gap >= 0, pressure >= 0, their product 0"
+#: the bounds at a/h = 10 on |a error|, |p0 error| and the RMS profile error over p0
+BOUNDS = (0.005, 0.01, 0.03)
 
 
-def record_hertz_errors(verification, case, a_err, p0_err, profile_err):
-    """Record the three errors that the Hertz tests assert on (1%, 1%, 3% of p0)."""
+def record_hertz_errors(verification, case, a_err, p0_err, profile_err, bounds=(0.01, 0.01, 0.03)):
+    """Record the three errors that a Hertz test asserts on, with the ``bounds`` it enforces
+    (on |a error|, |p0 error| and the RMS profile error over p0)."""
+    a_tol, p0_tol, profile_tol = bounds
     for quantity, error, reference, tolerance in (
-        ("relative error of the half-width", a_err, "a = sqrt(4 P R / (pi E*))", "|error| < 0.01"),
-        ("relative error of the peak pressure", p0_err, "p0 = 2 P / (pi a)", "|error| < 0.01"),
-        ("RMS pressure error in |x| < 0.8 a, over p0", profile_err, PROFILE, "< 0.03"),
+        ("relative error of the half-width", a_err, "a = sqrt(4 P R / (pi E*))", a_tol),
+        ("relative error of the peak pressure", p0_err, "p0 = 2 P / (pi a)", p0_tol),
     ):
-        verification(case, quantity, error, reference, tolerance, JOHNSON)
+        verification(case, quantity, error, reference, f"|error| < {tolerance:g}", JOHNSON)
+    quantity = "RMS pressure error in |x| < 0.8 a, over p0"
+    verification(case, quantity, profile_err, PROFILE, f"< {profile_tol:g}", JOHNSON)
 
 
 def hertz_errors(problem, hertz):
@@ -36,16 +41,17 @@ def hertz_errors(problem, hertz):
 
 @pytest.mark.serial  # 2 ranks: test_properties' comparison with one rank
 def test_hertz_half_width_and_peak_pressure(hertz_moderate, verification):
-    """At a/h = 10 the half-width and the peak pressure are within 1% (0.2% and 0.7%
-    measured; finer meshes level off at about 0.5%, benchmarks/results/hertz.json)."""
+    """At a/h = 10 the half-width is within 0.5% and the peak pressure within 1% of Hertz
+    (0.2% and 0.7% measured; finer meshes level off at about 0.5%,
+    benchmarks/results/hertz.json), the pressure profile within 3% of p0 (2.0%)."""
     problem, hertz = hertz_moderate
     a_err, p0_err, profile_err, exact = hertz_errors(problem, hertz)
     case = "Hertz 2D, Neo-Hookean, 4 load steps, a/h = 10"
-    record_hertz_errors(verification, case, a_err, p0_err, profile_err)
+    record_hertz_errors(verification, case, a_err, p0_err, profile_err, BOUNDS)
     assert exact.a / hertz.h_contact > 8  # the contact zone is resolved
-    assert abs(a_err) < 0.01
-    assert abs(p0_err) < 0.01
-    assert profile_err < 0.03
+    assert abs(a_err) < BOUNDS[0]
+    assert abs(p0_err) < BOUNDS[1]
+    assert profile_err < BOUNDS[2]
 
 
 @pytest.mark.serial  # 2 ranks: test_properties' comparison with one rank
@@ -71,7 +77,13 @@ def test_hertz_contact_law(hertz_moderate, verification):
     where the whole support of phi_i is in contact, int lambda_N phi_i = 0 where it is open;
     both hold to solver tolerance. Pointwise, the continuous P1 multiplier has a tail next to
     the contact edge that alternates in sign and decays by ~0.27 per element (the consistent
-    mass matrix): zero pressure is checked pointwise beyond 20 elements from the edge.
+    mass matrix): zero pressure is checked pointwise beyond 20 elements from the edge, and
+    the tail's first, negative, node is above -1% of p0 (-0.47% measured).
+
+    The weak gap, the weak multiplier where open and the multiplier far from the edge are
+    zero to the solver's tolerance (relative residual 1e-9): they are bounded by 1e-8, not by
+    their measured values (1e-12 and below), which a last quadratic Newton step puts
+    anywhere below it.
     """
     problem, hertz = hertz_moderate
     s = contact_samples(problem)
@@ -107,7 +119,7 @@ def test_hertz_contact_law(hertz_moderate, verification):
         "smallest nodal multiplier, over p0",
         s.lambda_N.min() / p0,
         "lambda_N >= 0",
-        "> -0.05",
+        "> -0.01",
         SIGNORINI,
     )
     if far.any():
@@ -130,7 +142,7 @@ def test_hertz_contact_law(hertz_moderate, verification):
         )
     assert weak_gap < 1e-8 * p0 / eps_N
     assert weak_lambda < 1e-8 * p0
-    assert np.all(s.lambda_N > -0.05 * p0)
+    assert np.all(s.lambda_N > -0.01 * p0)
     assert np.abs(s.lambda_N[far]).max() < 1e-8 * p0
     # pointwise, the closed gap is the O(h^2) mismatch of the two discrete surfaces, far
     # below the lambda / eps_N a penalty method would penetrate

@@ -4,6 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from mpi4py import MPI
 
 from contact_ufl.problem import ContactProblem
 from contact_ufl.results import body_resultants
@@ -14,6 +15,13 @@ TIGHT = {"snes_rtol": 1e-13, "snes_atol": 1e-15}
 UNIFORM = "the applied pressure: the patch test's exact solution is uniform"
 EQUILIBRIUM = "the equilibrium of a converged solve: the P1 test functions sum to one"
 ACTION = "action = reaction: the master shape functions sum to one"
+
+
+def deviation(problem):
+    """The largest |lambda_N / p - 1| over the multiplier nodes of all ranks."""
+    lam = problem.contacts[0].lambda_N.x.array
+    local = float(np.abs(lam / PRESSURE - 1.0).max(initial=0.0))
+    return problem.comm.allreduce(local, op=MPI.MAX)
 
 
 def record_pressure(verification, case, error, tolerance):
@@ -46,9 +54,9 @@ def composite():
 
 
 def test_patch_pressure_uniform(composite, verification):
-    lam = composite.contacts[0].lambda_N.x.array
-    record_pressure(verification, PATCH_2D, np.abs(lam / PRESSURE - 1.0).max(), "< 1e-3")
-    assert np.abs(lam / PRESSURE - 1.0).max() < 1e-3
+    error = deviation(composite)
+    record_pressure(verification, PATCH_2D, error, "< 1e-3")
+    assert error < 1e-3
 
 
 def test_patch_total_force_exact(composite, verification):
@@ -58,15 +66,16 @@ def test_patch_total_force_exact(composite, verification):
     is the verification.
 
     Its tangential part is not zero to round-off: the master surface tilts by the small
-    residual waviness of the non-matching interface (held by the supports of the sides).
+    residual waviness of the non-matching interface (held by the supports of the sides),
+    by 1e-7 of the normal force (4.6e-8 measured).
     """
     force = composite.contact_force()
     normal, tangential = abs(force[1] / PRESSURE - 1.0), abs(force[0]) / PRESSURE
     kind = "consistency"
     verification(PATCH_2D, "|F_y / (p w) - 1|", normal, 0.0, "< 1e-12", EQUILIBRIUM, kind=kind)
-    verification(PATCH_2D, "|F_x| / (p w)", tangential, 0.0, "< 1e-6", EQUILIBRIUM, kind=kind)
+    verification(PATCH_2D, "|F_x| / (p w)", tangential, 0.0, "< 1e-7", EQUILIBRIUM, kind=kind)
     assert abs(force[1] / PRESSURE - 1.0) < 1e-12
-    assert abs(force[0]) < 1e-6 * PRESSURE
+    assert abs(force[0]) < 1e-7 * PRESSURE
 
 
 def test_patch_action_reaction(composite, verification):
@@ -83,10 +92,10 @@ def test_patch_action_reaction(composite, verification):
 def test_patch_one_gauss_rule_is_not_enough(verification):
     """A single 2-point rule per facet misses the master kinks: the error is visible."""
     problem = solve_patch(3, 1)
-    lam = problem.contacts[0].lambda_N.x.array
+    error = deviation(problem)
     case = "patch test 2D, one 2-point Gauss rule per facet (expected to fail it)"
-    record_pressure(verification, case, np.abs(lam / PRESSURE - 1.0).max(), "> 1e-2")
-    assert np.abs(lam / PRESSURE - 1.0).max() > 1e-2
+    record_pressure(verification, case, error, "> 1e-2")
+    assert error > 1e-2
 
 
 @pytest.mark.parametrize(
@@ -100,10 +109,10 @@ def test_patch_3d(cell, degree, subdivisions, tolerance, verification):
     """The pressure within ``tolerance`` in 3D; the total force and action equals reaction
     hold by construction (see the 2D tests)."""
     problem = solve_patch(degree, subdivisions, dim=3, cell=cell)
-    lam = problem.contacts[0].lambda_N.x.array
+    error = deviation(problem)
     case = f"patch test 3D, {cell}, degree {degree} rule on {subdivisions} sub-facets"
-    record_pressure(verification, case, np.abs(lam / PRESSURE - 1.0).max(), f"< {tolerance:g}")
-    assert np.abs(lam / PRESSURE - 1.0).max() < tolerance
+    record_pressure(verification, case, error, f"< {tolerance:g}")
+    assert error < tolerance
     force = problem.contact_force()
     normal = abs(force[2] / PRESSURE - 1.0)
     quantity = "|F_z / (p A) - 1|"
@@ -129,11 +138,11 @@ def test_patch_lobatto_rule(verification):
     problem.solve(num_steps=1)
     assert problem.history.steps[0].newton_iterations <= 4
     assert problem.active_points() == problem.comm.allreduce(c.slave.X.size // 2)
-    lam = c.lambda_N.x.array
+    error = deviation(problem)
     case = "patch test 2D, Gauss-Lobatto rule on 4 sub-segments"
-    record_pressure(verification, case, np.abs(lam / PRESSURE - 1.0).max(), "< 5e-3")
+    record_pressure(verification, case, error, "< 5e-3")
     normal = abs(problem.contact_force()[1] / PRESSURE - 1.0)
     quantity = "|F_y / (p w) - 1|"
     verification(case, quantity, normal, 0.0, "< 1e-12", EQUILIBRIUM, kind="consistency")
-    assert np.abs(lam / PRESSURE - 1.0).max() < 5e-3
+    assert error < 5e-3
     assert abs(problem.contact_force()[1] / PRESSURE - 1.0) < 1e-12

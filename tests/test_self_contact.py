@@ -1,5 +1,12 @@
 """Self-contact: a surface searched against itself (the admissibility of pairs), and a slot
-in a block pressed until it closes on itself."""
+in a block pressed until it closes on itself.
+
+Verified against a closed form: a block cut through by a slot with non-matching faces,
+pressed shut, carries the uniform pressure of uniaxial strain (a patch test in
+self-contact); and by Taylor tests of the tangent. Equilibrium, action = reaction (property
+(e)) and the mirror symmetry of symmetric scenes hold by construction (consistency); the
+self-contact search is compared with a two-surface pair on the same slot (consistency).
+"""
 
 import basix.ufl
 import dolfinx
@@ -8,6 +15,7 @@ import pytest
 from conftest import across_ranks, assert_taylor_slopes
 from mpi4py import MPI
 from scipy.spatial import ConvexHull
+from test_taylor import SLOPE_TOL, record_slopes
 
 import contact_ufl as cu
 from contact_ufl.contact import projection
@@ -18,6 +26,20 @@ from contact_ufl.problem import ContactProblem
 from contact_ufl.verification import scenes
 from contact_ufl.verification.geometries import tag_single_body
 from contact_ufl.verification.taylor_cases import sliding_direction
+
+SLOT = "slot closing on itself, 2D, Neo-Hookean, 20 x 10 quadrilaterals"
+SLOT_3D = "slot closing on itself, 3D, Neo-Hookean, 20 x 2 x 10 hexahedra"
+RING = "half ring squeezed between two plates until its hole closes"
+EQUILIBRIUM = "the equilibrium of a converged solve"
+ACTION = "action = reaction, property (e): the master shape functions sum to one"
+MIRROR = "the mirror symmetry of the scene and its mesh"
+RANKS = "the same scene solved on one rank"
+#: the self-contact slot against the two-surface pair: top reaction (relative) and the
+#: tractions (over the largest)
+PAIR_REACTION = 5e-5
+PAIR_TRACTION = 5e-3
+#: the ring's departure from symmetry about y = 0 (one arc of the hole is the slave)
+RING_ASYMMETRY = 2e-4
 
 
 def _slit_2d(n: int = 40, a: float = 1.0, b: float = 0.06):
@@ -306,12 +328,22 @@ def _iterations(problem: ContactProblem) -> list[int]:
     return [s.newton_iterations for s in problem.history.steps]
 
 
-def _assert_same_run(alone: ContactProblem, problem: ContactProblem, quantity, rel: float):
+def _assert_same_run(
+    alone: ContactProblem, problem: ContactProblem, quantity, rel: float, record, case, name
+):
     """``alone`` (one rank) and ``problem``: the same ``quantity(problem)`` to ``rel`` of its
-    norm, and the same Newton iterations."""
+    norm (recorded with ``record`` as ``name`` of ``case``), and the same Newton
+    iterations."""
     a, b = quantity(alone), quantity(problem)
-    np.testing.assert_allclose(a, b, rtol=0, atol=rel * np.linalg.norm(a))
+    difference = np.abs(a - b).max() / np.linalg.norm(a)
+    record(case, name, difference, 0.0, f"< {rel:g}", RANKS, kind="consistency")
+    assert difference <= rel
     assert _iterations(alone) == _iterations(problem)
+
+
+def _record_balance(record, case, quantity, ratio, bound, source):
+    """Record a consistency check ``ratio < bound`` (a relative resultant or asymmetry)."""
+    record(case, quantity, ratio, 0.0, f"< {bound:g}", source, kind="consistency")
 
 
 @pytest.fixture(scope="module")
@@ -320,56 +352,156 @@ def closed_slot():
 
 
 @pytest.mark.serial  # 2 ranks: test_slot_same_result_on_any_number_of_ranks
-def test_slot_closes_on_itself(closed_slot):
+def test_slot_closes_on_itself(closed_slot, verification):
     """The slot pressed shut: Newton converges quadratically (a single pass: the lower face
-    is the slave, the upper face its master), the block is in equilibrium, the contact
-    forces on the one body cancel (property (e)) and the result is symmetric about x = 1."""
+    is the slave, the upper face its master). Consistency checks, which hold by
+    construction: the block is in equilibrium, the contact forces on the one body cancel
+    (property (e)) and the result is symmetric about x = 1 (as the scene and its mesh)."""
     problem = closed_slot
     assert _iterations(problem) == [3, 3, 4, 4]
     assert problem.active_points() >= 12
     # equilibrium: the two supports' reactions balance (the contact forces are internal)
     top = problem.reaction(2)
     assert top[1] < -0.2
-    assert np.linalg.norm(problem.reaction([1, 2])) < 1e-12 * np.linalg.norm(top)
+    balance = np.linalg.norm(problem.reaction([1, 2])) / np.linalg.norm(top)
+    quantity = "|sum of the support reactions| / |top reaction|"
+    _record_balance(verification, SLOT, quantity, balance, 1e-12, EQUILIBRIUM)
+    assert balance < 1e-12
     # property (e): the contact residual sums to zero over the body (slave and master sides
     # on the same body), while its slave side alone does not
     slave_side = problem.contact_force()
     assert slave_side[1] < -0.05
-    assert np.linalg.norm(_contact_resultant(problem)) < 1e-12 * np.linalg.norm(slave_side)
+    resultant = np.linalg.norm(_contact_resultant(problem)) / np.linalg.norm(slave_side)
+    quantity = "|contact resultant on the body| / |slave side's|"
+    _record_balance(verification, SLOT, quantity, resultant, 1e-14, ACTION)
+    assert resultant < 1e-14
     # one pass: only the lower face's points are paired; symmetric tractions about x = 1
     X, paired, t_N = _point_tractions(problem)
     assert np.all(np.isclose(X[paired, 1], 0.5))
     assert np.count_nonzero(t_N > 0) >= 12
     image = _mirror_image(X, np.stack([2.0 - X[:, 0], X[:, 1]], axis=1))
-    np.testing.assert_allclose(t_N[image], t_N, rtol=0, atol=1e-9 * t_N.max())
+    asymmetry = np.abs(t_N[image] - t_N).max() / t_N.max()
+    quantity = "largest |t_N(2 - x) - t_N(x)| / largest t_N"
+    _record_balance(verification, SLOT, quantity, asymmetry, 1e-12, MIRROR)
+    assert asymmetry < 1e-12
 
 
 @pytest.mark.serial  # 2 ranks: test_slot_same_result_on_any_number_of_ranks
-def test_slot_self_contact_equals_the_two_surface_pair(closed_slot):
+def test_slot_self_contact_equals_the_two_surface_pair(closed_slot, verification):
     """The same slot with the classical pair (lower face slave, upper face master): the same
-    contact up to the multiplier space. The self-contact slave surface also holds the side
-    walls and the upper face (unpaired: lambda_N = 0 there), and the multiplier equation
-    ties lambda_N to t_N in L2 over the whole slave surface, so lambda_N differs near the
-    slot's ends: by 1% of the peak at the edge of the contact zone, 2e-5 of the total force
-    (measured 1.6e-5)."""
+    contact up to the multiplier space (a consistency check of the self-contact search
+    against the two-surface one). The self-contact slave surface also holds the side walls
+    and the upper face (unpaired: lambda_N = 0 there), and the multiplier equation ties
+    lambda_N to t_N in L2 over the whole slave surface, so lambda_N differs near the slot's
+    ends: the tractions by 0.2% of the peak at the edge of the contact zone (bound
+    PAIR_TRACTION), the top reaction by 2.9e-5 (PAIR_REACTION)."""
     classical = _solved(MPI.COMM_WORLD, self_contact=False)
     assert _iterations(classical) == _iterations(closed_slot)
     assert classical.active_points() == closed_slot.active_points()
     a, b = closed_slot.reaction(2), classical.reaction(2)
-    assert np.linalg.norm(a - b) < 5e-5 * np.linalg.norm(b)
+    reaction = np.linalg.norm(a - b) / np.linalg.norm(b)
     X, _, t_self = _point_tractions(closed_slot)
     Y, _, t_classical = _point_tractions(classical)
     lower = np.isclose(X[:, 1], 0.5)
     mine, theirs = np.lexsort(X[lower].T), np.lexsort(Y.T)
     np.testing.assert_allclose(X[lower][mine], Y[theirs], atol=1e-14)
-    difference = np.abs(t_self[lower][mine] - t_classical[theirs])
-    assert difference.max() < 0.02 * t_classical.max()
+    traction = np.abs(t_self[lower][mine] - t_classical[theirs]).max() / t_classical.max()
+    source = "the same slot with a two-surface pair (lower face slave, upper face master)"
+    for quantity, value, bound in (
+        ("|top reaction difference| / |top reaction|", reaction, PAIR_REACTION),
+        ("largest t_N difference / largest t_N", traction, PAIR_TRACTION),
+    ):
+        verification(SLOT, quantity, value, 0.0, f"< {bound:g}", source, kind="consistency")
+    assert reaction < PAIR_REACTION
+    assert traction < PAIR_TRACTION
 
 
 @across_ranks
-def test_slot_same_result_on_any_number_of_ranks(closed_slot):
-    """One rank and this communicator's ranks: the same reaction and Newton iterations."""
-    _assert_same_run(_solved(MPI.COMM_SELF), closed_slot, lambda p: p.reaction(2), 1e-10)
+def test_slot_same_result_on_any_number_of_ranks(closed_slot, verification):
+    """One rank and this communicator's ranks: the same reaction (to round-off: 2e-16
+    measured) and Newton iterations."""
+    _assert_same_run(
+        _solved(MPI.COMM_SELF),
+        closed_slot,
+        lambda p: p.reaction(2),
+        1e-12,
+        verification,
+        f"{SLOT}, all ranks against one",
+        "largest top reaction difference / |top reaction|",
+    )
+
+
+def _cut_block_mesh(comm: MPI.Comm) -> dolfinx.mesh.Mesh:
+    """The block [0, 2] x [0, 1] cut through by the slot y in [0.5, 0.6]: its lower part in
+    10 x 5 quadrilaterals, its upper part in 7 x 4 (the faces of the slot do not match;
+    the lower part's nodes come first, so its face has the lower vertex keys)."""
+    points, cells, offset = [], [], 0
+    for nx, ny, y0, y1 in ((10, 5, 0.0, 0.5), (7, 4, 0.6, 1.0)):
+        X, Y = np.meshgrid(np.linspace(0, 2, nx + 1), np.linspace(y0, y1, ny + 1))
+        points.append(np.stack([X.ravel(), Y.ravel()], axis=1))
+        i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny)))
+        n0 = offset + j * (nx + 1) + i
+        cells.append(np.stack([n0, n0 + 1, n0 + nx + 1, n0 + nx + 2], axis=1))
+        offset += (nx + 1) * (ny + 1)
+    return _mesh_from_rank_0(comm, np.concatenate(cells), np.concatenate(points), "quadrilateral")
+
+
+def test_slot_closed_through_the_block_patch_test(verification):
+    """A contact patch test in self-contact: one body, the block cut through by a slot whose
+    faces do not match, one self-contact surface (both faces). The sides are held normally,
+    the bottom clamped, the top moved down by 0.15: once the slot (0.1) has closed, both
+    parts are in the same uniaxial strain, stretch ``s = 1 - 0.05 / 0.9``, and the
+    multiplier is the uniform pressure of the Neo-Hookean energy in plane strain, ``p =
+    mu (1/s - s) - lambda ln(s) / s``. With the composite rule of the patch test (8
+    sub-segments) the multipliers at the slave points are within 1e-3 of it (4.8e-4
+    measured, as in tests/test_patch.py), the top reaction within 5e-8 (1.7e-8)."""
+    mesh = _cut_block_mesh(MPI.COMM_WORLD)
+    e = 1e-9
+    cells, facets = tag_single_body(
+        mesh,
+        [
+            lambda x: np.isclose(x[1], 0.0),
+            lambda x: np.isclose(x[1], 1.0),
+            lambda x: (x[1] > 0.5 - e) & (x[1] < 0.6 + e),
+            lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 2.0),
+        ],
+    )
+    E, nu, depth, width = 1.0, 0.3, 0.15, 2.0
+    scene = cu.Scene(
+        mesh,
+        cells,
+        facets,
+        [cu.Body(1, cu.NeoHookean(E, nu))],
+        contacts=[cu.ContactPair(3, 3, eps_N=E, quadrature_subdivisions=8)],
+        dirichlet=[
+            cu.Dirichlet(1, (0.0, 0.0)),
+            cu.Dirichlet(2, lambda t: (0.0, -depth * t)),
+            cu.Dirichlet(4, 0.0, component=0),
+        ],
+    )
+    problem = ContactProblem(scene, verbose=False, petsc_options={"snes_rtol": 1e-13})
+    problem.solve(num_steps=4)
+    mu, lmbda = E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    stretch = 1.0 - (depth - 0.1) / 0.9
+    pressure = mu * (1.0 / stretch - stretch) - lmbda * np.log(stretch) / stretch
+    c = problem.contacts[0]
+    active = c.active()
+    X = c.slave.X.reshape(-1, 2)
+    # one pass: the points of the lower face are paired, all of them, those of the upper not
+    lower = np.isclose(X[:, 1], 0.5)
+    assert np.array_equal(active, lower)
+    assert problem.comm.allreduce(int(lower.sum())) == 10 * 2 * 8
+    deviation = np.abs(c.multiplier_at_points()[active] / pressure - 1.0).max(initial=0.0)
+    deviation = problem.comm.allreduce(deviation, op=MPI.MAX)
+    reaction = abs(problem.reaction(2)[1] / (-width * pressure) - 1.0)
+    case = "slot through a block, self-contact of non-matching faces (patch test)"
+    source = "uniaxial strain of a Neo-Hookean solid in plane strain: closed form"
+    closed_form = "p = mu (1/s - s) - lambda ln(s) / s"
+    quantity = "largest |lambda_N / p - 1| at the slave points"
+    verification(case, quantity, deviation, closed_form, "< 1e-3", source)
+    verification(case, "|top reaction / (p w) - 1|", reaction, closed_form, "< 5e-8", source)
+    assert deviation < 1e-3
+    assert reaction < 5e-8
 
 
 def test_self_contact_of_a_flat_face_is_refused():
@@ -397,13 +529,15 @@ def test_frictional_self_contact_is_refused():
         cu.ContactPair(3, 3, mu=0.2).validate(MPI.COMM_WORLD)
 
 
-def test_taylor_of_the_closed_slot(closed_slot):
+def test_taylor_of_the_closed_slot(closed_slot, verification):
     """The tangent at the closed slot (the lower face pressed by the upper one, both sides of
     one surface and of one body): second-order remainders along a smooth direction that
     deforms the block and changes the multipliers."""
     problem = closed_slot
     dz = sliding_direction(problem, 1, np.zeros(2), amplitude=0.02, multiplier=0.01)
-    assert_taylor_slopes(problem, dz, [1e-3 * 2.0**-k for k in range(4)])
+    steps = [1e-3 * 2.0**-k for k in range(4)]
+    result = assert_taylor_slopes(problem, dz, steps, tol=SLOPE_TOL)
+    record_slopes(verification, f"Taylor test, {SLOT}", result, tol=SLOPE_TOL)
 
 
 def _slot_mesh_3d(comm: MPI.Comm, nx: int = 20, ny: int = 2, nz: int = 10) -> dolfinx.mesh.Mesh:
@@ -423,9 +557,10 @@ def _slot_mesh_3d(comm: MPI.Comm, nx: int = 20, ny: int = 2, nz: int = 10) -> do
     return _mesh_from_rank_0(comm, cells, x, "hexahedron")
 
 
-def test_slot_closes_on_itself_in_3d():
+def test_slot_closes_on_itself_in_3d(verification):
     """The slot through a 3D block (plane strain by u_y = 0 on the sides y = 0, 0.2) pressed
-    shut: quadratic Newton, equilibrium, property (e) and symmetric tractions about x = 1."""
+    shut: quadratic Newton; equilibrium, property (e) and symmetric tractions about x = 1
+    (consistency checks, as in 2D)."""
     comm = MPI.COMM_WORLD
     mesh = _slot_mesh_3d(comm)
     e = 1e-9
@@ -456,13 +591,22 @@ def test_slot_closes_on_itself_in_3d():
     assert problem.active_points() >= 60
     top = problem.reaction(2)
     assert top[2] < -0.05
-    assert np.linalg.norm(problem.reaction([1, 2, 4])) < 1e-12 * np.linalg.norm(top)
+    balance = np.linalg.norm(problem.reaction([1, 2, 4])) / np.linalg.norm(top)
+    quantity = "|sum of the support reactions| / |top reaction|"
+    _record_balance(verification, SLOT_3D, quantity, balance, 1e-12, EQUILIBRIUM)
+    assert balance < 1e-12
     slave_side = problem.contact_force()
     assert slave_side[2] < -0.01
-    assert np.linalg.norm(_contact_resultant(problem)) < 1e-12 * np.linalg.norm(slave_side)
+    resultant = np.linalg.norm(_contact_resultant(problem)) / np.linalg.norm(slave_side)
+    quantity = "|contact resultant on the body| / |slave side's|"
+    _record_balance(verification, SLOT_3D, quantity, resultant, 1e-14, ACTION)
+    assert resultant < 1e-14
     X, _, t_N = _point_tractions(problem)
     image = _mirror_image(X, X * [-1.0, 1.0, 1.0] + [2.0, 0.0, 0.0])
-    np.testing.assert_allclose(t_N[image], t_N, rtol=0, atol=1e-9 * t_N.max())
+    asymmetry = np.abs(t_N[image] - t_N).max() / t_N.max()
+    quantity = "largest |t_N(2 - x) - t_N(x)| / largest t_N"
+    _record_balance(verification, SLOT_3D, quantity, asymmetry, 1e-12, MIRROR)
+    assert asymmetry < 1e-12
 
 
 # -- a ring squeezed between two plates until its hole closes ----------------------------
@@ -493,32 +637,52 @@ def _displacement(problem: ContactProblem) -> tuple[np.ndarray, np.ndarray]:
 
 
 @pytest.mark.serial  # 2 ranks: test_ring_same_result_on_any_number_of_ranks
-def test_ring_hole_closes_on_itself(squeezed_ring):
+def test_ring_hole_closes_on_itself(squeezed_ring, verification):
     """The plates' forces balance each other and the cut; the self-contact forces cancel on
-    the ring (property (e)) while its slave side alone carries most of the plates' force;
-    the result is symmetric about y = 0 up to the one-pass choice of slave arc (measured
-    6.5e-5 of the largest displacement)."""
+    the ring (property (e)) while its slave side alone carries most of the plates' force
+    (consistency checks, by construction); the result is symmetric about y = 0 up to the
+    one-pass choice of slave arc (RING_ASYMMETRY of the largest displacement)."""
     problem = squeezed_ring
     top, bottom, inner = problem.contacts
     plates = [problem.obstacle_reaction(c.pair.master) for c in (top, bottom)]
     assert plates[0][1] < -0.3
     total = problem.reaction(1) + plates[0] + plates[1]
-    assert np.linalg.norm(total) < 1e-12 * np.linalg.norm(plates[0])
+    balance = np.linalg.norm(total) / np.linalg.norm(plates[0])
+    quantity = "|plates' and cut's reactions| / |top plate's|"
+    _record_balance(verification, RING, quantity, balance, 1e-12, EQUILIBRIUM)
+    assert balance < 1e-12
     # the self pair: in contact over a good part of the hole, its resultant on the ring zero
     assert problem.comm.allreduce(int(inner.active().sum())) >= 30
     slave_side = problem.contact_force(2)
     assert slave_side[1] < -0.25
     plates_slave_side = problem.contact_force(0) + problem.contact_force(1)
-    assert np.linalg.norm(plates_slave_side) < 1e-12 * np.linalg.norm(plates[0])
-    assert np.linalg.norm(_contact_resultant(problem)) < 1e-12 * np.linalg.norm(slave_side)
+    plates_balance = np.linalg.norm(plates_slave_side) / np.linalg.norm(plates[0])
+    quantity = "|contact forces of the two plates on the ring| / |top plate's|"
+    _record_balance(verification, RING, quantity, plates_balance, 1e-12, EQUILIBRIUM)
+    assert plates_balance < 1e-12
+    resultant = np.linalg.norm(_contact_resultant(problem)) / np.linalg.norm(slave_side)
+    quantity = "|contact resultant on the ring| / |self pair's slave side|"
+    _record_balance(verification, RING, quantity, resultant, 1e-14, ACTION)
+    assert resultant < 1e-14
     # symmetry about y = 0: u(x, -y) = (u_x, -u_y)(x, y)
     X, U = _displacement(problem)
     image = _mirror_image(X, X * [1.0, -1.0])
-    asymmetry = np.abs(U[image] * [1.0, -1.0] - U).max()
-    assert asymmetry < 2e-4 * np.abs(U).max()
+    asymmetry = np.abs(U[image] * [1.0, -1.0] - U).max() / np.abs(U).max()
+    quantity = "largest |u mirrored about y = 0 - u| / largest |u|"
+    _record_balance(verification, RING, quantity, asymmetry, RING_ASYMMETRY, MIRROR)
+    assert asymmetry < RING_ASYMMETRY
 
 
 @across_ranks
-def test_ring_same_result_on_any_number_of_ranks(squeezed_ring):
-    alone = _ring_problem(MPI.COMM_SELF)
-    _assert_same_run(alone, squeezed_ring, lambda p: p.contact_force(2), 1e-9)
+def test_ring_same_result_on_any_number_of_ranks(squeezed_ring, verification):
+    """One rank and this communicator's ranks: the same self-contact force (to round-off:
+    7e-16 measured) and Newton iterations."""
+    _assert_same_run(
+        _ring_problem(MPI.COMM_SELF),
+        squeezed_ring,
+        lambda p: p.contact_force(2),
+        1e-12,
+        verification,
+        f"{RING}, all ranks against one",
+        "largest self pair's contact force difference / its norm",
+    )

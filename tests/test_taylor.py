@@ -13,36 +13,41 @@ from mpi4py import MPI
 from contact_ufl.verification.taylor_cases import curved_case
 
 TAYLOR = "Taylor's theorem: the remainder of an exact derivative is O(h^2)"
+#: the bounds on |slope - 2| of the first-order remainders (largest measured: 1.6e-4 on one
+#: rank, 1.8e-4 on two, 3D with friction) and on |slope - 1| of the zeroth-order ones (9.4e-6)
+SLOPE_TOL = 4e-4
+ZEROTH_TOL = 2e-5
 
 
-def record_slopes(verification, case, result, slope=2.0, source=TAYLOR):
+def record_slopes(verification, case, result, slope=2.0, source=TAYLOR, tol=0.01):
     """Record the slopes of the first-order remainder that assert_taylor_slopes checked
-    (within 0.01 of ``slope``)."""
+    (within ``tol`` of ``slope``: its default 0.01 unless the test passed another)."""
     quantity = "slopes of the Taylor remainder |R1(h)|"
-    verification(case, quantity, result.slopes, slope, "|slope - reference| < 0.01", source)
+    verification(case, quantity, result.slopes, slope, f"|slope - reference| < {tol:g}", source)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_taylor_second_order(dim, verification):
     problem, dz, steps = curved_case(dim)
     assert problem.active_points() > 10
-    result = assert_taylor_slopes(problem, dz, steps, zeroth=True)
+    result = assert_taylor_slopes(problem, dz, steps, tol=SLOPE_TOL)
     case = f"Taylor test {dim}D, curved surfaces, frictionless"
-    record_slopes(verification, case, result)
+    record_slopes(verification, case, result, tol=SLOPE_TOL)
     zeroth = np.diff(np.log(result.zeroth)) / np.diff(np.log(result.h))
     source = "Taylor's theorem: the zeroth-order remainder is O(h)"
     quantity = "slopes of the remainder |R0(h)|"
-    verification(case, quantity, zeroth, 1.0, "|slope - 1| < 0.05", source)
+    verification(case, quantity, zeroth, 1.0, f"|slope - 1| < {ZEROTH_TOL:g}", source)
+    assert np.all(np.abs(zeroth - 1.0) < ZEROTH_TOL), zeroth
 
 
 def test_taylor_detects_a_frozen_projection(verification):
     """Dropping the variation of the projected point leaves a first-order remainder."""
     problem, dz, steps = curved_case(2)
     problem.contacts[0].kinematics.frozen_projection = True
-    result = assert_taylor_slopes(problem, dz, steps, slope=1.0, unchanged=False)
+    result = assert_taylor_slopes(problem, dz, steps, slope=1.0, tol=SLOPE_TOL, unchanged=False)
     case = "Taylor test 2D, projection's variation dropped (a wrong tangent, on purpose)"
     source = "Taylor's theorem: an inexact derivative leaves an O(h) remainder"
-    record_slopes(verification, case, result, slope=1.0, source=source)
+    record_slopes(verification, case, result, slope=1.0, source=source, tol=SLOPE_TOL)
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.05])
@@ -55,8 +60,9 @@ def test_taylor_smoothed_master_normal(mu, verification):
     facet = curved_case(2, mu=mu)[0].contacts[0]
     change = np.abs(facet.projection.normal - c.projection.normal).max(initial=0.0)
     assert problem.comm.allreduce(change, op=MPI.MAX) > 1e-6  # another normal indeed
-    result = assert_taylor_slopes(problem, dz, steps)
-    record_slopes(verification, f"Taylor test 2D, smoothed master normal, mu = {mu:g}", result)
+    result = assert_taylor_slopes(problem, dz, steps, tol=SLOPE_TOL)
+    case = f"Taylor test 2D, smoothed master normal, mu = {mu:g}"
+    record_slopes(verification, case, result, tol=SLOPE_TOL)
 
 
 @pytest.mark.parametrize("cell, nn", [("tetrahedron", 3), ("hexahedron", 4)])
@@ -72,6 +78,6 @@ def test_taylor_smoothed_master_normal_3d(cell, nn, mu, verification):
     if cell == "hexahedron" and problem.comm.size > 1:  # fans of nodes on two ranks
         master = problem.contacts[0].master
         assert problem.comm.allreduce(master.num_facets, op=MPI.MIN) > 0
-    result = assert_taylor_slopes(problem, dz, steps)
+    result = assert_taylor_slopes(problem, dz, steps, tol=SLOPE_TOL)
     case = f"Taylor test 3D, {cell}, smoothed master normal, mu = {mu:g}"
-    record_slopes(verification, case, result)
+    record_slopes(verification, case, result, tol=SLOPE_TOL)
