@@ -1,31 +1,55 @@
 """Coulomb friction: consistent tangent in stick and in slip, friction only where mu > 0."""
 
 import dataclasses
+import functools
 
 import numpy as np
 import pytest
-from conftest import assert_taylor_slopes
+from conftest import across_ranks
 from mpi4py import MPI
 
 from contact_ufl.contact.coulomb import CoulombLaw
 from contact_ufl.problem import ContactProblem
+from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import scenes
 from contact_ufl.verification.scenes import curved_pair
 from contact_ufl.verification.taylor_cases import curved_case
 
+TAYLOR = "Taylor's theorem: the remainder of an exact derivative is O(h^2)"
+COULOMB = "Coulomb's law (theory, property (d)): stick below mu lambda_N, slip against the traction"
+DISC = "the disc projection: the applied traction lies in the disc of radius mu t_N by construction"
+
+
+def check_slopes(verification, case, result, slope=2.0, tol=5e-4, source=TAYLOR):
+    """Record the slopes of the first-order Taylor remainder, then assert that no point
+    changed facet or contact status over the steps and that every slope is ``slope``
+    within ``tol``."""
+    quantity = "slopes of the Taylor remainder |R1(h)|"
+    verification(case, quantity, result.slopes, slope, f"|slope - reference| < {tol:g}", source)
+    assert not result.facets_changed and not result.active_changed
+    assert np.all(np.abs(result.slopes - slope) < tol), result.slopes
+
 
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("mu, state", [(0.3, "slip"), (100.0, "stick")])
-def test_frictional_taylor_second_order(dim, mu, state):
+def test_frictional_taylor_second_order(dim, mu, state, verification):
+    """The tangent of the frictional residual in slip (every point) and in stick (every
+    point) is its derivative: the Taylor remainder falls with slope 2 within 5e-4 (2.1e-4
+    measured, 3D in slip)."""
     problem, dz, steps = curved_case(dim, mu=mu)
     c = problem.contacts[0]
     active = problem.comm.allreduce(int(c.active().sum()))
     stick = problem.comm.allreduce(int(c.stick().sum()))
     assert active > 10
     assert stick == (active if state == "stick" else 0)
-    assert_taylor_slopes(problem, dz, steps)
+    result = taylor_test(problem, dz, steps)
+    case = f"Taylor test {dim}D, curved surfaces, mu = {mu:g}, {state}"
+    check_slopes(verification, case, result)
 
 
+#: the frictionless curved pair leaves the rotation about the circles' centre free (the
+#: problem warns of it when made); only its unknowns are looked at here
+@pytest.mark.filterwarnings("ignore::contact_ufl.errors.NonUniqueSolutionWarning")
 def test_friction_unknowns_only_with_mu():
     scene = curved_pair(2)
     frictionless = ContactProblem(scene, verbose=False)
@@ -54,11 +78,11 @@ def test_no_nan_where_q_vanishes():
     assert np.isfinite(R.norm()) and np.isfinite(J.norm())
 
 
-def test_block_sticks_then_slides():
+def test_block_sticks_then_slides(verification):
     """A block pressed on a flat and pushed: stuck while the tangential force is below
     mu N (no slip, in the weak sense of the multiplier equation), sliding above it (every
     contact point slips, against the frictional traction on the slave body). The weak
-    slip of the stuck steps stays below 1e-6 of the step's push (2e-7 measured)."""
+    slip of the stuck steps stays below 1e-7 of the step's push (4.7e-8 measured)."""
     mu, push, steps = 0.3, 0.03, 10
     problem = ContactProblem(scenes.pushed_block(mu=mu, push=push), verbose=False)
     c = problem.contacts[0]
@@ -99,9 +123,32 @@ def test_block_sticks_then_slides():
     stuck = [r for r in log if r["t"] > 1.0 and r["ratio"] < 0.5 * mu]
     sliding = [r for r in log if r["t"] > 1.75]
     assert stuck and sliding
+    case = "block pressed on a flat and pushed, mu = 0.3"
+    weak_slip = max(r["weak_slip"] for r in stuck) / increment
+    largest_ratio = max(r["ratio"] for r in log)
+    slipping = min((r["active"] - r["stick"]) / r["active"] for r in sliding)
+    power = max(r["power"] for r in sliding)
+    record = functools.partial(verification, case)
+    record(
+        "largest weak slip of the stuck steps, over the step's push",
+        weak_slip,
+        0.0,
+        "< 1e-7",
+        COULOMB,
+    )
+    record(
+        "largest |Fx| / Fy over the steps, over mu",
+        largest_ratio / mu,
+        1.0,
+        "<= 1 + 1e-8",
+        DISC,
+        kind="consistency",
+    )
+    record("fewest slipping points / points in contact, t > 1.75", slipping, 1.0, "equal", COULOMB)
+    record("largest frictional traction . slip at a point, t > 1.75", power, "< 0", "< 0", COULOMB)
     for r in stuck:
         assert r["stick"] == r["active"] > 0
-        assert r["weak_slip"] < 1e-6 * increment
+        assert r["weak_slip"] < 1e-7 * increment
     for r in log:
         assert r["ratio"] <= mu * (1.0 + 1e-8)
     for r in sliding:
@@ -110,11 +157,12 @@ def test_block_sticks_then_slides():
         assert r["power"] < 0.0
 
 
-def test_objectivity_under_a_large_rotation():
-    """Rotating the whole frictional scene by 70 degrees rotates the contact force and leaves
-    the Newton iterations unchanged. (The bodies start apart: a point starting exactly at
-    g = 0 with lambda_N = 0 sits on the kink of the bracket, where round-off alone may pick
-    the Newton path.)"""
+def test_objectivity_under_a_large_rotation(verification):
+    """Rotating the whole frictional scene by 70 degrees rotates the contact force (to 1e-13
+    of it: both runs take the same Newton iterates, so they differ by rounding, 6e-15
+    measured) and leaves the Newton iterations unchanged. (The bodies start
+    apart: a point starting exactly at g = 0 with lambda_N = 0 sits on the kink of the
+    bracket, where round-off alone may pick the Newton path.)"""
     angle = np.deg2rad(70.0)
     runs = []
     for rotation in (0.0, angle):
@@ -129,33 +177,54 @@ def test_objectivity_under_a_large_rotation():
     R = scenes.rotation_2d(angle)
     f0, f1 = reference.contact_force(), rotated.contact_force()
     assert abs(f0[0]) > 0.1 * abs(f0[1])  # a real tangential load
-    assert np.allclose(R @ f0, f1, rtol=0, atol=1e-8 * np.linalg.norm(f0))
+    difference = np.abs(R @ f0 - f1).max() / np.linalg.norm(f0)
+    case = "Hertz 2D pressed and shifted, mu = 0.3, the scene rotated by 70 degrees"
+    quantity = "largest |rotated force - force of the rotated scene|, over |force|"
+    source = "objectivity (frame indifference) of the formulation"
+    verification(case, quantity, difference, 0.0, "< 1e-13", source)
+    assert difference < 1e-13
     assert [s.newton_iterations for s in reference.history.steps] == [
         s.newton_iterations for s in rotated.history.steps
     ]
 
 
-def test_pressed_from_touching_sticks_on_any_number_of_ranks():
+def _pressed_from_touching(comm):
     """The block of ``scenes.pushed_block`` pressed from touching (g = 0, lambda = 0, no
     slip: every point on the kink of the bracket and at the centre of a disc of radius 0):
-    every point sticks from the first iterate on, 3 Newton iterations, on this
-    communicator as on one rank. When round-off chose stick or slip there, the first step
-    took 8 iterations on one rank and 32 on two (25 of them cycling)."""
-
-    def pressed(comm):
-        problem = ContactProblem(scenes.pushed_block(push=0.3, comm=comm), verbose=False)
-        problem.solve(num_steps=1, t_end=0.5)
-        c = problem.contacts[0]
-        counts = np.array([c.active().sum(), c.stick().sum()])
-        return problem.history.steps[0].newton_iterations, problem.comm.allreduce(counts)
-
-    its, (active, stick) = pressed(MPI.COMM_WORLD)
-    assert its == 3 and active > 50 and stick == active
-    if MPI.COMM_WORLD.size > 1:
-        assert pressed(MPI.COMM_SELF)[0] == its
+    the first step's Newton iterations and the points in contact and sticking."""
+    problem = ContactProblem(scenes.pushed_block(push=0.3, comm=comm), verbose=False)
+    problem.solve(num_steps=1, t_end=0.5)
+    c = problem.contacts[0]
+    counts = np.array([c.active().sum(), c.stick().sum()])
+    return problem.history.steps[0].newton_iterations, problem.comm.allreduce(counts)
 
 
-def test_points_beyond_the_master_surface_are_released():
+@pytest.mark.serial  # 2 ranks: test_pressed_from_touching_on_any_number_of_ranks
+def test_pressed_from_touching_sticks(verification):
+    """Pressed from touching, every point sticks from the first iterate on, in 3 Newton
+    iterations: the two blocks are elastically identical under a uniform pressure, so their
+    surfaces expand alike and no tangential traction arises. When round-off chose stick or
+    slip on the kinks, the first step took 8 iterations on one rank and 32 on two."""
+    its, (active, stick) = _pressed_from_touching(MPI.COMM_WORLD)
+    case = "block pressed from touching onto an identical block, mu = 0.3"
+    quantity = "sticking points / points in contact"
+    source = "identical blocks under a uniform pressure: no tangential traction, no slip"
+    verification(case, quantity, stick / active, 1.0, "equal", source)
+    assert active > 50 and stick == active
+    assert its == 3
+
+
+@across_ranks
+def test_pressed_from_touching_on_any_number_of_ranks():
+    """The same first step on all ranks as on one: the same Newton iterations and the same
+    points in contact and sticking (round-off does not choose the state)."""
+    world = _pressed_from_touching(MPI.COMM_WORLD)
+    alone = _pressed_from_touching(MPI.COMM_SELF)
+    assert world[0] == alone[0]
+    assert np.array_equal(world[1], alone[1])
+
+
+def test_points_beyond_the_master_surface_are_released(verification):
     """The pushed block slides past the end of the lower block: its overhanging part is not
     in contact (the last master facet is not an infinite line)."""
     problem = ContactProblem(scenes.pushed_block(push=0.3), verbose=False)
@@ -166,6 +235,11 @@ def test_points_beyond_the_master_surface_are_released():
     end = c.master.current_nodes()[..., 0].max(initial=-np.inf)
     end = problem.comm.allreduce(end, op=MPI.MAX)
     overhang = x > end + 1e-9
+    released = problem.comm.allreduce(int((c.active() & overhang).sum()))
+    case = "block pushed past the end of the lower block, mu = 0.3"
+    quantity = "points in contact beyond the master's end"
+    source = "the closest-point projection onto a bounded master: none beyond its end"
+    verification(case, quantity, released, 0, "equal", source)
     assert problem.comm.allreduce(int(overhang.sum())) > 0
-    assert problem.comm.allreduce(int((c.active() & overhang).sum())) == 0
+    assert released == 0
     assert problem.comm.allreduce(int(c.active().sum())) > 20

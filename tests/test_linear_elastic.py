@@ -7,7 +7,7 @@ import pytest
 import ufl
 from conftest import symmetric_square
 from mpi4py import MPI
-from test_hertz import hertz_errors, record_hertz_errors
+from test_hertz import JOHNSON, PROFILE, hertz_errors
 
 import contact_ufl as cu
 from contact_ufl.loads import DeadTraction
@@ -67,7 +67,8 @@ def test_exported():
 
 def test_uniaxial_dead_traction_plane_strain(verification):
     """A block stretched by a dead traction t, free laterally: the plane-strain closed form
-    eps_11 = (1 - nu^2) t / E, eps_22 = -nu (1 + nu) t / E, in one Newton iteration."""
+    eps_11 = (1 - nu^2) t / E, eps_22 = -nu (1 + nu) t / E, in one Newton iteration, to
+    the rounding of the linear solve (1e-13; 1.6e-15 measured)."""
     E, nu, t = 1.0, 0.3, 0.08
     scene = symmetric_square(LinearElastic(E, nu), [DeadTraction(2, lambda s: (t * s, 0.0))])
     problem = ContactProblem(scene, verbose=False)
@@ -84,9 +85,9 @@ def test_uniaxial_dead_traction_plane_strain(verification):
         ("relative error of eps_11", e11, (1 - nu**2) * t / E, "(1 - nu^2) t / E"),
         ("relative error of eps_22", e22, -nu * (1 + nu) * t / E, "-nu (1 + nu) t / E"),
     ):
-        verification(case, quantity, measured / exact - 1.0, reference, "|error| <= 1e-10", source)
-    assert e11 == pytest.approx((1 - nu**2) * t / E, rel=1e-10)
-    assert e22 == pytest.approx(-nu * (1 + nu) * t / E, rel=1e-10)
+        verification(case, quantity, measured / exact - 1.0, reference, "|error| <= 1e-13", source)
+    assert e11 == pytest.approx((1 - nu**2) * t / E, rel=1e-13)
+    assert e22 == pytest.approx(-nu * (1 + nu) * t / E, rel=1e-13)
     assert history.steps[-1].newton_iterations == 1  # a linear bulk
 
 
@@ -104,19 +105,23 @@ def linear_hertz(h_contact=0.005, depth=0.005, steps=4):
 
 
 def test_hertz_linear_elastic(verification):
-    """2D Hertz at a/h = 10 with linear-elastic bodies: a and p0 within 1%, and at most 10
-    Newton iterations per load step (issue 12's target).
-
-    Measured (4 load steps): a +0.001%, p0 +0.82%, profile 2.0% of p0, Newton 8, 5, 4, 5;
-    the Neo-Hookean run of the same scene (test_hertz): a +0.20%, p0 +0.67%, profile 2.0%,
-    Newton 8, 5, 4, 5 (the contact nonlinearity, not the bulk, sets the iterations).
-    """
+    """2D Hertz at a/h = 10 with linear-elastic bodies: the half-width within 0.5%, the
+    bound of the Neo-Hookean run of the same mesh (test_hertz, +0.20%), that is the
+    discretisation error at a/h = 10 (8.7e-6 measured here: this mesh's linear-elastic value
+    lies near a sign change of the error, a cancellation a bound should not claim), p0 within
+    1% (+0.82%), the profile within 3% of p0 (2.0%), and at most 10 Newton iterations per
+    load step (5, 5, 4, 5 measured; the guide's "at most about 10", docs/guide/eps.md)."""
     problem, hertz, history = linear_hertz()
     a_err, p0_err, profile_err, exact = hertz_errors(problem, hertz)
     case = "Hertz 2D, linear elastic, 4 load steps, a/h = 10"
-    record_hertz_errors(verification, case, a_err, p0_err, profile_err)
+    for quantity, error, reference, tolerance in (
+        ("relative error of the half-width", a_err, "a = sqrt(4 P R / (pi E*))", "|error| < 0.005"),
+        ("relative error of the peak pressure", p0_err, "p0 = 2 P / (pi a)", "|error| < 0.01"),
+        ("RMS pressure error in |x| < 0.8 a, over p0", profile_err, PROFILE, "< 0.03"),
+    ):
+        verification(case, quantity, error, reference, tolerance, JOHNSON)
     assert exact.a / hertz.h_contact > 8
-    assert abs(a_err) < 0.01
+    assert abs(a_err) < 0.005
     assert abs(p0_err) < 0.01
     assert profile_err < 0.03
     assert not history.cutbacks

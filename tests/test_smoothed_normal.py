@@ -8,6 +8,7 @@ import dolfinx
 import numpy as np
 import pytest
 import ufl
+from conftest import across_ranks
 from mpi4py import MPI
 
 from contact_ufl.contact import master as master_module
@@ -29,6 +30,10 @@ from contact_ufl.verification.geometries import tag_single_body
 from contact_ufl.verification.scenes import curved_pair, warp_saddle
 from contact_ufl.verification.taylor_cases import curved_case, smooth_field
 
+#: what the smoothed normal is (docs/guide/contact.md): area-weighted nodal normals over each
+#: node's fan of facets, interpolated over each facet
+DEFINITION = "the smoothed normal's definition, computed here another way"
+
 #: reference coordinates of the vertices of a triangle and a quadrilateral (basix order)
 REFERENCE_VERTICES = {
     3: np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
@@ -36,7 +41,7 @@ REFERENCE_VERTICES = {
 }
 
 
-def test_fans_of_a_square_split_into_four_triangles():
+def test_fans_of_a_square_split_into_four_triangles(verification):
     """Centre 4 of the square 0-1-2-3 (counter-clockwise seen from +z): a closed fan of four
     triangles; a corner: an open fan of two, padded with the node itself."""
     triangles = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
@@ -47,9 +52,18 @@ def test_fans_of_a_square_split_into_four_triangles():
     X = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0.2]])
     nodes = np.concatenate([X[triangles], X[fans.reshape(4, -1)]], axis=1)
     normals = fan_normals(nodes, 3)
-    assert np.allclose(normals[0, 2], [0.0, 0.0, 1.0])  # the apex of a symmetric pyramid
     corner = np.cross(X[1] - X[0], X[4] - X[0]) + np.cross(X[4] - X[0], X[3] - X[0])
-    assert np.allclose(normals[0, 0], corner / np.linalg.norm(corner))
+    errors = [
+        np.abs(normals[0, 2] - [0.0, 0.0, 1.0]).max(),  # the apex of a symmetric pyramid
+        np.abs(normals[0, 0] - corner / np.linalg.norm(corner)).max(),
+    ]
+    case = "nodal normals of a pyramid over the unit square (four triangles)"
+    for quantity, error, reference in (
+        ("largest |nodal normal - e_z| at the apex", errors[0], "(0, 0, 1): the symmetry"),
+        ("largest |nodal normal - area-weighted sum| at a corner", errors[1], "the two facets"),
+    ):
+        verification(case, quantity, error, reference, "< 1e-15", "closed form")
+    assert errors[0] < 1e-15 and errors[1] < 1e-15
 
 
 def test_fans_reject_a_pinched_surface():
@@ -81,10 +95,12 @@ def warped_box_top(comm: MPI.Comm, cell: str):
 
 
 @pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
-def test_nodal_normals_gather_the_facets_of_every_rank(cell):
+def test_nodal_normals_gather_the_facets_of_every_rank(cell, verification):
     """The nodal normals of the carried fans are those of all the facets around each node,
     wherever they live: compared with the sum of the corner normals of every facet of every
-    rank. On two ranks the master surface (the top of one box) is split between them."""
+    rank. On two ranks the master surface (the top of one box) is split between them: this
+    test is meant for 2 ranks too (the gathering across ranks is what it checks), although
+    test_fans_are_the_same_on_any_number_of_ranks compares the same scene with one rank."""
     master, u, normals = warped_box_top(MPI.COMM_WORLD, cell)
     nn, comm = master.nn, MPI.COMM_WORLD
     # the reference: the corner normals of all facets of all ranks, summed at their nodes
@@ -98,7 +114,11 @@ def test_nodal_normals_gather_the_facets_of_every_rank(cell):
     np.add.at(summed, inverse.ravel(), corner.reshape(-1, 3))
     summed /= np.linalg.norm(summed, axis=1, keepdims=True)
     expected = summed[np.searchsorted(nodes, master.global_nodes)]
-    assert np.abs(normals - expected).max(initial=0.0) < 1e-13
+    error = comm.allreduce(np.abs(normals - expected).max(initial=0.0), MPI.MAX)
+    case = f"smoothed normal, warped box top ({cell}), {comm.size} rank" + "s" * (comm.size > 1)
+    quantity = "largest |nodal normal - sum of the corner normals of all ranks' facets|"
+    verification(case, quantity, error, 0.0, "< 1e-14", DEFINITION, kind="consistency")
+    assert error < 1e-14  # round-off: 1.4e-15 measured on 2 ranks
     assert comm.allreduce(len(normals), MPI.SUM) == (72 if nn == 3 else 36)  # 6 x 6 squares
     if comm.size > 1:  # every rank holds master facets, and fans reach the other's nodes
         mine = np.isin(master._ring, master.global_nodes)
@@ -115,8 +135,9 @@ def fans_by_key(master: MeshMaster) -> np.ndarray:
     return keys[first][np.searchsorted(ids, master._ring)]
 
 
+@across_ranks
 @pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
-def test_fans_are_the_same_on_any_number_of_ranks(cell):
+def test_fans_are_the_same_on_any_number_of_ranks(cell, verification):
     """The fans start at partition-independent nodes: the fans (nodes named by input index,
     in order) and the nodal normals of the distributed surface are those of the same surface
     on one rank."""
@@ -127,7 +148,13 @@ def test_fans_are_the_same_on_any_number_of_ranks(cell):
     at = order[[np.flatnonzero((ordered == k).all(axis=1))[0] for k in master.node_keys]]
     assert np.array_equal(whole.node_keys[at], master.node_keys)
     assert np.array_equal(fans_by_key(whole)[at], fans_by_key(master))
-    assert np.abs(whole_normals[at] - normals).max(initial=0.0) < 1e-14
+    difference = np.abs(whole_normals[at] - normals).max(initial=0.0)
+    difference = MPI.COMM_WORLD.allreduce(difference, MPI.MAX)
+    case = f"smoothed normal, warped box top ({cell}), {MPI.COMM_WORLD.size} ranks"
+    quantity = "largest |nodal normal - one rank's|"
+    source = "the same surface on one rank"
+    verification(case, quantity, difference, 0.0, "< 1e-14", source, kind="consistency")
+    assert difference < 1e-14
 
 
 def test_too_many_facets_around_a_node(monkeypatch):
@@ -171,16 +198,22 @@ def edge_jumps(problem, normal: str) -> np.ndarray:
 
 
 @pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
-def test_smoothed_normal_is_continuous_across_edges(cell):
-    """At a point of an edge the two facets sharing it give the same smoothed normal; their
-    facet normals differ (the surface is deformed and curved)."""
+def test_smoothed_normal_is_continuous_across_edges(cell, verification):
+    """At a point of an edge the two facets sharing it give the same smoothed normal (they
+    interpolate the same nodal normals along it); their facet normals differ (the surface
+    is deformed and curved)."""
     problem = curved_case(3, master_normal="smoothed", cell=cell)[0]
-    assert edge_jumps(problem, "smoothed").max() < 1e-13
+    jump = edge_jumps(problem, "smoothed").max()
+    case = f"smoothed normal, deformed curved master ({cell})"
+    quantity = "largest jump of the normal across a facet edge"
+    source = "the smoothed normal's definition: continuous from facet to facet"
+    verification(case, quantity, jump, 0.0, "< 1e-15", source, kind="consistency")
+    assert jump < 1e-15  # round-off
     assert edge_jumps(problem, "facet").max() > 1e-2
 
 
 @pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
-def test_smoothed_normal_twin_is_the_ufl_normal(cell):
+def test_smoothed_normal_twin_is_the_ufl_normal(cell, verification):
     """The search's NumPy normal (the pairing's, for results) is the UFL normal of the forms,
     and it is not the facet normal."""
     problem = curved_case(3, master_normal="smoothed", cell=cell)[0]
@@ -197,7 +230,12 @@ def test_smoothed_normal_twin_is_the_ufl_normal(cell):
         )
         return problem.comm.allreduce(dolfinx.fem.assemble_scalar(form), MPI.SUM)
 
-    assert integral(twin) < 1e-24
+    mismatch = np.sqrt(integral(twin))
+    case = f"smoothed normal, deformed curved master ({cell})"
+    quantity = "L2 norm of the UFL normal minus the NumPy normal on the slave surface"
+    source = "the search's NumPy normal and the forms' UFL normal (two implementations)"
+    verification(case, quantity, mismatch, 0.0, "< 1e-15", source, kind="consistency")
+    assert mismatch < 1e-15  # round-off
     assert integral(facet) > 1e-6
 
 
