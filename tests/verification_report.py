@@ -208,10 +208,12 @@ def render(records: list[dict]) -> str:
         "```",
         "",
         "```{note}",
-        f"Only some test files record so far ({len(files)}): "
+        f"Every test file that checks a computed quantity records ({len(files)} files): "
         + ", ".join(f"`{f}`" for f in files)
-        + ". The other tests of the suite check more than this page lists; it is not a "
-        "complete list of what is verified.",
+        + ". The files that check the tools (the demos and notebooks run, the docs build, "
+        "the benchmark report) do not. The page is made from a run of the default suite on "
+        "one rank: the slow tier (`make test-all`) and the comparisons of 2 ranks with one "
+        "(run by `make test`'s 2-rank half) are not in it.",
         "```",
         "",
         "The checks are of three kinds, listed apart: "
