@@ -130,6 +130,7 @@ def newton_and_force(problems: list[ContactProblem]) -> tuple[list[int], list[fl
     return its, [p.contact_force()[p.gdim - 1] for p in problems]
 
 
+@pytest.mark.serial  # a property of the step, not of the partition
 def test_first_contact_predictor_keeps_newton_flat(verification):
     """The first contact of a step from the open state: the free iterate overlaps the whole
     approach (3D Hertz: twice the contact area), and the semismooth Newton then releases
@@ -154,6 +155,7 @@ def test_first_contact_predictor_keeps_newton_flat(verification):
     assert max(abs(c) for c in changes) < 1e-8, changes
 
 
+@pytest.mark.serial  # a property of the step, not of the partition
 def test_first_contact_level_of_a_line_contact(verification):
     """2D Hertz (a line contact): the zone's edge lies at two thirds of the free iterate's
     deepest overlap here, which is the mean overlap of a parabolic strip; half the deepest

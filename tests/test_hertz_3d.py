@@ -350,6 +350,7 @@ def _one_deep_step(geometric_traction: str):
     return history.steps[-1], problem.contacts[0].integrate("normal")
 
 
+@pytest.mark.serial  # the 3D Hertz runs on 2 ranks in the rank comparisons
 def test_multiplier_weighted_geometric_terms_same_answer_fewer_iterations(verification):
     """Weighting the master's geometric tangent terms by min(t_N, lambda_N+) instead of the
     bracket t_N (``geometric_traction="multiplier"``) leaves the residual, and so the answer,

@@ -78,6 +78,7 @@ def runs():
     return run
 
 
+@pytest.mark.serial  # 2 ranks: test_extruded_ironing_equals_the_plane_one runs the 3D path
 def test_short_frictional_ironing(verification):
     """mu = 0.3 on the quick mesh, pressed in 10 steps and slid to t = 1.6 in 6: the default
     suite's check of the benchmark's 3D ironing. No cut-back; the support's force balances
