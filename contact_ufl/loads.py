@@ -134,6 +134,12 @@ class RigidMotion:
         value = self.motion(t)
         c, Q = (value, np.eye(gdim)) if _is_translation(value, gdim) else value
         c, Q = np.asarray(c, dtype=float), np.asarray(Q, dtype=float)
+        if c.shape != (gdim,) or Q.shape != (gdim, gdim):
+            raise ValueError(
+                f"RigidMotion: motion(t) must return a translation of {gdim} components, or a "
+                f"pair (translation, {gdim}x{gdim} rotation) in {gdim}D; got shapes "
+                f"{c.shape} and {Q.shape}"
+            )
         return c + (x - np.asarray(self.centre, dtype=float)) @ (Q - np.eye(gdim)).T
 
 

@@ -60,7 +60,9 @@ def test_default_eps_gives_the_same_solution(verification):
         ("relative change of the contact force", F1 / F0 - 1.0, 1e-4),
         ("relative change of the peak multiplier", peak[1] / peak[0] - 1.0, 1e-6),
     ):
-        verification(case, quantity, change, 0.0, f"|change| < {bound:g}", INDEPENDENT)
+        verification(
+            case, quantity, change, 0.0, f"|change| < {bound:g}", INDEPENDENT, kind="consistency"
+        )
     assert np.isfinite(F1) and F1 > 0
     assert abs(F1 / F0 - 1.0) < 1e-4
     assert abs(peak[1] / peak[0] - 1.0) < 1e-6
@@ -105,7 +107,9 @@ def test_newton_per_step_does_not_grow_under_refinement(verification):
         other = linear_hertz(0.005, factor * eps)
         change = other.contact_force()[1] / F - 1.0
         quantity = f"relative change of the contact force with {name}"
-        verification(case, quantity, change, 0.0, f"|change| < {bound:g}", INDEPENDENT)
+        verification(
+            case, quantity, change, 0.0, f"|change| < {bound:g}", INDEPENDENT, kind="consistency"
+        )
         assert max(s.newton_iterations for s in other.history.steps) <= 10
         assert abs(change) < bound
 

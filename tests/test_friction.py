@@ -135,6 +135,7 @@ def test_block_sticks_then_slides(verification):
         0.0,
         "< 1e-7",
         COULOMB,
+        kind="consistency",
     )
     record(
         "largest |Fx| / Fy over the steps, over mu",

@@ -35,11 +35,10 @@ def test_deep_indentation_record():
     assert record["steps"] >= 1 and record["cutbacks"] == len(record["failures"]) >= 4
     assert all(f["reason"].startswith("DIVERGED") for f in record["failures"])
     assert all(f["time"] > f["from_time"] for f in record["failures"])
-    assert all(f["inverted_cells"] >= 0 and f["active_points"] > 0 for f in record["failures"])
+    assert all(f["active_points"] > 0 for f in record["failures"])
     # the facet normal's cycling: points change contact status between the Newton iterates
     # of the tries (counted along each try, not at its end; a cycle can also be in the
     # pairing alone, which is not a status change)
-    assert all(f["status_changes"] >= 0 for f in record["failures"])
     cycling = [f for f in record["failures"] if "active-set cycling" in f["why"]]
     assert cycling and sum(f["status_changes"] > 0 for f in cycling) >= 2
 

@@ -60,10 +60,10 @@ def test_taylor_membrane(dim, side, mu, direction, verification):
         sides = kinematics._side[problem.contacts[0].projection.facet >= 0]
         facing = COMM.allreduce(int(np.count_nonzero(sides == direction)))
         assert facing > 0.9 * COMM.allreduce(len(sides))
-    result = assert_taylor_slopes(problem, dz, steps)
+    result = assert_taylor_slopes(problem, dz, steps, tol=4e-4)  # 1e-4 measured at most
     case = f"Taylor test {dim}D, membrane {side}, normal {direction:+g}, mu = {mu:g}"
     quantity = "slopes of the Taylor remainder |R1(h)|"
-    verification(case, quantity, result.slopes, 2.0, "|slope - reference| < 0.01", TAYLOR)
+    verification(case, quantity, result.slopes, 2.0, "|slope - reference| < 4e-4", TAYLOR)
 
 
 def _sandwich(dim: int) -> cu.ContactProblem:

@@ -116,11 +116,11 @@ def test_taylor_membrane_under_follower_pressure(dim, verification):
     """The tangent of the membrane energy and of the follower pressure's load stiffness
     (``ufl.derivative`` through the oriented normal), in the problem: Taylor slope 2."""
     problem, dz, steps = membrane_pressure_case(dim)
-    result = assert_taylor_slopes(problem, dz, steps, unchanged=False)
+    result = assert_taylor_slopes(problem, dz, steps, tol=3e-3, unchanged=False)  # 1e-3 measured
     case = f"Taylor test {dim}D, membrane under a follower pressure, no contact"
     quantity = "slopes of the Taylor remainder |R1(h)|"
     source = "Taylor's theorem: the remainder of an exact derivative is O(h^2)"
-    verification(case, quantity, result.slopes, 2.0, "|slope - reference| < 0.01", source)
+    verification(case, quantity, result.slopes, 2.0, "|slope - reference| < 3e-3", source)
 
 
 def test_non_orientable_membrane_is_refused():

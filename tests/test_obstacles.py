@@ -231,6 +231,7 @@ def test_block_dragged_on_a_rigid_plane_sticks_then_slips(verification):
         0.0,
         "< 1e-7",
         COULOMB,
+        kind="consistency",
     )
     note(
         "largest ||lambda_T| - mu lambda_N| / max mu lambda_N, t > 1.5",
@@ -238,6 +239,7 @@ def test_block_dragged_on_a_rigid_plane_sticks_then_slips(verification):
         0.0,
         "< 1e-14",
         COULOMB,
+        kind="consistency",
     )
     note("smallest cosine of lambda_T and the slip, t > 1.5", alignment, 1.0, "> 0.999", COULOMB)
     note(

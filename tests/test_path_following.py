@@ -123,8 +123,8 @@ def test_volume_control_equilibrium(inflated, verification):
 
 
 def test_load_control_stops_at_the_maximum(verification):
-    """The same balloon under a prescribed pressure 2% above the maximum: no step beyond
-    the maximum converges."""
+    """The same balloon under a prescribed pressure 2% above the maximum, in 4 steps: the
+    three steps below the maximum converge, and no step beyond it."""
     pressure = cu.FollowerPressure("membrane", lambda t: 1.02 * P_MAX * t)
     problem = cu.ContactProblem(balloon(pressure), verbose=False)
     with pytest.raises(cu.ConvergenceError, match="limit point"):
@@ -136,9 +136,10 @@ def test_load_control_stops_at_the_maximum(verification):
         "largest converged pressure over the closed-form maximum p_max",
         reached * 1.02,
         1.0,
-        "< 1",
+        "in [0.765, 1)",
         f"{BALLOON}: no equilibrium above its maximum",
     )
+    assert reached >= 0.75  # the steps below the maximum converged
     assert reached * 1.02 < 1.0  # stopped below the maximum
 
 

@@ -146,3 +146,11 @@ def test_a_dead_force_is_spread_over_the_reference_area(verification):
 def test_a_dead_load_of_the_wrong_shape_is_refused(value):
     with pytest.raises(ContactInputError, match=r"DeadForce on tag 2: the value is a vector of 2"):
         ContactProblem(symmetric_square(MATERIAL, [DeadForce(2, value)]), verbose=False)
+
+
+def test_a_rigid_motion_of_the_wrong_dimension_is_named():
+    def turn_3d(t):
+        return (0.0, 0.0), np.eye(3)
+
+    with pytest.raises(ContactInputError, match=r"pair \(translation, 2x2 rotation\) in 2D"):
+        ContactProblem(square_held_by(RigidMotion(turn_3d, (0.5, 0.5))), verbose=False)
