@@ -527,17 +527,53 @@ class ContactProblem:
         contact included) summed over the dofs of those facets, without the equations that
         prescribe them (assembled by :attr:`solver`, which owns the chain rule).
         """
+        local = np.zeros(self.gdim)
+        for _, forces in self._nodal_reactions(tag, domain):
+            local += forces.sum(axis=0)
+        return self.comm.allreduce(local, MPI.SUM)
+
+    @collective
+    def reaction_moment(
+        self,
+        tag: int | str | Sequence[int | str],
+        about: Sequence[float],
+        domain: int | str | None = None,
+    ) -> float | np.ndarray:
+        """Moment about the point ``about`` of the support reaction on the facets ``tag``
+        (as in :meth:`reaction`) at the current state: ``sum_a (x_a - about) x R_a`` over
+        their nodes at their current positions ``x_a``, e.g. the torque that turns a hub
+        (:class:`~contact_ufl.loads.RigidMotion`). In 2D the moment about the out-of-plane
+        axis (a number), in 3D a vector."""
+        local = np.zeros(3)
+        p = np.zeros(3)
+        p[: self.gdim] = np.asarray(about, dtype=float)
+        for x, forces in self._nodal_reactions(tag, domain, positions=True):
+            arm, force = np.zeros((len(x), 3)), np.zeros((len(x), 3))
+            arm[:, : self.gdim], force[:, : self.gdim] = x - p[: self.gdim], forces
+            local += np.cross(arm, force).sum(axis=0)
+        moment = self.comm.allreduce(local, MPI.SUM)
+        return float(moment[2]) if self.gdim == 2 else moment
+
+    def _nodal_reactions(self, tag, domain, positions: bool = False) -> list[tuple]:
+        """(current positions or None, reaction forces ``(n, gdim)``) of this rank's owned
+        nodes of the facets ``tag``, mesh by mesh (:meth:`reaction`)."""
         keys = [tag] if isinstance(tag, int | str) else list(tag)
         nodes: dict[int, list[np.ndarray]] = {}
         for key in keys:
             k, t = self.scene.locate(key, "facet", domain)
             nodes.setdefault(k, []).append(self.bulks[k].facet_dofs(t))
         R = self.solver.assemble(self.residual_form)
-        local = np.zeros(self.gdim)
+        out = []
         for k, blocks in nodes.items():
-            values = R.array[self.block_rows(k)].reshape(-1, self.gdim)
-            local += values[keysets.unique(np.concatenate(blocks))].sum(axis=0)
-        return self.comm.allreduce(local, MPI.SUM)
+            owned = keysets.unique(np.concatenate(blocks))
+            forces = R.array[self.block_rows(k)].reshape(-1, self.gdim)[owned]
+            x = None
+            if positions:
+                bulk = self.bulks[k]
+                X = bulk.V.tabulate_dof_coordinates()[owned, : self.gdim]
+                x = X + bulk.u.x.array.reshape(-1, self.gdim)[owned]
+            out.append((x, forces))
+        return out
 
     @collective
     def obstacle_reaction(self, obstacle: RigidObstacle) -> np.ndarray:

@@ -8,6 +8,7 @@ on rollers stretches it uniformly."""
 import numpy as np
 import pytest
 from conftest import symmetric_square, tagged_unit_square
+from mpi4py import MPI
 
 from contact_ufl.errors import ContactInputError
 from contact_ufl.loads import DeadForce, Dirichlet, RigidMotion
@@ -154,3 +155,80 @@ def test_a_rigid_motion_of_the_wrong_dimension_is_named():
 
     with pytest.raises(ContactInputError, match=r"pair \(translation, 2x2 rotation\) in 2D"):
         ContactProblem(square_held_by(RigidMotion(turn_3d, (0.5, 0.5))), verbose=False)
+
+
+def annulus(h: float, theta: float) -> Scene:
+    """A linear elastic annulus, radii A < B, clamped at its rim; its hub turned by
+    ``theta`` at t = 1 (a RigidMotion about the centre)."""
+    import gmsh
+
+    from contact_ufl.gmshio import gmsh_session, read_gmsh
+
+    def turn(t):
+        c, s = np.cos(theta * t), np.sin(theta * t)
+        return (0.0, 0.0), [[c, -s], [s, c]]
+
+    comm = MPI.COMM_WORLD
+    with gmsh_session("annulus", {"Mesh.MeshSizeMax": h}):
+        if comm.rank == 0:
+            outer = gmsh.model.occ.addDisk(0.0, 0.0, 0.0, B, B)
+            inner = gmsh.model.occ.addDisk(0.0, 0.0, 0.0, A, A)
+            gmsh.model.occ.cut([(2, outer)], [(2, inner)])
+            gmsh.model.occ.synchronize()
+            (_, surface), *_ = gmsh.model.getEntities(2)
+            curves = [c for _, c in gmsh.model.getBoundary([(2, surface)], oriented=False)]
+            length = {c: gmsh.model.occ.getMass(1, c) for c in curves}
+            hub = [c for c in curves if abs(length[c] - 2 * np.pi * A) < 1e-9]
+            rim = [c for c in curves if abs(length[c] - 2 * np.pi * B) < 1e-9]
+            gmsh.model.addPhysicalGroup(2, [surface], name="ring")
+            gmsh.model.addPhysicalGroup(1, hub, name="hub")
+            gmsh.model.addPhysicalGroup(1, rim, name="rim")
+            gmsh.model.mesh.generate(2)
+        data = read_gmsh(gmsh.model if comm.rank == 0 else None, comm, gdim=2)
+    return Scene.from_mesh_data(
+        data,
+        bodies=[Body("ring", LinearElastic(1.0, 0.3))],
+        dirichlet=[Dirichlet("rim", (0.0, 0.0)), Dirichlet("hub", RigidMotion(turn, (0.0, 0.0)))],
+    )
+
+
+A, B = 0.5, 1.0
+
+
+def test_the_torque_of_a_turned_hub(verification):
+    """The hub of a clamped linear elastic annulus turned by a small angle theta: the
+    torque on it (reaction_moment) against the closed form 4 pi G theta A^2 B^2 / (B^2 -
+    A^2) (u_theta = C r + D / r, u_r = 0), its error falling under refinement (P1 on the
+    polygonal annulus: 4.0e-3 at h = 0.1, 1.3e-3 at h = 0.05), and the rim's torque its
+    opposite (to the solver's tolerance)."""
+    theta, G = 1e-4, 1.0 / (2.0 * 1.3)
+    exact = 4.0 * np.pi * G * theta * A**2 * B**2 / (B**2 - A**2)
+    errors, balance = [], []
+    for h in (0.1, 0.05):
+        problem = ContactProblem(annulus(h, theta), verbose=False)
+        problem.solve(num_steps=1)
+        hub = problem.reaction_moment("hub", (0.0, 0.0))
+        rim = problem.reaction_moment("rim", (0.0, 0.0))
+        errors.append(hub / exact - 1.0)
+        balance.append(abs(hub + rim) / exact)
+    case = "annulus, linear elastic, hub turned by 1e-4 rad, rim clamped"
+    verification(
+        case,
+        "relative error of the hub's torque, h = 0.1 and 0.05",
+        errors,
+        "T = 4 pi G theta A^2 B^2 / (B^2 - A^2)",
+        "|error| < 6e-3, 2e-3",
+        "closed form (plane torsion of an annulus)",
+    )
+    verification(
+        case,
+        "|hub torque + rim torque| over the closed form",
+        balance,
+        0.0,
+        "< 1e-7",
+        "equilibrium of the converged solve",
+        kind="consistency",
+    )
+    assert abs(errors[0]) < 6e-3 and abs(errors[1]) < 2e-3
+    assert abs(errors[1]) < 0.5 * abs(errors[0])  # converging
+    assert max(balance) < 1e-7
