@@ -58,6 +58,7 @@ def test_default_master_normal_reaches_half_the_radius(verification):
     assert record_half_width(verification, case, problem) > WHOLE_ARC
 
 
+@pytest.mark.serial  # a property of the facet normal, not of the partition
 def test_facet_normal_stops_before_half_the_radius():
     """The same run with the facet normal asked for: cut back until it gives up, short of the
     end; the error says why (Newton cycles between contact states) and what removes the

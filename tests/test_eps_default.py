@@ -41,6 +41,7 @@ def test_default_eps_is_softer_modulus_over_slave_size(E_flat):
     assert float(c.friction.eps_T.value) == float(c.normal.eps_N.value)
 
 
+@pytest.mark.serial  # a property of the equations, not of the partition
 def test_default_eps_gives_the_same_solution(verification):
     """Hertz with eps_N = E/h (200 here) and with the default E/L (0.45): the contact force
     agrees to 1e-4 and the peak multiplier to 1e-6 (measured 6.5e-5 and 5.7e-7 at this mesh:

@@ -307,6 +307,7 @@ def top_displacement(problem) -> float:
     return float(total[0] / total[1])
 
 
+@pytest.mark.serial  # Newton counts, and the equations driven otherwise: not the partition
 @pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
 @pytest.mark.parametrize("gap", [0.0, 1e-3])
 def test_force_driven_patch_3d_newton_count_and_displacement_driven(cell, gap, verification):

@@ -158,6 +158,7 @@ def test_block_sticks_then_slides(verification):
         assert r["power"] < 0.0
 
 
+@pytest.mark.serial  # a property of the equations, not of the partition
 def test_objectivity_under_a_large_rotation(verification):
     """Rotating the whole frictional scene by 70 degrees rotates the contact force (to 1e-13
     of it: both runs take the same Newton iterates, so they differ by rounding, 6e-15
