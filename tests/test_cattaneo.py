@@ -4,6 +4,9 @@ import pytest
 
 from contact_ufl.verification.runs import cattaneo_mindlin_run
 
+# one rank: friction on 2 ranks is compared with one in test_ironing and test_beams
+pytestmark = pytest.mark.serial
+
 JOHNSON = "Johnson, Contact Mechanics (1985), 7.1: closed form"
 #: the mesh of the test: h = 0.0025 within 0.12 of the first point of contact (a ~ 0.05)
 MESH = "h = 0.0025 within 0.12 of the first contact (a/h ~ 20)"
