@@ -86,7 +86,10 @@ SANDWICH_IN_PLANE = {2: 1e-11, 3: 4e-8}
 ROUND_OFF = 1e-14
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize(
+    "dim",
+    [2, pytest.param(3, marks=pytest.mark.serial)],  # 3D on 2 ranks: the tube on a plate
+)
 def test_membrane_sandwich_patch(dim, verification):
     """A membrane between the patch-test blocks, master of the upper block's pair and slave
     on the lower block: uniform multipliers ``lambda_N = p`` on both pairs (to the

@@ -197,6 +197,7 @@ def edge_jumps(problem, normal: str) -> np.ndarray:
     return np.linalg.norm(first - second, axis=1)
 
 
+@pytest.mark.serial  # 2 ranks: test_taylor's smoothed 3D normal, the fans' gather test
 @pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
 def test_smoothed_normal_is_continuous_across_edges(cell, verification):
     """At a point of an edge the two facets sharing it give the same smoothed normal (they
@@ -212,6 +213,7 @@ def test_smoothed_normal_is_continuous_across_edges(cell, verification):
     assert edge_jumps(problem, "facet").max() > 1e-2
 
 
+@pytest.mark.serial  # 2 ranks: test_taylor's smoothed 3D normal, the fans' gather test
 @pytest.mark.parametrize("cell", ["tetrahedron", "hexahedron"])
 def test_smoothed_normal_twin_is_the_ufl_normal(cell, verification):
     """The search's NumPy normal (the pairing's, for results) is the UFL normal of the forms,

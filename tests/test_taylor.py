@@ -66,7 +66,10 @@ def test_taylor_smoothed_master_normal(mu, verification):
 
 
 @pytest.mark.parametrize("cell, nn", [("tetrahedron", 3), ("hexahedron", 4)])
-@pytest.mark.parametrize("mu", [0.0, 0.05])
+@pytest.mark.parametrize(
+    "mu",
+    [pytest.param(0.0, marks=pytest.mark.serial), 0.05],  # 2 ranks: with friction
+)
 def test_taylor_smoothed_master_normal_3d(cell, nn, mu, verification):
     """In 3D the smoothed normal depends on the fans of the master facet's nodes (triangles
     of tetrahedra, bilinear quadrilaterals of hexahedra), gathered with the facet's nodes:
