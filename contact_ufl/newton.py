@@ -1063,13 +1063,8 @@ class NewtonSolver:
 
     def _free_pieces(self) -> list:
         """(piece, its pairs) of the pieces with a free rigid mode and contact pairs."""
-        if self._pieces is None:
-            problem = self.problem
-            self._pieces = [
-                (piece, on)
-                for piece in free_bodies.pieces(problem)
-                if len(piece.modes) and (on := free_bodies.pairs_on(problem, piece))
-            ]
+        if self._pieces is None:  # those the problem found when it was made
+            self._pieces = [(piece, on) for piece, on in self.problem.free_pieces if on]
         return self._pieces
 
     def _turning_hint(self) -> str:

@@ -364,13 +364,20 @@ class ContactProblem:
         unique along them (collective). A membrane's tension holds what its supports
         leave free to first order (a string turning about a point of its chord), so only
         its translations along directions no support holds count."""
+        #: the pieces of the meshes with a free rigid mode, each with its contact pairs
+        #: (:mod:`contact_ufl.free_bodies`; the solver's closing iterate uses them too)
+        self.free_pieces = [
+            (piece, free_bodies.pairs_on(self, piece))
+            for piece in free_bodies.pieces(self)
+            if len(piece.modes)
+        ]
         loose = []
-        for piece in free_bodies.pieces(self):
+        for piece, on in self.free_pieces:
             modes = piece.modes
             if self.bulks[piece.mesh].membrane:
                 modes = np.eye(modes.shape[1])[: self.gdim][piece.free]
             if len(modes):
-                loose.append((piece, modes, free_bodies.pairs_on(self, piece)))
+                loose.append((piece, modes, on))
         for piece, modes, on in loose:
             if on:
                 continue
