@@ -39,7 +39,7 @@ CAUSES = {
     "limit point": "limit point",
     "status changing in": "slow, contact state changing",
 }
-"""Short names of the diagnoses of :meth:`contact_ufl.newton.NewtonSolver.diagnose`, by a
+"""Short names of the diagnoses of :meth:`contact_ufl.strategies.StepSolver.diagnose`, by a
 text each contains."""
 
 

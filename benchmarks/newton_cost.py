@@ -1,7 +1,7 @@
 """The cost of a Newton iteration and its parts, with contact and without (issue 12, item 4).
 
 Solves each scene with :class:`~contact_ufl.problem.ContactProblem` and reads the solver's
-:class:`~contact_ufl.newton.NewtonTimings` (seconds on rank 0, reset after the solver is
+:class:`~contact_ufl.timings.NewtonTimings` (seconds on rank 0, reset after the solver is
 made, so the set-up is not counted):
 
 * 2D Hertz (:func:`contact_ufl.verification.scenes.hertz_2d`, P1, depth 0.02 in two load
@@ -193,7 +193,7 @@ def _factorise(A: PETSc.Mat, options: dict, repeat: int) -> dict:
 def displacement_block(problem: ContactProblem) -> PETSc.Mat:
     """The displacement block (the meshes' displacements, no multipliers) of the contact
     tangent at the current state: the bodies tied where the contact pairs them."""
-    J = problem.solver.evaluate_jacobian(problem.solver.x)
+    J = problem.operator.evaluate_jacobian(problem.operator.x)
     layout = problem.layout
     rows = [layout.owned(b, np.arange(layout.local_sizes[b])) for b in range(len(problem.bulks))]
     index = PETSc.IS().createGeneral(np.concatenate(rows).astype(PETSc.IntType), comm=problem.comm)
@@ -203,7 +203,7 @@ def displacement_block(problem: ContactProblem) -> PETSc.Mat:
 def glued(problem: ContactProblem, options: dict, repeat: int) -> tuple[dict, dict]:
     """The factorisations of the contact tangent and of its displacement block (the glued
     bodies), timed alike (see the module's ``--glued``)."""
-    J = problem.solver.evaluate_jacobian(problem.solver.x)
+    J = problem.operator.evaluate_jacobian(problem.operator.x)
     tangent = _factorise(J, options, repeat)
     G = displacement_block(problem)
     block = _factorise(G, options, repeat)
@@ -222,7 +222,7 @@ def _per_rank(problem: ContactProblem, cpu: float, timings) -> list[dict]:
     points, and share of the rows and nonzeros of ``K`` (the gathered blocks, through
     ``T^T K T``), ``A`` (the unknowns' blocks, assembled straight) and ``T``: where the work
     is."""
-    solver = problem.solver
+    operator = problem.operator
     local = PETSc.Mat.InfoType.LOCAL
     n = max(timings.iterations, 1)
     mine = {
@@ -232,11 +232,13 @@ def _per_rank(problem: ContactProblem, cpu: float, timings) -> list[dict]:
         "search_own_s": sum(c.search_time for c in problem.contacts) / n,
         "slave_points": int(sum(len(c.projection.facet) for c in problem.contacts)),
         "unknowns": problem.layout.local_size,
-        "K_rows": solver._K.getLocalSize()[0] if solver._K is not None else 0,
-        "K_nonzeros": _nonzeros(solver._K),
-        "A_nonzeros": _nonzeros(solver._A),
-        "T_nonzeros": int(solver._T.getInfo(local)["nz_used"]),
-        "J_nonzeros": int(solver._J.getInfo(local)["nz_used"]),
+        "K_rows": operator._gathered_tangent.getLocalSize()[0]
+        if operator._gathered_tangent is not None
+        else 0,
+        "K_nonzeros": _nonzeros(operator._gathered_tangent),
+        "A_nonzeros": _nonzeros(operator._unknown_blocks),
+        "T_nonzeros": int(operator._T.getInfo(local)["nz_used"]),
+        "J_nonzeros": int(operator.matrix.getInfo(local)["nz_used"]),
     }
     return problem.comm.allgather(mine)
 
@@ -244,7 +246,7 @@ def _per_rank(problem: ContactProblem, cpu: float, timings) -> list[dict]:
 def save_tangent(problem: ContactProblem, path: str) -> None:
     """Write the contact tangent at the current state and the index set of its displacement
     unknowns (PETSc binary; read by ``benchmarks/linear_solvers.py``)."""
-    J = problem.solver.evaluate_jacobian(problem.solver.x)
+    J = problem.operator.evaluate_jacobian(problem.operator.x)
     layout = problem.layout
     rows = [layout.owned(b, np.arange(layout.local_sizes[b])) for b in range(len(problem.bulks))]
     index = PETSc.IS().createGeneral(np.concatenate(rows).astype(PETSc.IntType), comm=problem.comm)
@@ -322,7 +324,7 @@ def run(
     if glue and contact:
         record["tangent"], record["glued"] = glued(problem, options, glue)
     elif glue:  # the bulk tangent timed alike, to be replaced by the glued block's
-        J = problem.solver.evaluate_jacobian(problem.solver.x)
+        J = problem.operator.evaluate_jacobian(problem.operator.x)
         record["tangent"] = _factorise(J, options, glue)
     return record
 

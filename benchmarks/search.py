@@ -1,6 +1,6 @@
-"""Throughput of the closest-point search alone (``contact_ufl.contact.projection``).
+"""Throughput of the closest-point search alone (``contact_ufl.contact.search``).
 
-Times :func:`~contact_ufl.contact.projection.closest_points` (points per second, one core:
+Times :func:`~contact_ufl.contact.search.closest_points` (points per second, one core:
 the BLAS/OpenMP thread pools are limited to one thread) against the number of master facets,
 on three wavy master surfaces:
 
@@ -153,8 +153,13 @@ from collections.abc import Callable  # noqa: E402
 import numpy as np  # noqa: E402
 import resultfile  # noqa: E402
 
-from contact_ufl.contact import projection  # noqa: E402
-from contact_ufl.contact.projection import closest_points  # noqa: E402
+from contact_ufl.contact.search import (  # noqa: E402
+    SelfContact,
+    TreeCache,
+    closest_points,
+    numpy_search,
+)
+from contact_ufl.contact.search.numpy_facets import MasterFacets  # noqa: E402
 
 AMPLITUDE = 0.05
 
@@ -233,8 +238,7 @@ def time_call(points: np.ndarray, nodes: np.ndarray, radius: float) -> dict:
     """CPU times of a first call of ``closest_points`` (no KD-tree kept from an earlier call)
     and of a second one (the KD-trees reused), the best wall and CPU times over a few more
     calls (the trees of the unchanged master reused), and the fraction of points paired."""
-    trees = projection.TreeCache() if hasattr(projection, "TreeCache") else None
-    options = {} if trees is None else {"trees": trees}
+    options = {"trees": TreeCache()}
     start = time.process_time()
     closest_points(points, nodes, radius, **options)
     first = time.process_time() - start
@@ -259,12 +263,12 @@ def stages(points: np.ndarray, nodes: np.ndarray) -> dict:
     of the master (KD-tree reused), one K-nearest query of the centroids per point (K = 1
     and the search's K), and one exact projection per point (on the facet of its nearest
     centroid)."""
-    trees = projection.TreeCache()
-    master = projection._Master(nodes, trees)
+    trees = TreeCache()
+    master = MasterFacets(nodes, trees)
     # the KD-tree of all the centroids (one level on these even meshes)
     tree = master.levels[0].tree if hasattr(master, "levels") else master.tree
-    K = min(projection._K[nodes.shape[2]], len(nodes))
-    _, master_s, _ = best_of(lambda: projection._Master(nodes, trees))
+    K = min(numpy_search._K[nodes.shape[2]], len(nodes))
+    _, master_s, _ = best_of(lambda: MasterFacets(nodes, trees))
     _, k1_s, (_, nearest) = best_of(lambda: tree.query(points, k=1))
     _, kK_s, _ = best_of(lambda: tree.query(points, k=K))
     n = len(points)
@@ -470,10 +474,10 @@ def self_contact_sweep(n: int) -> list[dict]:
     a1 = nodes[:, 1] - nodes[:, 0]
     normals = np.stack([a1[:, 1], -a1[:, 0]], axis=1)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    rule = projection.SelfContact(facet_nodes, facet_nodes, normals)
+    rule = SelfContact(facet_nodes, facet_nodes, normals)
     records = []
     for radius in (0.05, np.inf):
-        trees = projection.TreeCache()
+        trees = TreeCache()
         start = time.process_time()
         closest_points(points, nodes, radius, trees, rule)
         first = time.process_time() - start
@@ -529,7 +533,7 @@ def points_sweep(nf: int, counts) -> list[dict]:
             times = []
             for n in counts:
                 points = slave_points(nodes.shape[2], n, h, rng)
-                trees = projection.TreeCache()
+                trees = TreeCache()
                 closest_points(points, nodes, h, trees=trees)
                 _, cpu, _ = best_of(_searcher(points, [nodes, shifted], h, trees, moved))
                 times.append(cpu)
@@ -612,7 +616,7 @@ def scene_sweep(quick: bool) -> list[dict]:
     :func:`closest_points` (the kernel the other sweeps time). Records: the CPU seconds of
     the fastest of ``SCENE_CALLS`` calls and of their median (``cpu_seconds``,
     ``cpu_median_seconds``), points/s of each, the kernel's share of them all."""
-    from contact_ufl.contact import search as search_module
+    from contact_ufl.contact.search import pairing as search_module
     from contact_ufl.problem import ContactProblem
     from contact_ufl.verification import scenes
 

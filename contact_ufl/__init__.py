@@ -27,8 +27,10 @@ The parts, as modules: :mod:`.scene` (bodies, domains, supports, loads, pairs),
 :mod:`.gmshio` (meshes from gmsh), :mod:`.materials`, :mod:`.plasticity`, :mod:`.loads`,
 :mod:`.membranes` (membranes and strings), :mod:`.contact` (the contact pair as composed
 parts), :mod:`.bulk` (the displacement and bulk
-weak form of one mesh), :mod:`.problem` (fields and forms), :mod:`.newton`
-(the SNES solver), :mod:`.stepping` (load stepping), :mod:`.results`, :mod:`.output`,
+weak form of one mesh), :mod:`.problem` (fields, forms and results), :mod:`.operator` (the
+discrete operator: residual and tangent of an iterate), :mod:`.newton` (the SNES driver),
+:mod:`.strategies` (how a load step is tried), :mod:`.diagnosis` (why it failed),
+:mod:`.stepping` (load stepping with cut-back), :mod:`.results`, :mod:`.output`,
 :mod:`.taylor`. Verification scenes and references live in :mod:`.verification`, which the
 library never imports.
 """
@@ -61,13 +63,16 @@ from contact_ufl.membranes import (
     MembraneNeoHookean,
     MembraneSVK,
 )
-from contact_ufl.newton import FIELD_SPLIT_PETSC_OPTIONS, NewtonSolver, NewtonTimings
+from contact_ufl.newton import FIELD_SPLIT_PETSC_OPTIONS, NewtonDriver
+from contact_ufl.operator import ContactOperator
 from contact_ufl.output import ResultWriter
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.problem import ContactProblem
 from contact_ufl.scene import Body, Domain, Scene
 from contact_ufl.stepping import History, LoadStepper, StepRecord
+from contact_ufl.strategies import StepSolver, default_strategies
 from contact_ufl.taylor import taylor_test
+from contact_ufl.timings import NewtonTimings
 
 __version__ = "0.1.0"
 
@@ -76,6 +81,7 @@ __all__ = [
     "Body",
     "BodyForce",
     "ContactInputError",
+    "ContactOperator",
     "ContactPair",
     "ContactProblem",
     "ConvergenceError",
@@ -95,7 +101,7 @@ __all__ = [
     "MeshData",
     "NearlyIncompressibleWarning",
     "NeoHookean",
-    "NewtonSolver",
+    "NewtonDriver",
     "NewtonTimings",
     "NonUniqueSolutionWarning",
     "ResultWriter",
@@ -106,7 +112,9 @@ __all__ = [
     "SaintVenantKirchhoff",
     "Scene",
     "StepRecord",
+    "StepSolver",
     "VolumeControl",
+    "default_strategies",
     "output",
     "read_gmsh",
     "results",

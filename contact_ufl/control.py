@@ -109,6 +109,7 @@ class VolumeConstraint:
         self.block: int | None = None
         self._value = 0.0
         self._resultant_forms = None
+        self._gathers: list = []
         self.set_time(0.0)
 
     # -- what the problem assembles -------------------------------------------------------
@@ -134,8 +135,9 @@ class VolumeConstraint:
         density = self.volume_density - self.target / self.area
         return [self.scale * density * q * self.bulk.dx(self.control.tag)]
 
-    def update(self, layout) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
-        """Set ``p_h`` to the unknown pressure; every owned dof of ``p_h`` gathers it."""
+    def update(self, x, layout) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """Set ``p_h`` to the unknown pressure (which the unknowns ``x`` hold); every owned
+        dof of ``p_h`` gathers it (:class:`~contact_ufl.coupling.Coupling`)."""
         comm = self.P.mesh.comm
         value = comm.allreduce(float(self.pressure_unknown.x.array[: self._owned_q].sum()))
         self.p.x.array[:] = self._value = value
@@ -143,7 +145,12 @@ class VolumeConstraint:
             int(layout.owned(self.block, np.zeros(1))[0]) if self._owned_q else -1, MPI.MAX
         )
         owned = self.P.dofmap.index_map.size_local
-        return [(self.p, np.full(owned, column, dtype=np.int64))]
+        self._gathers = [(self.p, np.full(owned, column, dtype=np.int64))]
+        return self._gathers
+
+    def pattern_gathers(self) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """The gathers of the last :meth:`update` (none wider)."""
+        return self._gathers
 
     @property
     def _owned_q(self) -> int:

@@ -13,13 +13,13 @@ it, a free mode is a null vector of the piece's tangent (the stored energy and d
 not change under it). Where no contact pair on the piece has a point in contact and the
 residual has a net load along a free mode (a force, or a moment over the piece's size), the
 Newton equation has no solution: the step cannot converge until the contact closes
-(:meth:`contact_ufl.newton.NewtonSolver.solve_step` then starts with its closing iterate).
+(:class:`contact_ufl.strategies.FirstTry` then starts with its closing iterate).
 
 A free mode held by a point in contact starts no closing iterate. A rotation held only by
 contact may still be held poorly: a frictionless contact of a curved surface holds it only
 through the facets of the discrete surface (the disc turning about its centre slides over
 itself), with a tangent near singular. The diagnosis of a failed step then says that the
-body is free to turn, and about which point (:meth:`contact_ufl.newton.NewtonSolver.diagnose`);
+body is free to turn, and about which point (:class:`contact_ufl.diagnosis.StepDiagnosis`);
 hold it by a support (:func:`contact_ufl.verification.scenes.hertz_2d_driven` holds the
 disc's axis).
 """
@@ -27,17 +27,25 @@ disc's axis).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import dolfinx
 import numpy as np
 from mpi4py import MPI
 
 from contact_ufl import keysets
+from contact_ufl.bulk import Bulk
 
-if TYPE_CHECKING:
-    from contact_ufl.bulk import Bulk
-    from contact_ufl.problem import ContactProblem
+
+class ContactProblem(Protocol):
+    """What this module asks of a problem: its meshes' bulks, contact pairs and numbering."""
+
+    comm: MPI.Comm
+    gdim: int
+    bulks: list[Bulk]
+    contacts: list
+
+    def block_rows(self, k: int) -> slice: ...
 
 
 @dataclass

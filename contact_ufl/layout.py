@@ -63,6 +63,38 @@ class StackedLayout:
         return self.rank_offsets[owner] + self.block_offsets[owner, block] + index - starts[owner]
 
 
+class GlobalValues:
+    """The values of a distributed vector at stacked (global) indices, on this rank: a
+    PETSc scatter made once (collective), read as often as the vector changes.
+
+    Parameters
+    ----------
+    vec
+        A vector of the layout (its communicator and numbering).
+    indices
+        Stacked indices to read; ``-1`` reads 0.
+    """
+
+    def __init__(self, vec: PETSc.Vec, indices: npt.ArrayLike):
+        indices = np.asarray(indices, dtype=np.int64)
+        self._size = len(indices)
+        self._where = np.flatnonzero(indices >= 0)
+        wanted = indices[self._where].astype(PETSc.IntType)
+        source = PETSc.IS().createGeneral(wanted, comm=PETSc.COMM_SELF)
+        self._values = PETSc.Vec().createSeq(len(wanted), comm=PETSc.COMM_SELF)
+        self._scatter = PETSc.Scatter().create(vec, source, self._values, None)
+        source.destroy()
+
+    def read(self, vec: PETSc.Vec) -> npt.NDArray[np.float64]:
+        """The values of ``vec`` at the indices (collective)."""
+        self._scatter.scatter(
+            vec, self._values, addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD
+        )
+        out = np.zeros(self._size)
+        out[self._where] = self._values.array_r
+        return out
+
+
 def chain_operator(
     rows: StackedLayout,
     cols: StackedLayout,

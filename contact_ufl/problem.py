@@ -1,13 +1,14 @@
 """The contact problem: the fields, unknowns and UFL forms of a scene, its Dirichlet data,
-pseudo-time and the step protocol of everything with history.
+pseudo-time and the step protocol of everything with history, and the results of a solve.
 
 Data flow: scene -> forms (bulk in UFL, contact terms of :mod:`contact_ufl.contact`) over
-the assembled fields ``[u, xhat_1, lambda_1, ...]`` -> the Newton solver of
-:mod:`contact_ufl.newton` (chain rule onto the unknowns ``[u, lambda_1, ...]``) -> load
-stepping of :mod:`contact_ufl.stepping` -> results. This module imports neither:
-:attr:`ContactProblem.solver` and :meth:`ContactProblem.solve` make them on first use (a
-convenience), and the results that need the chain rule (:meth:`ContactProblem.reaction`,
-:meth:`ContactProblem.contact_residual`) ask the solver, which owns it.
+the assembled fields ``[u, xhat_1, lambda_1, ...]`` -> the discrete operator of
+:mod:`contact_ufl.operator` (chain rule onto the unknowns ``[u, lambda_1, ...]``) -> the
+Newton driver of :mod:`contact_ufl.newton`, tried by the step strategies of
+:mod:`contact_ufl.strategies` -> load stepping of :mod:`contact_ufl.stepping` -> results.
+The problem composes them (:attr:`ContactProblem.solver`, made on first use); the results
+that need the chain rule (:meth:`ContactProblem.reaction`,
+:meth:`ContactProblem.contact_residual`) ask the operator, which owns it.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import functools
 import operator
 import warnings
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple
 
 import dolfinx
 import numpy as np
@@ -29,14 +30,16 @@ from contact_ufl.bulk import Bulk
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.control import VolumeConstraint, VolumeControl
+from contact_ufl.diagnosis import StepDiagnosis
 from contact_ufl.errors import NonUniqueSolutionWarning
 from contact_ufl.layout import StackedLayout
 from contact_ufl.mpi import collective, global_bounds, global_diameter
+from contact_ufl.newton import NewtonDriver
+from contact_ufl.operator import AssembledSystem, ContactOperator, DirichletRows
+from contact_ufl.results import inverted_cell_centres
 from contact_ufl.scene import Domain, Scene
-
-if TYPE_CHECKING:
-    from contact_ufl.newton import NewtonSolver
-    from contact_ufl.stepping import History, LoadStepper, StepRecord
+from contact_ufl.stepping import History, LoadStepper, StepRecord
+from contact_ufl.strategies import StepSolver
 
 
 def _support_hint(piece, modes: np.ndarray) -> str:
@@ -107,9 +110,10 @@ class ContactProblem:
     The problem holds one :class:`~contact_ufl.bulk.Bulk` per mesh (its displacement,
     bodies, loads, plastic histories and supports), the contact interfaces between them, the
     residual and Jacobian forms over the assembled fields, the Dirichlet rows and the
-    pseudo-time. It is solved by a
-    :class:`~contact_ufl.newton.NewtonSolver` (:attr:`solver`) stepped by a
-    :class:`~contact_ufl.stepping.LoadStepper` (:attr:`stepper`), both made on first use::
+    pseudo-time. It is solved by a :class:`~contact_ufl.strategies.StepSolver`
+    (:attr:`solver`: the discrete operator, the Newton driver and the step strategies)
+    stepped by a :class:`~contact_ufl.stepping.LoadStepper` (:attr:`stepper`), both made on
+    first use::
 
         problem = ContactProblem(scene)
         problem.solve(num_steps=4)
@@ -201,7 +205,7 @@ class ContactProblem:
         self._build_dirichlet()
         self._check_rigid_modes()
         self._report_overlaps()
-        self._solver: NewtonSolver | None = None
+        self._solver: StepSolver | None = None
         self._stepper: LoadStepper | None = None
         self._closed = False
 
@@ -345,7 +349,7 @@ class ContactProblem:
         the first step resolves unless the pair ramps it in (``overlap_ramp``)."""
         for c in self.contacts:
             overlap = c.initial_overlap
-            if overlap > c.touching and self.verbose and self.comm.rank == 0:
+            if overlap > c.round_off and self.verbose and self.comm.rank == 0:
                 how = (
                     "resolved in the first load step (ContactPair.overlap_ramp ramps it in)"
                     if c.pair.overlap_ramp is None
@@ -365,7 +369,7 @@ class ContactProblem:
         leave free to first order (a string turning about a point of its chord), so only
         its translations along directions no support holds count."""
         #: the pieces of the meshes with a free rigid mode, each with its contact pairs
-        #: (:mod:`contact_ufl.free_bodies`; the solver's closing iterate uses them too)
+        #: (:mod:`contact_ufl.free_bodies`; the step strategies and diagnosis use them too)
         self.free_pieces = [
             (piece, free_bodies.pairs_on(self, piece))
             for piece in free_bodies.pieces(self)
@@ -457,23 +461,76 @@ class ContactProblem:
 
     # -- solver and load stepping (made on first use) -----------------------------------
     @property
-    def solver(self) -> NewtonSolver:
-        """The :class:`~contact_ufl.newton.NewtonSolver` of this problem, made on first use
-        with :attr:`petsc_options` (the state it starts from is the converged state of step
-        0), or the one made directly for it. One solver per problem: it owns the search
-        state of the contacts and the chain operator T."""
+    def solver(self) -> StepSolver:
+        """The :class:`~contact_ufl.strategies.StepSolver` of this problem, made on first
+        use with :attr:`petsc_options` (the state it starts from is the converged state of
+        step 0). One solver per problem: its operator owns the search state of the contacts
+        and the chain operator T."""
         if self._closed:
             raise RuntimeError("this problem is closed (problem.close()): make a new one")
         if self._solver is None:
-            from contact_ufl.newton import NewtonSolver
-
-            self._solver = NewtonSolver(self, self.petsc_options, self.petsc_options_prefix)
+            self._solver = self._make_solver()
         return self._solver
+
+    @property
+    def operator(self) -> ContactOperator:
+        """The discrete operator of :attr:`solver`: the state of an iterate, the residual
+        ``T^T r`` and the tangent ``T^T K T``."""
+        return self.solver.operator
+
+    def _make_solver(self) -> StepSolver:
+        """The operator at the current state, committed as the converged state of step 0,
+        the Newton driver over its callbacks, and the step strategies (collective)."""
+        dirichlet = DirichletRows(
+            self.dirichlet_rows, self.dirichlet_scale, lambda: self.prescribed(self.t)
+        )
+        couplings = [*self.contacts, *self.controls]
+        system = AssembledSystem(
+            self.fields,
+            self.unknowns,
+            self.layout,
+            self.full_layout,
+            self.residual_form,
+            self.jacobian_form,
+            couplings,
+            dirichlet,
+            len(self.bulks),
+        )
+        operator = ContactOperator(system, pattern_superset=self.gdim == 2)
+        operator.update_pairing(operator.x)
+        self.commit(operator.x)  # the initial state is the converged state of step 0
+        self.begin_step()
+        operator.update_pairing(operator.x)
+        operator.first_tangent()
+        # a force scale: 1e-11 of E_max L^(d-1) with L the scene's diameter
+        size, E = self.scales()
+        options = {"snes_atol": 1e-11 * E * size ** (self.gdim - 1)} | self.petsc_options
+        newton = NewtonDriver(
+            self.comm,
+            operator.residual,
+            operator.jacobian,
+            operator.residual_vector,
+            operator.matrix,
+            options,
+            self.petsc_options_prefix,
+            field_splits=operator.field_splits(self.gdim),
+            timings=operator.timings,
+            verbose=self.verbose,
+        )
+        diagnosis = StepDiagnosis(
+            self.comm, self.contacts, self.free_pieces, lambda: inverted_cell_centres(self)
+        )
+        return StepSolver(self, operator, newton, diagnosis)
+
+    def net_free_load(self, residual: np.ndarray, piece: free_bodies.Piece) -> float:
+        """The load of the residual (a vector of the unknowns) along the free rigid modes of
+        ``piece`` (:func:`contact_ufl.free_bodies.net_free_load`; collective)."""
+        return free_bodies.net_free_load(self, residual, piece)
 
     def close(self) -> None:
         """Free the PETSc objects of this problem's solver (collective), for scripts that make
-        many problems on more than one rank (see :meth:`NewtonSolver.close
-        <contact_ufl.newton.NewtonSolver.close>`); the fields keep their values. A problem is
+        many problems on more than one rank (see :meth:`StepSolver.close
+        <contact_ufl.strategies.StepSolver.close>`); the fields keep their values. A problem is
         also a context manager that closes on leaving: ``with ContactProblem(scene) as
         problem: ...``."""
         if self._solver is not None:
@@ -491,8 +548,6 @@ class ContactProblem:
         """The :class:`~contact_ufl.stepping.LoadStepper` of :attr:`solver`, made on first
         use."""
         if self._stepper is None:
-            from contact_ufl.stepping import LoadStepper
-
             self._stepper = LoadStepper(self, self.solver)
         return self._stepper
 
@@ -532,7 +587,7 @@ class ContactProblem:
 
         It is the residual of the displacement equations (internal minus external forces,
         contact included) summed over the dofs of those facets, without the equations that
-        prescribe them (assembled by :attr:`solver`, which owns the chain rule).
+        prescribe them (assembled by :attr:`operator`, which owns the chain rule).
         """
         local = np.zeros(self.gdim)
         for _, forces in self._nodal_reactions(tag, domain):
@@ -569,7 +624,7 @@ class ContactProblem:
         for key in keys:
             k, t = self.scene.locate(key, "facet", domain)
             nodes.setdefault(k, []).append(self.bulks[k].facet_dofs(t))
-        R = self.solver.assemble(self.residual_form)
+        R = self.operator.assemble(self.residual_form)
         out = []
         for k, blocks in nodes.items():
             owned = keysets.unique(np.concatenate(blocks))
@@ -610,12 +665,12 @@ class ContactProblem:
     @collective
     def contact_residual(self) -> PETSc.Vec:
         """The contact terms alone of the residual at the current state, as a vector of the
-        unknowns (master parts gathered through the chain rule of :attr:`solver`)."""
+        unknowns (master parts gathered through the chain rule of :attr:`operator`)."""
         if self._contact_residual_form is None:
             self._contact_residual_form = jit.form(
                 self._contact_residual_ufl, entity_maps=[c.slave.entity_map for c in self.contacts]
             )
-        return self.solver.assemble(self._contact_residual_form)
+        return self.operator.assemble(self._contact_residual_form)
 
     @collective
     def contact_force(self, k: int | None = None) -> np.ndarray:

@@ -1,9 +1,10 @@
 """Load stepping with cut-back: the pseudo-time from the current state to its end.
 
 Every step follows the step protocol of the problem: :meth:`begin_step
-<contact_ufl.problem.ContactProblem.begin_step>`, a Newton solve (:meth:`NewtonSolver.solve_step
-<contact_ufl.newton.NewtonSolver.solve_step>`), then, once converged, :meth:`commit
-<contact_ufl.problem.ContactProblem.commit>`. A failed step is restored and halved.
+<contact_ufl.problem.ContactProblem.begin_step>`, the step's strategies
+(:meth:`StepSolver.solve_step <contact_ufl.strategies.StepSolver.solve_step>`), then, once
+converged, :meth:`commit <contact_ufl.problem.ContactProblem.commit>`. A step that all
+strategies fail is restored and halved: the cut-back, the last resort.
 """
 
 from __future__ import annotations
@@ -11,15 +12,33 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
+from mpi4py import MPI
 
 from contact_ufl.errors import ContactInputError, ConvergenceError
+from contact_ufl.strategies import StepSolver
 
-if TYPE_CHECKING:
-    from contact_ufl.newton import NewtonSolver
-    from contact_ufl.problem import ContactProblem
+
+class SteppedProblem(Protocol):
+    """What the load stepper asks of the problem it steps: pseudo-time, the step protocol
+    of everything with history, and a step's results."""
+
+    t: float
+    unknowns: list
+    verbose: bool
+    comm: MPI.Comm
+
+    def set_time(self, t: float) -> None: ...
+
+    def begin_step(self) -> None: ...
+
+    def commit(self, x) -> None: ...
+
+    def active_points(self) -> int: ...
+
+    def contact_force(self) -> np.ndarray: ...
 
 
 @dataclass
@@ -34,7 +53,7 @@ class StepRecord:
         Pseudo-time reached.
     newton_iterations
         Newton iterations of the step (of all tries, see
-        :meth:`~contact_ufl.newton.NewtonSolver.solve_step`).
+        :meth:`~contact_ufl.strategies.StepSolver.solve_step`).
     residual
         Norm of the residual at convergence.
     active_points
@@ -68,8 +87,8 @@ class Cutback(NamedTuple):
     reason
         SNES's converged reason of its last try (a ``DIVERGED_*`` name).
     why
-        What went wrong at its last iterate (:meth:`NewtonSolver.diagnose
-        <contact_ufl.newton.NewtonSolver.diagnose>`): inverted elements and where, contact
+        What went wrong at its last iterate (:meth:`StepSolver.diagnose
+        <contact_ufl.strategies.StepSolver.diagnose>`): inverted elements and where, contact
         cycling, or a stalled residual (a limit point).
     """
 
@@ -95,7 +114,7 @@ class History:
 
 
 class LoadStepper:
-    """Load stepping with cut-back of a problem and its Newton solver.
+    """Load stepping with cut-back of a problem and its step solver.
 
     Usually made by :attr:`ContactProblem.stepper
     <contact_ufl.problem.ContactProblem.stepper>`.
@@ -105,7 +124,7 @@ class LoadStepper:
     problem
         The problem (pseudo-time, step protocol, results of a step).
     solver
-        Its Newton solver.
+        Its step solver.
     verbose
         Print one line per load step on rank 0 (``None``: as the problem's ``verbose``
         says at the time).
@@ -116,7 +135,7 @@ class LoadStepper:
         Accepted steps and cut-backs of all solves so far.
     """
 
-    def __init__(self, problem: ContactProblem, solver: NewtonSolver, verbose: bool | None = None):
+    def __init__(self, problem: SteppedProblem, solver: StepSolver, verbose: bool | None = None):
         self.problem = problem
         self.solver = solver
         self.verbose = verbose
@@ -127,7 +146,7 @@ class LoadStepper:
         num_steps: int = 10,
         t_end: float = 1.0,
         max_cutbacks: int = 8,
-        callback: Callable[[ContactProblem, StepRecord], None] | None = None,
+        callback: Callable[[SteppedProblem, StepRecord], None] | None = None,
     ) -> History:
         """Load stepping from the current pseudo-time to ``t_end`` in ``num_steps`` steps.
 
@@ -189,7 +208,7 @@ class LoadStepper:
             )
             self.history.steps.append(record)
             problem.commit(solver.x)
-            solver.forget_state()
+            solver.operator.forget_state()
             self._print(_format(record))
             if callback is not None:
                 callback(problem, record)
@@ -202,7 +221,7 @@ class LoadStepper:
         for f, a in zip(self.problem.unknowns, saved, strict=True):
             f.x.array[:] = a
         self.problem.set_time(t)
-        self.solver.forget_state()
+        self.solver.operator.forget_state()
 
     def _print(self, text: str) -> None:
         verbose = self.problem.verbose if self.verbose is None else self.verbose

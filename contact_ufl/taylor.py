@@ -50,19 +50,19 @@ def taylor_test(problem, direction: PETSc.Vec, steps: Sequence[float]) -> Taylor
     any slave point changed master facet or contact status over the steps (the remainder
     then has a kink and no order can be expected).
     """
-    comm, solver = problem.comm, problem.solver
-    z = solver.x.copy()
-    solver.forget_state()
-    R0 = solver.evaluate_residual(z)
+    comm, operator = problem.comm, problem.operator
+    z = operator.x.copy()
+    operator.forget_state()
+    R0 = operator.evaluate_residual(z)
     facets0, active0 = _signature(problem)
     Jdz = R0.duplicate()
-    solver.evaluate_jacobian(z).mult(direction, Jdz)
+    operator.evaluate_jacobian(z).mult(direction, Jdz)
     zeroth, first = [], []
     facets_changed = active_changed = False
     for h in steps:
         zh = z.copy()
         zh.axpy(h, direction)
-        Rh = solver.evaluate_residual(zh)
+        Rh = operator.evaluate_residual(zh)
         facets, active = _signature(problem)
         facets_changed |= not _same(facets, facets0, comm)
         active_changed |= not _same(active, active0, comm)
@@ -70,7 +70,7 @@ def taylor_test(problem, direction: PETSc.Vec, steps: Sequence[float]) -> Taylor
         zeroth.append(Rh.norm())
         Rh.axpy(-h, Jdz)
         first.append(Rh.norm())
-    solver.evaluate_residual(z)
+    operator.evaluate_residual(z)
     return TaylorResult(
         np.asarray(steps, float), np.array(zeroth), np.array(first), facets_changed, active_changed
     )

@@ -121,11 +121,11 @@ def test_the_bulk_cells_pack_no_contact_data():
     assert set(contact[0].integral_types) == {dolfinx.fem.IntegralType.exterior_facet}
 
 
-def _move_off(solver) -> None:
-    """Set the solver's state to its unknowns moved by up to 1e-3 (another state)."""
-    x = solver.x.copy()
+def _move_off(operator) -> None:
+    """Set the operator's state to its unknowns moved by up to 1e-3 (another state)."""
+    x = operator.x.copy()
     x.array[:] += 1e-3 * np.sin(np.arange(len(x.array)))
-    solver._set_state(x)
+    operator.set_state(x)
 
 
 @pytest.mark.parametrize(
@@ -143,10 +143,10 @@ def test_a_fixed_bulk_stiffness_is_assembled_once_a_step(make, fixed, case, veri
     assembled part by part, at a state that is not the one ``B`` was assembled at, to
     round-off (consistency; measured equal)."""
     problem = ContactProblem(make(depth=0.01).scene, verbose=False)
-    solver = problem.solver
-    constant, varying = assembly.split_constant(solver._unknown_forms)
+    operator = problem.operator
+    constant, varying = assembly.split_constant(operator._unknown_forms)
     assert sum(len(parts) for row in constant for parts in row) == fixed
-    assert (solver._B is not None) == bool(fixed)
+    assert (operator._fixed_blocks is not None) == bool(fixed)
     assert all(
         p._cpp_object.coefficients or p._cpp_object.constants
         for row in varying
@@ -154,12 +154,12 @@ def test_a_fixed_bulk_stiffness_is_assembled_once_a_step(make, fixed, case, veri
         for p in parts
     )
     problem.solve(num_steps=1)  # B made on the step's first tangent, then reused
-    _move_off(solver)
-    J = solver._J.duplicate()
-    solver._assemble_unknown_blocks(J)
-    expected = solver._J.duplicate()
+    _move_off(operator)
+    J = operator.matrix.duplicate()
+    operator._assemble_unknown_blocks(J)
+    expected = operator.matrix.duplicate()
     expected.zeroEntries()
-    assembly.assemble_matrix(expected, solver._unknown_forms)
+    assembly.assemble_matrix(expected, operator._unknown_forms)
     expected.assemble()
     (rows, columns, values), (rows_e, columns_e, values_e) = (
         J.getValuesCSR(),
@@ -182,13 +182,13 @@ def test_the_gathered_blocks_drop_only_zeros_between_points(make):
     """The gathered blocks' matrix ``K`` holds no coupling between two points of the
     master-node data (a quadrature space) and assembles to DOLFINx's full pattern's matrix
     exactly: what it drops is zero."""
-    solver = ContactProblem(make(depth=0.01).scene, verbose=False).solver
-    _move_off(solver)
-    full = assembly.create_matrix(solver._gathered_forms)
+    operator = ContactProblem(make(depth=0.01).scene, verbose=False).operator
+    _move_off(operator)
+    full = assembly.create_matrix(operator._gathered_forms)
     matrices = []
-    for K in (full, solver._K):
+    for K in (full, operator._gathered_tangent):
         K.zeroEntries()
-        assembly.assemble_matrix(K, solver._gathered_forms)
+        assembly.assemble_matrix(K, operator._gathered_forms)
         K.assemble()
         indptr, columns, values = K.getValuesCSR()
         shape = (len(indptr) - 1, K.getSize()[1])

@@ -11,6 +11,7 @@ from mpi4py import MPI
 from contact_ufl.materials import LinearElastic
 from contact_ufl.mpi import global_diameter
 from contact_ufl.problem import ContactProblem
+from contact_ufl.strategies import default_strategies
 from contact_ufl.verification import scenes
 
 INDEPENDENT = (
@@ -124,7 +125,7 @@ def first_contact(dim: int, h_contact: float, level) -> ContactProblem:
         scene = scenes.hertz_3d(h_contact=h_contact, depth=0.01).scene
         scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=None)
     problem = ContactProblem(scene, verbose=False)
-    problem.solver.first_contact_level = level
+    problem.solver.strategies = default_strategies(first_contact_level=level)
     problem.solve(num_steps=1)
     return problem
 
@@ -192,8 +193,6 @@ def test_first_contact_level_of_a_line_contact(verification):
 
 
 def test_first_contact_level_is_checked():
-    problem = ContactProblem(scenes.hertz_2d(h_contact=0.02, depth=0.02).scene, verbose=False)
     for level in ("median", 1.5, 0.0):
-        problem.solver.first_contact_level = level
         with pytest.raises(ValueError, match="first_contact_level must be 'mean'"):
-            problem.solve(num_steps=1)
+            default_strategies(first_contact_level=level)

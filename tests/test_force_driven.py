@@ -2,7 +2,7 @@
 
 A body whose only support in the contact direction is the contact itself is free until it
 touches: at the start of the first step its tangent is singular and no Newton step finds the
-contact. The solver's closing iterate (:meth:`contact_ufl.newton.NewtonSolver.solve_step`)
+contact. The solver's closing iterate (:class:`contact_ufl.strategies.FirstTry`)
 ties the points nearest the master surface for one iterate; the solution is that of the
 same equations, so it must equal the displacement-driven solution that carries the same
 force (2D Hertz, stiff realistic moduli), and the closed form of the patch test (3D, from a
@@ -154,7 +154,7 @@ def test_force_driven_hertz_from_a_gap_with_the_field_split(force, verification)
 def test_without_the_closing_iterate_the_first_step_fails():
     """The same scene, the closing iterate switched off: no step converges."""
     problem = cu.ContactProblem(hertz_scene("force", 8e7), verbose=False)
-    problem.solver.close_gaps = False
+    problem.solver.strategies = cu.default_strategies(close_gaps=False)
     with pytest.raises(cu.ConvergenceError, match="from t = 0 "):
         problem.solve(num_steps=2, max_cutbacks=1)
 
@@ -236,7 +236,7 @@ def rotational_stiffness(problem: cu.ContactProblem) -> float:
     load.set(0.0)
     load.array[2 * top + 1] = x
     ksp = solver.snes.getKSP()
-    ksp.setOperators(solver.evaluate_jacobian(solver.x))
+    ksp.setOperators(solver.operator.evaluate_jacobian(solver.x))
     turn = load.duplicate()
     ksp.solve(load, turn)
     moment = problem.comm.allreduce(float(np.sum(x * x)), MPI.SUM)

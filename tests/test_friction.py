@@ -68,13 +68,13 @@ def test_no_nan_where_q_vanishes():
     c = problem.contacts[0]
     c.friction.lambda_T.x.array[:] = 0.0
     c.friction.mask_n.x.array[:] = 0.0  # no slip history
-    solver = problem.solver
-    solver.forget_state()
+    operator = problem.operator
+    operator.forget_state()
     import dolfinx.fem.petsc
 
-    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
-    R = solver.evaluate_residual(solver.x)
-    J = solver.evaluate_jacobian(solver.x)
+    dolfinx.fem.petsc.assign(problem.unknowns, operator.x)
+    R = operator.evaluate_residual(operator.x)
+    J = operator.evaluate_jacobian(operator.x)
     assert np.isfinite(R.norm()) and np.isfinite(J.norm())
 
 

@@ -161,8 +161,9 @@ def test_diagnosis_of_the_iterates(iterates, expected):
     from contact_ufl.verification import scenes
 
     problem = ContactProblem(scenes.hertz_2d_driven("force", 1.0, h_contact=0.1), verbose=False)
-    problem.solver.iterates = iterates
-    assert expected in problem.solver.diagnose()
+    diagnosis = problem.solver.diagnosis
+    diagnosis.signatures = [signature for _, signature in iterates]
+    assert expected in diagnosis.diagnose([norm for norm, _ in iterates])
 
 
 @pytest.mark.slow

@@ -125,7 +125,7 @@ def _check_forces(history: list[dict], measured: dict, verification, case: str) 
 def test_every_step_converged_to_the_end(ironing, verification):
     """SNES's converged reason of every accepted step, the cut-backs (none on the quick mesh
     since a failed full-step try is followed by one from the predicted state,
-    :attr:`NewtonSolver.predictor <contact_ufl.newton.NewtonSolver.predictor>`; 3 with
+    :class:`~contact_ufl.strategies.PredictedStateRetry`; 3 with
     friction before) and, against the snapshot (regression), the numbers of accepted steps,
     unknowns and Newton iterations (within 2%)."""
     mu = ironing["mu"]

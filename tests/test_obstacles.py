@@ -330,8 +330,8 @@ def test_slip_follows_the_obstacle(dim, verification):
     """A slave body carried along with the obstacle's rigid motion (translation and rotation)
     since the last converged step does not slip on it: zero slip, unchanged gaps."""
     problem, _, _ = obstacle_case(dim, mu=0.05)
-    c, solver = problem.contacts[0], problem.solver
-    problem.commit(solver.x)
+    c, operator = problem.contacts[0], problem.operator
+    problem.commit(operator.x)
     problem.begin_step()
     gap = c.projection.gap.copy()
     p1, Q1 = c.kinematics.pose
@@ -342,9 +342,9 @@ def test_slip_follows_the_obstacle(dim, verification):
     X = problem.V.tabulate_dof_coordinates()[:, :dim]
     x = X + problem.u.x.array.reshape(-1, dim)
     problem.u.x.array[:] = (p2 + (x - p1) @ (Q2 @ Q1.T).T - X).ravel()
-    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
-    solver.forget_state()
-    solver.evaluate_residual(solver.x)
+    dolfinx.fem.petsc.assign(problem.unknowns, operator.x)
+    operator.forget_state()
+    operator.evaluate_residual(operator.x)
     slip = np.abs(c.friction.slip_at_points()).max(initial=0.0)
     slip = problem.comm.allreduce(slip, op=MPI.MAX)
     paired = c.projection.facet >= 0

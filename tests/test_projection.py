@@ -1,4 +1,4 @@
-"""Tests of the closest-point projection (`contact_ufl.contact.projection`)."""
+"""Tests of the closest-point projection (`contact_ufl.contact.search.closest_points`)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from contact_ufl.contact.projection import closest_points, shape_functions
+from contact_ufl.contact.search import closest_points, shape_functions
 
 #: rank-local NumPy and C kernels on arrays made here: the 2-rank run would repeat them
 #: on each rank

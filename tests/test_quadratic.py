@@ -1,7 +1,7 @@
 """Quadratic elements in contact: degree-2 displacement on straight and curved geometry.
 
 The master facets are then quadratic (3-node segments in 2D, 6-node triangles in 3D): the
-closest point on them is found by Newton (:mod:`contact_ufl.contact.curved`), its
+closest point on them is found by Newton (:mod:`contact_ufl.contact.search.curved`), its
 linearisation has the facet's curvature, and the tangent stays the derivative of the
 residual (Taylor remainders of order 2), frictionless and in slip.
 """
@@ -18,11 +18,10 @@ from mpi4py import MPI
 from test_self_contact import _slot_scene
 from test_taylor import SLOPE_TOL, check_zeroth_slopes, record_slopes
 
-from contact_ufl.contact import curved
 from contact_ufl.contact.interface import ContactInterface
 from contact_ufl.contact.obstacles import RigidPlane
-from contact_ufl.contact.projection import closest_points, shape_functions
 from contact_ufl.contact.quadrature import composite_quadrature, iso_subdivisions
+from contact_ufl.contact.search import closest_points, curved, shape_functions
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import ContactInputError
 from contact_ufl.materials import LinearElastic

@@ -15,15 +15,25 @@ from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_
 from test_quadratic import random_quadrilaterals, random_segments, random_triangles
 from test_search_exact import near_and_far
 
-from contact_ufl.contact import compiled, projection
-from contact_ufl.contact.projection import TreeCache, closest_points
-from contact_ufl.contact.search import ClosestPointSearch
+from contact_ufl.contact.search import (
+    FACET_KINDS,
+    ClosestPointSearch,
+    SelfContact,
+    TreeCache,
+    closest_points,
+    compiled,
+    facet_kind,
+)
+from contact_ufl.contact.search import closest as closest_module
+from contact_ufl.contact.search.curved import bernstein_hull
+from contact_ufl.contact.search.hierarchy import Hierarchy
+from contact_ufl.contact.search.kinds import QUADRATIC
 from contact_ufl.problem import ContactProblem
 from contact_ufl.verification import scenes
 
 FIELDS = ("xi", "y", "normal", "gap", "distance", "sliding")
 #: the reference of the records: the package's other implementation of the same search
-NUMPY_SEARCH = "this code's NumPy search (CONTACT_UFL_SEARCH=numpy)"
+NUMPY_SEARCH = "this code's NumPy search (backend='numpy')"
 #: The bound of the flat kinds' fields (size ~1), compiled against NumPy: round-off (measured
 #: equal but for 1.1e-16 in the gap); the margin allows another compiler's order of sums.
 FLAT = 1e-14
@@ -120,7 +130,7 @@ SURFACES = {
 @pytest.mark.parametrize("radius", [np.inf, 0.05])
 @serial
 def test_compiled_equals_numpy(make, nf, radius, monkeypatch, verification):
-    """Consistency: the compiled search and the NumPy one (``CONTACT_UFL_SEARCH=numpy``)
+    """Consistency: the compiled search and the NumPy one (its oracle, ``backend="numpy"``)
     find the same facets and, to round-off, the same closest points.
 
     The flat kinds repeat the NumPy operations (equal to the last bit but for the order of
@@ -132,13 +142,12 @@ def test_compiled_equals_numpy(make, nf, radius, monkeypatch, verification):
     rng = np.random.default_rng(nf + 11)
     nodes = make(rng, nf)
     points = near_and_far(rng, nodes, 400)
-    fast = closest_points(points, nodes, radius)
-    monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
-    slow = closest_points(points, nodes, radius)
+    fast = closest_points(points, nodes, radius, backend="compiled")
+    slow = closest_points(points, nodes, radius, backend="numpy")
     np.testing.assert_array_equal(fast.facet, slow.facet)
     assert 0 < np.count_nonzero(fast.facet >= 0)
     paired = fast.facet >= 0
-    quadratic = projection.facet_kind(*nodes.shape[1:]) in projection.QUADRATIC
+    quadratic = facet_kind(*nodes.shape[1:]) in QUADRATIC
     fields_tol, M_tol = (QUADRATIC_FIELDS, QUADRATIC_M) if quadratic else (FLAT, FLAT)
     fields = max(
         np.abs(getattr(fast, k)[paired] - getattr(slow, k)[paired]).max() for k in FIELDS[:-1]
@@ -211,7 +220,7 @@ _ROW = np.dtype([("lo", "<f4", (3, 4)), ("hi", "<f4", (3, 4)), ("child", "<i8", 
 _EMPTY = 1 << 62
 
 
-def _leaf_slots(hierarchy: projection._Hierarchy):
+def _leaf_slots(hierarchy: Hierarchy):
     """The slots of the walk's rows that hold a leaf: their float boxes (lo, hi: (L, 3)) and
     the leaves' facets (start, count)."""
     buffer = hierarchy.tree
@@ -249,11 +258,11 @@ def test_tree_boxes_are_the_tightest_floats_around_the_leaves(make, scale):
     a bound by one float exactly where the nearest float is on the wrong side of it."""
     rng = np.random.default_rng(11)
     nodes = np.ascontiguousarray(make(rng, 300) * scale)
-    hierarchy = projection._Hierarchy(nodes)
+    hierarchy = Hierarchy(nodes)
     hierarchy.refit(nodes)
-    nf, nn, g = nodes.shape
-    kind = projection.facet_kind(nn, g)
-    hull = projection.bernstein_hull(kind, nodes) if kind in projection.QUADRATIC else nodes
+    nf, nodes_per_facet, g = nodes.shape
+    kind = facet_kind(nodes_per_facet, g)
+    hull = bernstein_hull(kind, nodes) if kind in QUADRATIC else nodes
     lo_f, hi_f, start, count = _leaf_slots(hierarchy)
     order = np.argsort(start)
     lo_f, hi_f, start = lo_f[order], hi_f[order], start[order]
@@ -278,7 +287,7 @@ def test_refit_measures_the_change_and_knows_an_unchanged_master():
     quarter of the largest facet radius, and replaces it beyond."""
     rng = np.random.default_rng(5)
     nodes = np.ascontiguousarray(triangle_soup(rng, 500))
-    hierarchy = projection._Hierarchy(nodes)
+    hierarchy = Hierarchy(nodes)
     hierarchy.refit(nodes)
     assert hierarchy.fitted(nodes)
     moved = nodes.copy()
@@ -305,7 +314,7 @@ def test_build_cache_and_concurrent_builds(tmp_path):
     """Four processes building the kernel at once into an empty cache directory: all load
     it, one library named by the source hash remains, no temporary file is left."""
     env = {**os.environ, "CONTACT_UFL_CACHE_DIR": str(tmp_path)}
-    code = "from contact_ufl.contact import compiled; compiled.kernel(); print('ok')"
+    code = "from contact_ufl.contact.search import compiled; compiled.kernel(); print('ok')"
     runs = [
         subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE, text=True)
         for _ in range(4)
@@ -349,11 +358,27 @@ def test_a_build_error_is_raised_on_every_rank(monkeypatch):
 
 @serial
 def test_numpy_search_on_request(monkeypatch):
-    """``CONTACT_UFL_SEARCH=numpy`` selects the NumPy search (no compiled kernel used)."""
-    kinds = ((2, 2), (3, 3), (4, 3), (3, 2), (6, 3), (9, 3))  # flat and quadratic
-    assert all(projection._compiled(nn, gdim) for nn, gdim in kinds)
+    """The back end is the ``backend`` argument; without it ``CONTACT_UFL_SEARCH``, else the
+    compiled search, for every facet kind; an unknown name is an error."""
+    kinds = [(kind.nodes_per_facet, kind.gdim) for kind in FACET_KINDS]
+    compiled_backend = closest_module.compiled_backend
+    monkeypatch.delenv("CONTACT_UFL_SEARCH", raising=False)
+    assert all(compiled_backend(None, n, gdim) for n, gdim in kinds)
+    assert not any(compiled_backend("numpy", n, gdim) for n, gdim in kinds)
     monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
-    assert not any(projection._compiled(nn, gdim) for nn, gdim in kinds)
+    assert not any(compiled_backend(None, n, gdim) for n, gdim in kinds)
+    assert all(compiled_backend("compiled", n, gdim) for n, gdim in kinds)
+    with pytest.raises(ValueError, match="back end 'fortran'"):
+        closest_points(np.zeros((1, 2)), np.zeros((1, 2, 2)), backend="fortran")
+
+
+@serial
+def test_the_oracle_comparison_covers_every_facet_kind():
+    """The surfaces of :func:`test_compiled_equals_numpy` hold every facet kind of the
+    table (the NumPy search is the oracle of the compiled one for each)."""
+    rng = np.random.default_rng(0)
+    covered = {facet_kind(*make(rng, 8).shape[1:]) for make in SURFACES}
+    assert covered == {kind.name for kind in FACET_KINDS}
 
 
 @pytest.mark.parametrize("search", ["compiled", "numpy"])
@@ -469,17 +494,17 @@ def test_self_contact_bins_keep_their_trees(monkeypatch):
     a1 = nodes[:, 1] - nodes[:, 0]
     normals = np.stack([a1[:, 1], -a1[:, 0]], axis=1)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    rule = projection.SelfContact(facet_nodes, facet_nodes, normals)
+    rule = SelfContact(facet_nodes, facet_nodes, normals)
     points = nodes.mean(axis=1)
-    assert n > projection._DIRECTIONS_MIN
+    assert n > closest_module._DIRECTIONS_MIN
     built = []
-    init = projection._Hierarchy.__init__
+    init = Hierarchy.__init__
 
     def counted(self, nodes):
         built.append(len(nodes))
         init(self, nodes)
 
-    monkeypatch.setattr(projection._Hierarchy, "__init__", counted)
+    monkeypatch.setattr(Hierarchy, "__init__", counted)
     trees = TreeCache()
     first = closest_points(points, nodes, 0.05, trees, rule)
     assert len(built) > 1 and len(trees.parts) > 1
@@ -503,7 +528,7 @@ def cell_order(points: np.ndarray) -> np.ndarray:
     ``1024^gdim`` grid over their bounding box: the points of a cell, then of its neighbours,
     come one after the other (they walk the same branches of a tree while it is in cache).
     Stable: equal keys in the given order. The reference of the compiled search's order
-    (``_Hierarchy.order``)."""
+    (``Hierarchy.order``)."""
     lo = points.min(axis=0)
     span = float((points.max(axis=0) - lo).max())
     if not (np.isfinite(span) and span > 0.0):
@@ -555,10 +580,8 @@ def test_exact_ties_break_as_the_numpy_search(cells, kind, monkeypatch, verifica
     rng = np.random.default_rng(5)
     errors = []
     for order in (np.arange(len(nodes)), rng.permutation(len(nodes))):
-        fast = closest_points(points, nodes[order], np.inf)
-        monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
-        slow = closest_points(points, nodes[order], np.inf)
-        monkeypatch.delenv("CONTACT_UFL_SEARCH")
+        fast = closest_points(points, nodes[order], np.inf, backend="compiled")
+        slow = closest_points(points, nodes[order], np.inf, backend="numpy")
         np.testing.assert_array_equal(fast.facet, slow.facet)
         errors += [np.abs(getattr(fast, k) - getattr(slow, k)).max() for k in FIELDS[:-1]]
     case = f"compiled search: exact ties on a flat lattice of {len(nodes)} {kind}"
@@ -578,9 +601,7 @@ def test_far_from_the_origin(offset, monkeypatch):
         base = make(rng, nf)
         points = near_and_far(rng, base, 300) * 1e-3 + offset
         nodes = base * 1e-3 + offset
-        fast = closest_points(points, nodes, np.inf)
-        monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
-        slow = closest_points(points, nodes, np.inf)
-        monkeypatch.delenv("CONTACT_UFL_SEARCH")
+        fast = closest_points(points, nodes, np.inf, backend="compiled")
+        slow = closest_points(points, nodes, np.inf, backend="numpy")
         np.testing.assert_array_equal(fast.facet, slow.facet)
         np.testing.assert_allclose(fast.y, slow.y, rtol=0, atol=1e-14 * abs(offset))

@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 from test_projection import segment_polyline, triangle_soup, warped_quads, wavy_quads
 
-from contact_ufl.contact import projection
-from contact_ufl.contact.projection import TreeCache, closest_points, shape_functions
-from contact_ufl.contact.search import fan_columns
+from contact_ufl.contact.search import TreeCache, closest_points, fan_columns, shape_functions
+from contact_ufl.contact.search import closest as closest_module
+from contact_ufl.contact.search.numpy_facets import MasterFacets
+from contact_ufl.contact.search.numpy_search import spatial_order
 
 #: rank-local NumPy and C kernels on arrays made here: the 2-rank run would repeat them
 #: on each rank
@@ -193,11 +194,11 @@ def test_reused_tree_after_the_master_moves(verification):
 def test_points_searched_in_cell_order(make, nf, surface, monkeypatch, verification):
     """The points ordered by cells before the search (as on a large master surface): the
     results come back in the order of the points given."""
-    monkeypatch.setattr(projection, "_SORT", 0)
+    monkeypatch.setattr(closest_module, "_SORT", 0)
     rng = np.random.default_rng(nf + 2)
     nodes = make(rng, nf)
     points = near_and_far(rng, nodes, 30)
-    order = projection._spatial_order(points)
+    order = spatial_order(points)
     assert not np.array_equal(order, np.arange(len(points)))  # the order changes
     error = check(points, nodes, 0.3)[1]
     record(verification, f"pruned search: {surface}, points in cell order", error)
@@ -239,13 +240,13 @@ def test_graded_master_candidates(monkeypatch):
     monkeypatch.setenv("CONTACT_UFL_SEARCH", "numpy")
     fine, graded, points = _graded_master()
     pairs = []
-    lower_bound = projection._Master.lower_bound
+    lower_bound = MasterFacets.lower_bound
 
     def counted(self, x, f, pid=None):
         pairs.append(len(f))
         return lower_bound(self, x, f, pid)
 
-    monkeypatch.setattr(projection._Master, "lower_bound", counted)
+    monkeypatch.setattr(MasterFacets, "lower_bound", counted)
     for radius in (0.04, np.inf):
         counts = []
         for nodes in (fine, graded):

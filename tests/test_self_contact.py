@@ -18,9 +18,15 @@ from scipy.spatial import ConvexHull
 from test_taylor import SLOPE_TOL, record_slopes
 
 import contact_ufl as cu
-from contact_ufl.contact import projection
-from contact_ufl.contact.projection import SelfContact, closest_points
-from contact_ufl.contact.search import release_master_side
+from contact_ufl.contact.search import (
+    SelfContact,
+    TreeCache,
+    closest_points,
+    numpy_search,
+    release_master_side,
+)
+from contact_ufl.contact.search import closest as closest_module
+from contact_ufl.contact.search.numpy_facets import MasterFacets
 from contact_ufl.errors import ContactInputError
 from contact_ufl.problem import ContactProblem
 from contact_ufl.verification import scenes
@@ -83,7 +89,7 @@ def _facet_points(nodes: np.ndarray, facet_nodes: np.ndarray):
 
 def _brute_force(points, nodes, rule: SelfContact, radius=np.inf):
     """Distance and facet of each point over its admissible facets, one point at a time."""
-    centre = projection._Master(nodes).axis
+    centre = MasterFacets(nodes).axis
     dist = np.full(len(points), np.inf)
     for p, x in enumerate(points):
         f = np.arange(len(nodes))
@@ -120,7 +126,7 @@ def test_self_contact_searched_again(slit, radius):
     facet by facet."""
     nodes, facet_nodes = slit()
     points, rule = _facet_points(nodes, facet_nodes)
-    trees = projection.TreeCache()
+    trees = TreeCache()
     closest_points(points, nodes, radius, trees, rule)
     proj = closest_points(points, nodes, radius, trees, rule)
     expected = _brute_force(points, nodes, rule)
@@ -137,15 +143,15 @@ def test_self_contact_by_normal_bins(slit, radius, monkeypatch):
     nodes, facet_nodes = slit()
     points, rule = _facet_points(nodes, facet_nodes)
     reference = closest_points(points, nodes, radius, self_contact=rule)
-    monkeypatch.setattr(projection, "_DIRECTIONS_MIN", 0)
+    monkeypatch.setattr(closest_module, "_DIRECTIONS_MIN", 0)
     sizes = []
-    search = projection._search
+    search = closest_module._search
 
     def counted(points, nodes, *args):
         sizes.append(len(nodes))
         return search(points, nodes, *args)
 
-    monkeypatch.setattr(projection, "_search", counted)
+    monkeypatch.setattr(closest_module, "_search", counted)
     proj = closest_points(points, nodes, radius, self_contact=rule)
     assert len(sizes) > 1 and max(sizes) < len(nodes)  # bins, each without some facets
     np.testing.assert_array_equal(proj.facet, reference.facet)
@@ -178,8 +184,8 @@ def test_self_contact_blocks_and_order(slit, monkeypatch):
     nodes, facet_nodes = slit()
     points, rule = _facet_points(nodes, facet_nodes)
     reference = closest_points(points, nodes, self_contact=rule)
-    monkeypatch.setattr(projection, "_BLOCK", 7)
-    monkeypatch.setattr(projection, "_SORT", 0)
+    monkeypatch.setattr(numpy_search, "_BLOCK", 7)
+    monkeypatch.setattr(closest_module, "_SORT", 0)
     proj = closest_points(points, nodes, self_contact=rule)
     np.testing.assert_array_equal(proj.facet, reference.facet)
     np.testing.assert_array_equal(proj.distance, reference.distance)

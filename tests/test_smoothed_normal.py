@@ -12,17 +12,11 @@ from conftest import across_ranks
 from mpi4py import MPI
 
 from contact_ufl.contact import master as master_module
-from contact_ufl.contact.facets import FACET_EDGES
-from contact_ufl.contact.master import (
-    CYCLIC_ORDER,
-    MeshMaster,
-    fan_normals,
-    node_fans,
-    smoothed_normals_3d,
-)
+from contact_ufl.contact.master import CYCLIC_ORDER, MeshMaster, node_fans
 from contact_ufl.contact.obstacles import RigidPlane
 from contact_ufl.contact.pair import ContactPair
-from contact_ufl.contact.projection import shape_functions
+from contact_ufl.contact.search import FACET_EDGES, shape_functions
+from contact_ufl.contact.search.normals import fan_normals, smoothed_normals_3d
 from contact_ufl.errors import ContactInputError
 from contact_ufl.layout import StackedLayout
 from contact_ufl.problem import ContactProblem

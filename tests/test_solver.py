@@ -11,9 +11,11 @@ from mpi4py import MPI
 
 from contact_ufl.errors import ConvergenceError
 from contact_ufl.loads import Dirichlet
-from contact_ufl.newton import FIELD_SPLIT_PETSC_OPTIONS, NewtonSolver, NewtonTimings
+from contact_ufl.newton import FIELD_SPLIT_PETSC_OPTIONS
 from contact_ufl.problem import ContactProblem
 from contact_ufl.stepping import LoadStepper
+from contact_ufl.strategies import default_strategies
+from contact_ufl.timings import NewtonTimings
 from contact_ufl.verification import scenes
 
 #: the package's field split with linear solves tight enough to compare with MUMPS's
@@ -67,7 +69,7 @@ def test_diverging_step_is_cut_back(verification):
     force is that of four steps without cut-back (a frictionless hyperelastic problem does
     not depend on the load path; consistency, to the Newton tolerance)."""
     problem = hertz_problem(snes_max_it=3)
-    problem.solver.predictor = None
+    problem.solver.strategies = default_strategies(predictor=None)
     history = problem.solve(num_steps=1)
     assert len(history.cutbacks) >= 1
     assert history.cutbacks[0][0] == pytest.approx(1.0)
@@ -96,10 +98,10 @@ def test_cutbacks_run_out_with_a_clear_error():
 def test_solver_and_stepping_made_by_hand(verification):
     """``problem.solve`` is the solver and the load stepping composed: made by hand they give
     the same steps, Newton iterations and forces (to the last bit on one rank; on two, MUMPS's
-    parallel factorisation is reproducible only to round-off); a problem has one solver."""
+    parallel factorisation is reproducible only to round-off)."""
     problem = hertz_problem()
-    solver = NewtonSolver(problem)
-    assert problem.solver is solver
+    solver = problem.solver
+    solver.strategies = default_strategies()
     history = LoadStepper(problem, solver).solve(num_steps=4)
     reference = hertz_problem()
     reference.solve(num_steps=4)
@@ -121,8 +123,6 @@ def test_solver_and_stepping_made_by_hand(verification):
     quantity = "max difference of residuals, contact force, reaction, over |F|"
     verification(HERTZ, quantity, error, 0.0, tol, source, kind="consistency")
     assert error <= tol
-    with pytest.raises(ValueError, match="has a solver already"):
-        NewtonSolver(problem)
 
 
 def test_a_dropped_problem_is_freed():
@@ -169,7 +169,7 @@ def test_a_failed_step_says_where_elements_invert():
     iterate inverts elements (its residual is not a number); the error names the step, the
     reason and where the elements inverted (the loaded block's cells)."""
     problem = ContactProblem(scenes.patch(pressure=3.0), verbose=False)
-    problem.solver.fallback_linesearch = None
+    problem.solver.strategies = default_strategies(fallback_line_search=None)
     with pytest.raises(ConvergenceError, match=r"load step 1.*inverted elements in \d+ cells"):
         problem.solve(num_steps=1, max_cutbacks=1)
     (first, second) = problem.history.cutbacks
@@ -185,15 +185,17 @@ def test_solver_pattern_holds_the_pairings_met():
     from petsc4py import PETSc
 
     problem = hertz_problem()
-    solver = problem.solver
-    timings = solver.timings
+    operator = problem.operator
+    timings = operator.timings
     timings.reset()
     problem.solve(num_steps=2)
     assert timings.new_patterns >= 1
     assert timings.analyses < timings.new_patterns
-    J = solver.evaluate_jacobian(solver.x)
+    J = operator.evaluate_jacobian(operator.x)
     union = J.duplicate(copy=True)
-    union.axpy(1.0, solver._JT, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    union.axpy(
+        1.0, operator._chained_tangent, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+    )
     assert union.getInfo()["nz_used"] == J.getInfo()["nz_used"]
 
 
@@ -203,7 +205,7 @@ def test_rebuilt_solver_pattern_gives_the_same_solution(verification):
     results = []
     for slack in (0.5, -1.0):
         problem = hertz_problem()
-        problem.solver.pattern_slack = slack
+        problem.operator.pattern.slack = slack
         problem.solve(num_steps=2)
         results.append((problem.solver.timings.analyses, problem.solver.x.array.copy()))
     (kept, x_kept), (rebuilt, x_rebuilt) = results
@@ -224,7 +226,7 @@ def test_a_failed_first_try_is_tried_again_from_the_predicted_state(verification
     forces, counts = {}, {}
     for predictor in (None, "retry", "first"):
         problem = hertz_problem()
-        problem.solver.predictor = predictor
+        problem.solver.strategies = default_strategies(predictor=predictor)
         problem.solve(num_steps=1, t_end=0.25)
         problem.solver.snes.setTolerances(max_it=3)
         problem.solve(num_steps=3, t_end=1.0)
@@ -247,13 +249,13 @@ def test_a_solve_at_its_start_time_predicts_nothing(verification):
     state (it raised ZeroDivisionError with the predicted state first), and makes the
     iterations of the steps without a predicted state (the same force to round-off)."""
     problem = hertz_problem()
-    problem.solver.predictor = "first"
+    problem.solver.strategies = default_strategies(predictor="first")
     problem.solve(num_steps=1, t_end=0.25)
     problem.begin_step()
     assert problem.solver.solve_step(problem.t)[0]
     problem.solve(num_steps=1, t_end=0.5)
     reference = hertz_problem()
-    reference.solver.predictor = None
+    reference.solver.strategies = default_strategies(predictor=None)
     reference.solve(num_steps=2, t_end=0.5)
     assert problem.t == pytest.approx(0.5)
     error = difference(problem.contact_force()[1], reference.contact_force()[1])
@@ -264,10 +266,8 @@ def test_a_solve_at_its_start_time_predicts_nothing(verification):
 
 
 def test_an_unknown_predictor_is_refused():
-    problem = hertz_problem()
-    problem.solver.predictor = "linear"
     with pytest.raises(ValueError, match="predictor must be 'retry', 'first' or None"):
-        problem.solve(num_steps=1)
+        default_strategies(predictor="linear")
 
 
 def test_field_split_solver_gives_the_same_solution(verification):
@@ -277,7 +277,7 @@ def test_field_split_solver_gives_the_same_solution(verification):
     results = []
     for options in ({}, FIELD_SPLIT):
         problem = hertz_problem(**options)
-        problem.solver.pattern_slack = -1.0  # a new pattern, and a reset, at the second step
+        problem.operator.pattern.slack = -1.0  # a new pattern, and a reset, at the second step
         problem.solver.timings.reset()
         problem.solve(num_steps=2)
         results.append((problem.solver, problem.solver.x.array.copy()))
@@ -343,12 +343,12 @@ def test_solver_matrix_rebuilt_inside_a_newton_solve(verification):
     results = []
     for slack in (0.5, -1.0):
         problem = ContactProblem(scenes.hertz_3d(h_contact=0.025).scene, verbose=False)
-        problem.solver.pattern_slack = slack
+        problem.operator.pattern.slack = slack
         problem.solve(num_steps=2)
         results.append((problem.solver, problem.solver.x.array.copy()))
     (kept, x_kept), (rebuilt, x_rebuilt) = results
-    assert kept._retired is None  # the union stayed within the slack
-    assert rebuilt._retired is not None  # replaced inside a Newton solve
+    assert kept.newton._retired is None  # the union stayed within the slack
+    assert rebuilt.newton._retired is not None  # replaced inside a Newton solve
     assert rebuilt.timings.iterations == kept.timings.iterations
     error = difference(x_rebuilt, x_kept)
     source = "the solve with the default pattern slack"
@@ -367,25 +367,29 @@ def test_a_pairing_within_the_solver_pattern_keeps_the_analysis(monkeypatch, ver
 
     def solve(grow_always: bool):
         problem = ContactProblem(scenes.hertz_3d(h_contact=0.02).scene, verbose=False)
-        solver = problem.solver
+        operator = problem.operator
         # Newton from the open state, its many pairings (the first contact's predictor
         # iterate starts from about the final zone and meets fewer)
-        solver.first_contact_level = None
+        problem.solver.strategies = default_strategies(first_contact_level=None)
         if grow_always:
-            monkeypatch.setattr(solver, "_within_solver_pattern", lambda keys: False)
-        add, missing = solver._add_gathered_blocks, []
+            monkeypatch.setattr(operator.pattern, "within_matrix", lambda keys: False)
+        add, missing = operator._add_gathered_blocks, []
 
         def add_checked(J):
             union = J.duplicate(copy=False)
-            union.axpy(1.0, solver._JT, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            union.axpy(
+                1.0,
+                operator._chained_tangent,
+                structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN,
+            )
             missing.append(union.getInfo()["nz_used"] - J.getInfo()["nz_used"])
             union.destroy()
             add(J)
 
-        monkeypatch.setattr(solver, "_add_gathered_blocks", add_checked)
-        solver.timings.reset()
+        monkeypatch.setattr(operator, "_add_gathered_blocks", add_checked)
+        operator.timings.reset()
         problem.solve(num_steps=2)
-        return solver.timings, solver.x.array.copy(), missing
+        return operator.timings, operator.x.array.copy(), missing
 
     (kept, x_kept, missing), (grown, x_grown, _) = solve(False), solve(True)
     assert kept.analyses < grown.analyses
@@ -407,7 +411,7 @@ def test_a_closed_problem_frees_its_solver_and_refuses_to_solve():
     with hertz_problem() as problem:
         problem.solve(num_steps=1)
         solver = problem.solver
-        held = [solver.snes, solver._J, solver._T, solver.x]
+        held = [solver.snes, solver.operator.matrix, solver.operator._T, solver.x]
         u, force = problem.u.x.array.copy(), problem.contact_force()
     assert all(obj.handle == 0 for obj in held)
     np.testing.assert_array_equal(problem.u.x.array, u)
@@ -455,17 +459,17 @@ def test_an_error_in_a_callback_is_raised_and_leaves_the_problem_usable(monkeypa
     and unknowns of the last converged step) and the next solve works (the SNES's vectors
     are not left locked)."""
     problem = ContactProblem(scenes.hertz_2d(h_contact=0.05, depth=0.01).scene, verbose=False)
-    solver = problem.solver
-    update = solver._update_contact
+    operator = problem.operator
+    update = operator.update_pairing
 
     def broken(*args, **kwargs):
         raise RuntimeError("a bug in the contact update")
 
-    monkeypatch.setattr(solver, "_update_contact", broken)
+    monkeypatch.setattr(operator, "update_pairing", broken)
     with pytest.raises(RuntimeError, match="a bug in the contact update"):
         problem.solve(num_steps=1)
     assert problem.t == 0.0  # the failed step is undone
-    monkeypatch.setattr(solver, "_update_contact", update)
+    monkeypatch.setattr(operator, "update_pairing", update)
     problem.solve(num_steps=1)
     assert problem.t == 1.0 and len(problem.history.steps) == 1
     assert problem.contact_force()[1] != 0.0 and not problem.history.cutbacks
@@ -484,14 +488,18 @@ def test_unknown_blocks_assembled_straight_give_the_chain_rule_tangent(mu, verif
         scenes.hertz_2d(h_contact=0.02, depth=0.01, mu=mu).scene, verbose=False
     )
     problem.solve(num_steps=1)
-    solver = problem.solver
-    assert solver._A is not None and solver._K is not None  # the split is in use
-    J = solver.evaluate_jacobian(solver.x)
+    operator = problem.operator
+    assert (
+        operator._unknown_blocks is not None and operator._gathered_tangent is not None
+    )  # the split is in use
+    J = operator.evaluate_jacobian(operator.x)
     K = assembly.create_matrix(problem.jacobian_form)
     assembly.assemble_matrix(K, problem.jacobian_form)
     K.assemble()
-    whole = K.PtAP(solver._T)
-    solver._zero_dirichlet_rows(whole)
+    whole = K.PtAP(operator._T)
+    layout, dirichlet = problem.layout, operator.system.dirichlet
+    rows = (layout.rank_offsets[layout.rank] + dirichlet.rows).astype(PETSc.IntType)
+    whole.zeroRows(rows, diag=dirichlet.scale)
     whole.axpy(-1.0, J, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
     assert J.norm() > 0.0
     error = whole.norm() / J.norm()

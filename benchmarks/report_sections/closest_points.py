@@ -79,7 +79,7 @@ RADII = (1.0, 10.0, 100.0, None)
 SECTIONS = (
     Section(
         "Closest-point search",
-        "The closest-point search alone (`projection.closest_points`, one core), in CPU "
+        "The closest-point search alone (`search.closest_points`, one core), in CPU "
         "points per second of one process. Synthetic masters: a wavy surface of segments "
         "(2D), triangles or bilinear quadrilaterals (3D), slave points on a perturbed copy "
         "of it, search radius h (about half the points paired) to infinite (all paired); the "

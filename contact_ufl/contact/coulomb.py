@@ -100,9 +100,9 @@ class CoulombLaw:
     in_contact
         Where the normal law counts the point as in contact (a UFL condition; see
         :func:`disc_projection`). ``None``: where ``t_N > 0``.
-    touching
+    round_off
         The normal law's length of round-off: a slip within it of zero counts as stick
-        (a trial traction within ``eps_T touching`` of the disc; :func:`disc_projection`).
+        (a trial traction within ``eps_T round_off`` of the disc; :func:`disc_projection`).
     mu
         Friction coefficient (> 0).
     eps_T
@@ -116,7 +116,7 @@ class CoulombLaw:
         mu: float,
         eps_T: float,
         in_contact=None,
-        touching: float = 0.0,
+        round_off: float = 0.0,
     ):
         self.kinematics = k = kinematics
         self.slave: SlaveSurface = k.slave
@@ -144,8 +144,8 @@ class CoulombLaw:
         self.y_n = self.reference.y_n
         self.slip = self.mask_n * tangential(k.x - self.y_n)
         self.q = tangential(self.lambda_T) + self.eps_T * self.slip
-        self.touching = touching
-        self.t_T = disc_projection(self.q, self.mu * t_N, in_contact, self.eps_T * touching)
+        self.round_off = round_off
+        self.t_T = disc_projection(self.q, self.mu * t_N, in_contact, self.eps_T * round_off)
 
     @property
     def mask_n(self) -> dolfinx.fem.Function:
@@ -185,10 +185,10 @@ class CoulombLaw:
         return self.reference.gathers()
 
     # -- the step protocol ------------------------------------------------------------
-    def update_history(self, T, x, block_slice) -> None:
-        """Refresh the slip reference at the current state (through T where it is
-        gathered from the displacement)."""
-        self.reference.update_history(T, x, block_slice)
+    def follow(self, x, gathers: list) -> None:
+        """Move the slip reference with the master to the unknowns ``x`` (through this
+        law's gathers in ``gathers``, where it is gathered from the displacement)."""
+        self.reference.follow(x, gathers)
 
     def commit(self, x, normal_traction: np.ndarray, in_contact: np.ndarray | None = None) -> None:
         """Remember the converged projection: the reference of the next step's slip.
@@ -250,7 +250,7 @@ class CoulombLaw:
         self, normal_traction: np.ndarray, in_contact: np.ndarray | None = None
     ) -> np.ndarray:
         """Mask of the owned slave points in stick (``|q| <= mu t_N``, within the round-off
-        band ``eps_T touching``), of those in contact; ``normal_traction``: ``t_N`` at the
+        band ``eps_T round_off``), of those in contact; ``normal_traction``: ``t_N`` at the
         owned points; ``in_contact``: the mask of the points in contact (default:
         ``t_N > 0``; see :func:`disc_projection`)."""
         return self._disc_at_points(normal_traction, in_contact)[0]
@@ -266,7 +266,7 @@ class CoulombLaw:
 
     def _disc_at_points(self, normal_traction: np.ndarray, in_contact: np.ndarray | None):
         q, radius = self._trial_and_radius(normal_traction)
-        round_off = float(self.eps_T.value) * self.touching
+        round_off = float(self.eps_T.value) * self.round_off
         return disc_projection_at_points(q, radius, in_contact, round_off)
 
     def _tangential(self, w: np.ndarray) -> np.ndarray:

@@ -1,9 +1,8 @@
-"""Contact surfaces as facets of a mesh: the tagged facets, their cells, normals and edges.
+"""Contact surfaces as facets of a mesh: the tagged facets, their cells and normals.
 
-Conventions shared by the slave and the master side (and by :mod:`.projection`): a facet of
-``nn`` nodes is a segment (2 nodes, 2D), a triangle (3 nodes) or a bilinear quadrilateral
-(4 nodes, basix vertex order) in 3D; a quadratic facet (:mod:`.curved`) has these as its
-vertices, and its edges (:data:`FACET_EDGES`, :func:`on_edges`) are those of its vertices.
+Conventions shared by the slave and the master side: the facet kinds of
+:mod:`contact_ufl.contact.search.kinds` (a segment in 2D, a triangle or a bilinear
+quadrilateral in basix vertex order in 3D, and their quadratic versions).
 """
 
 from __future__ import annotations
@@ -89,19 +88,3 @@ def outward_normals(vertices: np.ndarray, cell_centres: np.ndarray) -> np.ndarra
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     sign = np.sign(np.einsum("fd,fd->f", n, vertices.mean(axis=1) - cell_centres))
     return n * sign[:, None]
-
-
-#: Edges of a master facet by its (oriented) node numbers: the end points of a segment, the
-#: edges of a triangle and of a bilinear quadrilateral (basix vertex order).
-FACET_EDGES = {2: [(0,), (1,)], 3: [(0, 1), (0, 2), (1, 2)], 4: [(0, 1), (0, 2), (1, 3), (2, 3)]}
-
-
-def on_edges(nn: int, xi: np.ndarray, tol: float = 1e-12) -> np.ndarray:
-    """Which edges of :data:`FACET_EDGES` hold the points ``xi`` ``(n, fdim)`` of facets of
-    ``nn`` nodes, ``(n, ne)``."""
-    if nn == 2:
-        return np.stack([xi[:, 0] <= tol, xi[:, 0] >= 1 - tol], axis=1)
-    s, t = xi[:, 0], xi[:, 1]
-    if nn == 3:
-        return np.stack([t <= tol, s <= tol, s + t >= 1 - tol], axis=1)
-    return np.stack([t <= tol, s <= tol, s >= 1 - tol, t >= 1 - tol], axis=1)

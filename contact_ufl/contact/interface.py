@@ -31,6 +31,7 @@ import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from contact_ufl import jit
 from contact_ufl.contact.coulomb import CoulombLaw
@@ -40,8 +41,7 @@ from contact_ufl.contact.master import MeshMaster
 from contact_ufl.contact.normal import NormalLaw
 from contact_ufl.contact.obstacles import ObstacleKinematics
 from contact_ufl.contact.pair import ContactPair
-from contact_ufl.contact.projection import Projection
-from contact_ufl.contact.search import ClosestPointSearch
+from contact_ufl.contact.search import ClosestPointSearch, Projection
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
 from contact_ufl.layout import StackedLayout
@@ -160,7 +160,7 @@ class ContactInterface:
                 master_u, master_tags, master_block, master_orientation, pair
             )
         eps_N = pair.eps_N if pair.eps_N is not None else default_eps(self.slave, modulus)
-        self.normal = NormalLaw(self.slave, eps_N, self.touching)
+        self.normal = NormalLaw(self.slave, eps_N, self.round_off)
         #: the initial overlap of each slave point (a positive reference gap), and the gap
         #: the laws see: less the part of it not yet ramped in (``ContactPair.overlap_ramp``)
         self.overlap = np.where(self.reference.facet >= 0, np.maximum(self.reference.gap, 0), 0)
@@ -182,7 +182,7 @@ class ContactInterface:
                 pair.mu,
                 pair.eps_T or eps_N,
                 self.normal.in_contact_condition(self.gap, self.kinematics.mask),
-                self.touching,
+                self.round_off,
             )
             if pair.frictional
             else None
@@ -211,7 +211,7 @@ class ContactInterface:
             np.vstack([self.slave.X.reshape(-1, gdim), self.master.X_nodes.reshape(-1, gdim)]),
         )
         #: a gap within round-off of zero, ``1e-12`` of the surfaces' size (see ``macaulay``)
-        self.touching = 1e-12 * size
+        self.round_off = 1e-12 * size
         #: the margin of the points whose master terms enter the tangent (``_engaged_only``)
         self.engaged_margin = 1e-6 * size
         radius = pair.search_radius or 0.25 * size
@@ -222,7 +222,7 @@ class ContactInterface:
             "two sides would both have to be searched",
         )
         search = ClosestPointSearch(
-            self.slave, self.master, radius, self.touching, pair.self_contact
+            self.slave, self.master, radius, self.round_off, pair.self_contact
         )
         kinematics = MeshKinematics(self.u, self.slave, self.master, search)
         self.reference = kinematics.check_facing(
@@ -239,7 +239,7 @@ class ContactInterface:
         self.master = obstacle = pair.master
         obstacle.validate(comm, gdim)
         size = global_diameter(comm, self.slave.X.reshape(-1, gdim))
-        self.touching = 1e-12 * size
+        self.round_off = 1e-12 * size
         radius = pair.search_radius or 0.25 * size
         kinematics = ObstacleKinematics(self.u, self.slave, obstacle, radius)
         self.reference = kinematics.check_facing(
@@ -291,11 +291,16 @@ class ContactInterface:
         lam = np.maximum(self.normal.multiplier_at_points(), 0.0)
         self.slave.set_at_points(self.geometric_shift, np.minimum(t_N, lam) - t_N)
 
-    def update(self, layout: StackedLayout) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
-        """Search, and refresh the point data of the kinematics.
+    def update(
+        self, x: PETSc.Vec, layout: StackedLayout
+    ) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
+        """Search, refresh the point data of the kinematics, and move the slip reference
+        with the master (:class:`~contact_ufl.coupling.Coupling`).
 
         Parameters
         ----------
+        x
+            The unknowns (whose values the displacements hold).
         layout
             Layout of the unknowns (one displacement block per mesh, then the multipliers).
 
@@ -311,7 +316,10 @@ class ContactInterface:
             proj.gap = np.where(proj.facet >= 0, proj.gap - shift, proj.gap)
         self._set_geometric_shift()
         gathers += self.friction.gathers() if self.friction else []
-        return gathers if self.pair.on_obstacle else self._engaged_only(gathers)
+        gathers = gathers if self.pair.on_obstacle else self._engaged_only(gathers)
+        if self.friction:
+            self.friction.follow(x, gathers)
+        return gathers
 
     def _engaged_only(
         self, gathers: list[tuple[dolfinx.fem.Function, np.ndarray]]
@@ -405,11 +413,6 @@ class ContactInterface:
         """The largest overlap of the two surfaces in the reference configuration (a press
         fit; 0 where they do not overlap), over all ranks (collective)."""
         return float(self.V.mesh.comm.allreduce(self.overlap.max(initial=0.0), MPI.MAX))
-
-    def update_history(self, T, x, block_slice) -> None:
-        """Refresh the data that needs the chain operator (the slip reference)."""
-        if self.friction:
-            self.friction.update_history(T, x, block_slice)
 
     def begin_step(self) -> None:
         """Start a load step from the last committed state."""

@@ -9,9 +9,9 @@ quadrature point as data on the slave submesh (quadrature elements):
     projection. It is a *field of the assembled system* (it has a test function, which is
     the master virtual displacement at the nodes), tied to the unknowns by ``xhat = Xhat +
     P u`` (``P`` gathers master dofs; see :mod:`contact_ufl.layout`).
-``xhat0, x0, xi0, M``
+``xhat0, x0, xi0, sliding``
     copies of the current master nodes and slave point, the reference coordinates of the
-    projection and its linearisation matrix (:mod:`.projection`), held as data.
+    projection and its linearisation matrix ``M`` (:mod:`.search.projection`), held as data.
 
 The projected point is written as ``xi = xi0 + M b(x - x0, xhat - xhat0)`` (the linearised
 closest-point condition, ``docs/theory.md``): its value is the one found by the
@@ -26,35 +26,35 @@ from __future__ import annotations
 import dolfinx
 import numpy as np
 import ufl
+from petsc4py import PETSc
 
 from contact_ufl.contact.master import MeshMaster
-from contact_ufl.contact.projection import Projection, shape_functions
-from contact_ufl.contact.search import ClosestPointSearch, Pairing
+from contact_ufl.contact.search import ClosestPointSearch, Pairing, Projection, shape_functions
 from contact_ufl.contact.slave import SlaveSurface
-from contact_ufl.layout import StackedLayout
+from contact_ufl.layout import GlobalValues, StackedLayout
 
 
-def master_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
+def master_shape_functions(nodes_per_facet: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
     """UFL shape functions of a master facet and their xi-derivatives.
 
-    Conventions as in :mod:`.projection`: segment (2 nodes), triangle (3 nodes), bilinear
+    The facet kinds of :mod:`.search.kinds`: segment (2 nodes), triangle (3 nodes), bilinear
     quadrilateral (4 nodes, basix vertex order); quadratic segment (3 nodes, ``xi`` of one
-    coordinate) and triangle (6 nodes) of :mod:`.curved`.
+    coordinate), triangle (6 nodes) and quadrilateral (9 nodes).
     """
-    if nn == 3 and xi.ufl_shape == (1,) or nn in (6, 9):
-        return quadratic_shape_functions(nn, xi)
-    if nn == 2:
+    if nodes_per_facet == 3 and xi.ufl_shape == (1,) or nodes_per_facet in (6, 9):
+        return quadratic_shape_functions(nodes_per_facet, xi)
+    if nodes_per_facet == 2:
         s = xi[0]
         return [1 - s, s], [[-1.0], [1.0]]
-    if nn == 3:
+    if nodes_per_facet == 3:
         s, t = xi[0], xi[1]
         return [1 - s - t, s, t], [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]
-    if nn == 4:
+    if nodes_per_facet == 4:
         s, t = xi[0], xi[1]
         N = [(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t]
         dN = [[-(1 - t), -(1 - s)], [1 - t, -s], [-t, 1 - s], [t, s]]
         return N, dN
-    raise ValueError(f"no master facet with {nn} nodes")
+    raise ValueError(f"no master facet with {nodes_per_facet} nodes")
 
 
 def _line(u) -> tuple[list, list]:
@@ -66,14 +66,14 @@ def _line(u) -> tuple[list, list]:
     ]
 
 
-def quadratic_shape_functions(nn: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
-    """UFL twin of :func:`.curved.quadratic_shape_functions`: the 3-node segment (ends, then
-    midpoint), the 6-node triangle (vertices, then the midpoints of edges 01, 12, 02) and the
-    9-node quadrilateral (:data:`.curved.QUADRILATERAL9_EDGES`)."""
-    if nn == 3:
+def quadratic_shape_functions(nodes_per_facet: int, xi: ufl.core.expr.Expr) -> tuple[list, list]:
+    """UFL twin of :func:`.search.shapes.quadratic_shape_functions`: the 3-node segment
+    (ends, then midpoint), the 6-node triangle (vertices, then the midpoints of edges 01, 12,
+    02) and the 9-node quadrilateral (:data:`.search.curved.QUADRILATERAL9_EDGES`)."""
+    if nodes_per_facet == 3:
         line, dline = _line(xi[0])
         return line, [[d] for d in dline]
-    if nn == 9:
+    if nodes_per_facet == 9:
         (ls, dls), (lt, dlt) = _line(xi[0]), _line(xi[1])
         index = ((0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (1, 2), (2, 1), (0, 2), (2, 2))
         N = [ls[i] * lt[j] for i, j in index]
@@ -127,17 +127,18 @@ def smoothed_normal(xi, nodes, flags, mask) -> ufl.core.expr.Expr:
     return n / ufl.sqrt(ufl.dot(n, n) + (1.0 - mask))
 
 
-def smoothed_normal_3d(xi, nodes, nn: int, mask) -> ufl.core.expr.Expr:
+def smoothed_normal_3d(xi, nodes, nodes_per_facet: int, mask) -> ufl.core.expr.Expr:
     """3D master normal interpolated from averaged nodal normals over the facet.
 
-    ``nodes`` rows: the facet's ``nn`` nodes, then the fan of each (``K + 1`` slots, see
-    :mod:`.master`). The nodal normal of ``a`` is the normalised sum of the corner normals
-    ``(s_i - a) x (s_i+1 - a)`` of its fan (the area-weighted average of the unit normals of
-    the facets around ``a``; padded slots hold ``a`` and add zero); the normal at ``xi`` is
-    the normalised interpolation of the nodal normals with the facet's shape functions.
+    ``nodes`` rows: the facet's ``nodes_per_facet`` nodes, then the fan of each (``K + 1``
+    slots, see :mod:`.master`). The nodal normal of ``a`` is the normalised sum of the corner
+    normals ``(s_i - a) x (s_i+1 - a)`` of its fan (the area-weighted average of the unit
+    normals of the facets around ``a``; padded slots hold ``a`` and add zero); the normal at
+    ``xi`` is the normalised interpolation of the nodal normals with the facet's shape
+    functions.
     """
-    slots = (nodes.ufl_shape[0] - nn) // nn
-    N, _ = master_shape_functions(nn, xi)
+    slots = (nodes.ufl_shape[0] - nodes_per_facet) // nodes_per_facet
+    N, _ = master_shape_functions(nodes_per_facet, xi)
 
     def node(k):
         return ufl.as_vector([nodes[k, i] for i in range(3)])
@@ -146,9 +147,9 @@ def smoothed_normal_3d(xi, nodes, nn: int, mask) -> ufl.core.expr.Expr:
         return v / ufl.sqrt(ufl.dot(v, v) + (1.0 - mask))
 
     n = 0
-    for a in range(nn):
+    for a in range(nodes_per_facet):
         x_a = node(a)
-        fan = [node(nn + a * slots + i) - x_a for i in range(slots)]
+        fan = [node(nodes_per_facet + a * slots + i) - x_a for i in range(slots)]
         n_a = sum(ufl.cross(fan[i], fan[i + 1]) for i in range(slots - 1))
         n = n + N[a] * unit(n_a)
     return unit(n)
@@ -197,12 +198,14 @@ class MeshKinematics:
         self.fdim = self.gdim - 1
         self.nn, self.nx = master.nn, master.nx
         space = slave.point_space
-        self.Qx = space((self.nx * self.gdim,))
-        self.xhat = dolfinx.fem.Function(self.Qx, name="master_nodes")
-        self.xhat0 = dolfinx.fem.Function(self.Qx)
+        #: the point space of ``xhat``: ``nx`` gathered nodes of ``gdim`` coordinates
+        self.xhat_space = space((self.nx * self.gdim,))
+        self.xhat = dolfinx.fem.Function(self.xhat_space, name="master_nodes")
+        self.xhat0 = dolfinx.fem.Function(self.xhat_space)
         self.x0 = dolfinx.fem.Function(space((self.gdim,)))
         self.xi0 = dolfinx.fem.Function(space((self.fdim,)))
-        self.M = dolfinx.fem.Function(space((self.fdim, self.fdim)))
+        #: the linearisation matrix ``M`` of the projected point (``Projection.sliding``)
+        self.sliding = dolfinx.fem.Function(space((self.fdim, self.fdim)))
         self.mask = dolfinx.fem.Function(space(()))
         #: (smoothed normal, 2D) whether the neighbour before / after the segment exists
         smoothed_2d = master.smoothed and self.gdim == 2
@@ -230,31 +233,37 @@ class MeshKinematics:
         return ufl.as_matrix([[f[a * gdim + i] for i in range(gdim)] for a in range(self.nx)])
 
     def _build(self) -> None:
-        gdim, fdim, nn = self.gdim, self.fdim, self.nn
+        gdim, fdim, nodes_per_facet = self.gdim, self.fdim, self.nn
         X = ufl.SpatialCoordinate(self.u.function_space.mesh)
         self.x = x = X + self.u
         xh, xh0 = self.nodes(self.xhat), self.nodes(self.xhat0)
-        N0, dN0 = master_shape_functions(nn, self.xi0)
+        N0, dN0 = master_shape_functions(nodes_per_facet, self.xi0)
         y0 = interpolate(N0, xh0, gdim)
         dxh = xh - xh0
         dx = x - self.x0
         b = []
         for al in range(fdim):
-            a0 = interpolate([dN0[a][al] for a in range(nn)], xh0, gdim)
+            a0 = interpolate([dN0[a][al] for a in range(nodes_per_facet)], xh0, gdim)
             slide = dx - interpolate(N0, dxh, gdim)
             b.append(
                 ufl.dot(a0, slide)
-                + ufl.dot(self.x0 - y0, interpolate([dN0[a][al] for a in range(nn)], dxh, gdim))
+                + ufl.dot(
+                    self.x0 - y0,
+                    interpolate([dN0[a][al] for a in range(nodes_per_facet)], dxh, gdim),
+                )
             )
-        self.xi = xi = self.xi0 + self.M * ufl.as_vector(b)
-        self.N, dN = master_shape_functions(nn, xi)
+        self.xi = xi = self.xi0 + self.sliding * ufl.as_vector(b)
+        self.N, dN = master_shape_functions(nodes_per_facet, xi)
         self.y = interpolate(self.N, xh, gdim)
         if self.master.smoothed and gdim == 2:
             self.nu = smoothed_normal(xi, xh, self.neighbour_flags, self.mask)
         elif self.master.smoothed:
-            self.nu = smoothed_normal_3d(xi, xh, nn, self.mask)
+            self.nu = smoothed_normal_3d(xi, xh, nodes_per_facet, self.mask)
         else:
-            tangents = [interpolate([dN[a][al] for a in range(nn)], xh, gdim) for al in range(fdim)]
+            tangents = [
+                interpolate([dN[a][al] for a in range(nodes_per_facet)], xh, gdim)
+                for al in range(fdim)
+            ]
             self.nu = facet_normal(tangents, self.mask)
         if self.side is not None:
             self.nu = self.side * self.nu
@@ -277,7 +286,7 @@ class MeshKinematics:
     def master_residuals(self, traction: ufl.core.expr.Expr) -> list[ufl.Form]:
         """The residuals of :attr:`fields`: the virtual work of the contact traction on the
         master side, ``int T . U2*(Y) dS_o`` (action and reaction)."""
-        vhat = ufl.TestFunction(self.Qx)
+        vhat = ufl.TestFunction(self.xhat_space)
         return [ufl.dot(traction, self.test_at_projection(vhat)) * self.slave.ds]
 
     def update(self, layout: StackedLayout) -> list[tuple[dolfinx.fem.Function, np.ndarray]]:
@@ -288,7 +297,7 @@ class MeshKinematics:
         self.set_pairing(pairing)
         npts = len(pairing.points)
         self.gather = self.slave.unrolled(
-            self.Qx, pairing.columns.reshape(npts, self.nx * self.gdim), fill=-1
+            self.xhat_space, pairing.columns.reshape(npts, self.nx * self.gdim), fill=-1
         )
         self._neighbourhood = pairing.neighbourhood
         return [(self.xhat, self.gather)]
@@ -307,7 +316,7 @@ class MeshKinematics:
         wide = np.where(fan[:, None, None, :] >= 0, fan[:, None, None, :] + component, -1)
         wide = np.broadcast_to(wide, (npts, self.nx, gdim, fan.shape[1]))
         wide = wide.reshape(npts, self.nx * gdim, fan.shape[1])
-        return [(self.xhat, self.slave.unrolled(self.Qx, wide, fill=-1))]
+        return [(self.xhat, self.slave.unrolled(self.xhat_space, wide, fill=-1))]
 
     def set_pairing(self, pairing: Pairing) -> None:
         """Make the point data those of a new search result (value of xi, M, nodes...)."""
@@ -320,7 +329,7 @@ class MeshKinematics:
         slave.set_at_points(self.x0, pairing.points)
         slave.set_at_points(self.xi0, np.where(paired[:, None], proj.xi, 0.0))
         sliding = paired[:, None, None] & (not self.frozen_projection)
-        slave.set_at_points(self.M, np.where(sliding, proj.sliding, 0.0))
+        slave.set_at_points(self.sliding, np.where(sliding, proj.sliding, 0.0))
         slave.set_at_points(self.mask, paired.astype(float))
         if self.neighbour_flags is not None:
             slave.set_at_points(self.neighbour_flags, pairing.flags)
@@ -398,7 +407,7 @@ class MeshSlipReference:
         self._gather_n = None
         self._x_commit = None
         self._xhat_n_commit = None
-        self._work = None  # vectors of update_history, allocated once
+        self._work = None  # the work vector and reader of follow, made once a step
         self._committed = None  # the converged state, until the next step begins
         gdim = k.gdim
         nodes_n = ufl.as_matrix(
@@ -429,22 +438,24 @@ class MeshSlipReference:
             self._gather_n = np.full_like(self._facet_part(self.kinematics.gather), -1)
         return [(self.xhat_n, self._gather_n)]
 
-    def update_history(self, T, x, block_slice) -> None:
-        """Current positions of the last step's master facet nodes: ``xhat_n,commit +
-        P_n (u - u_commit)``, evaluated through T (the nodes may live on any rank)."""
+    def follow(self, x: PETSc.Vec, gathers: list[tuple[dolfinx.fem.Function, np.ndarray]]) -> None:
+        """Current positions of the last step's master facet nodes at the unknowns ``x``:
+        ``xhat_n,commit + P_n (u - u_commit)``, read from ``x`` at the columns of this
+        field's gather in ``gathers`` (the nodes may live on any rank; a column ``-1``, a
+        point out of contact, keeps the committed positions)."""
         xhat = self.kinematics.xhat
         owned = len(self._gather_n)
         if self._x_commit is None:
             owned_x = owned // self._facet_dofs * xhat.function_space.dofmap.index_map_bs
             self.xhat_n.x.array[:owned] = self._facet_part(xhat.x.array[:owned_x])
         else:
-            if self._work is None:
-                self._work = (x.duplicate(), T.createVecLeft())
-            dx, full = self._work
+            if self._work is None:  # once a step: the committed columns are the step's
+                self._work = (x.duplicate(), GlobalValues(x, self._gather_n))
+            dx, reader = self._work
             x.copy(dx)
             dx.axpy(-1.0, self._x_commit)
-            T.mult(dx, full)
-            moved = full.array[block_slice(self.xhat_n)]
+            columns = next(cols for f, cols in gathers if f is self.xhat_n)
+            moved = np.where(columns >= 0, reader.read(dx), 0.0)
             self.xhat_n.x.array[:owned] = self._xhat_n_commit + moved
         self.xhat_n.x.scatter_forward()
 
@@ -469,6 +480,7 @@ class MeshSlipReference:
             return
         gather, xhat_owned, x, xi, mask, xhat = self._committed
         self._gather_n = gather
+        self._work = None  # the columns read change with the step
         self._xhat_n_commit = xhat_owned
         self._x_commit = x
         self.xi_n.x.array[:] = xi

@@ -22,8 +22,6 @@ depend on the nodes around each facet node; those nodes are carried with the fac
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import basix
 import dolfinx
 import numpy as np
@@ -32,13 +30,12 @@ from mpi4py import MPI
 
 from contact_ufl import keysets
 from contact_ufl.contact.facets import (
-    FACET_EDGES,
     basix_cell,
     exterior_facet_cells,
     facet_normals,
     tagged_facets,
 )
-from contact_ufl.contact.projection import shape_functions
+from contact_ufl.contact.search import FACET_EDGES, MasterCandidates
 from contact_ufl.errors import collective_check
 from contact_ufl.layout import StackedLayout
 
@@ -58,9 +55,10 @@ class MeshMaster:
     """A meshed master surface: oriented facets whose nodes are displacement dofs.
 
     Facet nodes are the vertices of the facets (linear segments, triangles, bilinear
-    quadrilaterals), ordered so that the normal of :mod:`.projection` points out of
+    quadrilaterals), ordered so that the normal of :mod:`.search.kinds` points out of
     the master body; with a degree-2 displacement followed by the dofs of the facet's edge
-    midpoints (3-node segments, 6-node triangles of :mod:`.curved`).
+    midpoints (3-node segments, 6-node triangles, 9-node quadrilaterals of
+    :mod:`.search.kinds`).
 
     Parameters
     ----------
@@ -201,7 +199,7 @@ class MeshMaster:
         """The cell-local dofs of the edge midpoints of quadratic facets of the oriented
         cell-local ``vertices`` ``(nf, nv)`` (local facets ``local``): of the segment's edge
         (2D); of the edges 01, 12 and 02 of a triangle; of the edges 01, 13, 23 and 02 of a
-        quadrilateral, then its centre (the node orders of :mod:`.curved`)."""
+        quadrilateral, then its centre (the node orders of :mod:`.search.kinds`)."""
         mesh = self.V.mesh
         layout = self.V.dofmap.dof_layout
         edges = basix.topology(basix_cell(mesh, mesh.topology.dim))[1]
@@ -248,7 +246,7 @@ class MeshMaster:
 
     def _build_membrane(self, orientation: dolfinx.fem.Function) -> None:
         """The master facets of a membrane (string): its tagged cells, ordered so that the
-        normal of :mod:`.projection` is the membrane's oriented normal ``n0``."""
+        normal of :mod:`.search.kinds` is the membrane's oriented normal ``n0``."""
         mesh = self.V.mesh
         tdim = mesh.topology.dim
         cells = tagged_facets(self.facet_tags, self.tag, "master")
@@ -277,8 +275,7 @@ def _boundary_edges(comm: MPI.Comm, keys: np.ndarray, nodes: np.ndarray):
 
     ``keys`` are the input indices of the (oriented) facet nodes ``nodes``.
     """
-    nn = nodes.shape[1]
-    edges = FACET_EDGES[nn]
+    edges = FACET_EDGES[nodes.shape[1]]
     width = len(edges[0])
     local = np.stack([np.sort(keys[:, list(e)], axis=1) for e in edges], axis=1)  # (nf, ne, w)
     everything = np.concatenate(comm.allgather(local.reshape(-1, width)))
@@ -326,7 +323,10 @@ def segment_neighbours(
 
 
 def node_fans(
-    comm: MPI.Comm, global_nodes: np.ndarray, nn: int, node_keys: np.ndarray | None = None
+    comm: MPI.Comm,
+    global_nodes: np.ndarray,
+    nodes_per_facet: int,
+    node_keys: np.ndarray | None = None,
 ) -> npt.NDArray[np.int64]:
     """The fan of every node of the oriented 3D master facets, over all ranks.
 
@@ -344,8 +344,8 @@ def node_fans(
     comm
         Communicator of the master surface.
     global_nodes
-        Global index of the nodes of this rank's oriented facets, ``(nf, nn)``.
-    nn
+        Global index of the nodes of this rank's oriented facets, ``(nf, nodes_per_facet)``.
+    nodes_per_facet
         Nodes of a facet (3 or 4).
     node_keys
         Keys of those nodes that do not depend on the partition (input indices), so that
@@ -354,14 +354,14 @@ def node_fans(
 
     Returns
     -------
-    ndarray, shape (nf, nn, K + 1)
+    ndarray, shape (nf, nodes_per_facet, K + 1)
         Global node index of the slots of the fan of each node of this rank's facets.
     """
-    cyclic = list(CYCLIC_ORDER[nn])
+    cyclic = list(CYCLIC_ORDER[nodes_per_facet])
 
     def corners_of_all_ranks(a: np.ndarray) -> np.ndarray:
         everything = np.concatenate(comm.allgather(a.astype(np.int64).reshape(-1)))
-        return everything.reshape(-1, nn)[:, cyclic]
+        return everything.reshape(-1, nodes_per_facet)[:, cyclic]
 
     ordered = corners_of_all_ranks(global_nodes)
     keys = corners_of_all_ranks(global_nodes if node_keys is None else node_keys)
@@ -440,81 +440,3 @@ def node_rows(comm: MPI.Comm, global_nodes: np.ndarray, wanted: np.ndarray) -> n
     keys = np.concatenate(comm.allgather(global_nodes.reshape(-1).astype(np.int64)))
     find, _ = _lookup(keys)  # a stable order: of equal keys, the first row is found
     return find(wanted.reshape(-1))[0]
-
-
-@dataclass
-class MasterCandidates:
-    """The master facets of one rank, as the search exchanges them: their current nodes and
-    a table of their fixed data.
-
-    Attributes
-    ----------
-    nodes
-        Current positions of the gathered nodes of each facet, ``(nf, nx, gdim)``: the facet's
-        own ``nn`` nodes first, then (smoothed normal) in 2D the nodes before and after it,
-        in 3D the fans of its nodes (:func:`node_fans`).
-    table
-        The fixed data of each facet side by side, ``int64`` ``(nf, nx + nv + ne + nflags)``
-        (its parts: :func:`table_parts`): the stacked index of the first displacement
-        unknown of each gathered node (``columns``, ``nx``), the rank-independent keys of the
-        facet (tie-break: its sorted vertex input indices, ``keys``, ``nv``), which of its
-        edges lie on the boundary of the master surface (``boundary``, ``ne``) and (smoothed
-        normal, 2D) whether the neighbour before / after exists (``flags``, 2; else none).
-    """
-
-    nodes: np.ndarray
-    table: np.ndarray
-
-
-def table_parts(table: np.ndarray, nx: int, nv: int) -> tuple[np.ndarray, ...]:
-    """The columns, keys, boundary edges (``bool``) and flags (``bool``) of the rows of a
-    table of :class:`MasterCandidates` (``nx`` gathered nodes and ``nv`` vertices a facet)."""
-    ne = len(FACET_EDGES[nv])
-    columns, keys = table[:, :nx], table[:, nx : nx + nv]
-    boundary = table[:, nx + nv : nx + nv + ne].astype(bool)
-    return columns, keys, boundary, table[:, nx + nv + ne :].astype(bool)
-
-
-def smoothed_normals(xi: np.ndarray, nodes: np.ndarray, flags: np.ndarray) -> np.ndarray:
-    """NumPy twin of :func:`contact_ufl.contact.kinematics.smoothed_normal` for paired
-    points: ``xi (n, 1)``, ``nodes (n, 4, 2)``, ``flags (n, 2)``; returns unit normals
-    ``(n, 2)`` (by coordinate columns: NumPy reduces rows of two numbers slowly)."""
-    a, b, before, after = ([nodes[:, k, d] for d in range(2)] for k in range(4))
-    segment = [b[d] - a[d] for d in range(2)]
-    incoming = [np.where(flags[:, 0], a[d] - before[d], segment[d]) for d in range(2)]
-    outgoing = [np.where(flags[:, 1], after[d] - b[d], segment[d]) for d in range(2)]
-
-    def unit_perp(t):
-        length = np.sqrt(t[1] * t[1] + t[0] * t[0])
-        return [t[1] / length, -t[0] / length]
-
-    s, u = xi[:, 0], 1.0 - xi[:, 0]
-    ends = [unit_perp(incoming), unit_perp(segment), unit_perp(outgoing)]
-    n = [u * (ends[0][d] + ends[1][d]) + s * (ends[1][d] + ends[2][d]) for d in range(2)]
-    length = np.sqrt(n[0] * n[0] + n[1] * n[1])
-    return np.stack([n[0] / length, n[1] / length], axis=1)
-
-
-def fan_normals(nodes: np.ndarray, nn: int) -> np.ndarray:
-    """Unit nodal normals of 3D master facets from their carried nodes: ``nodes (n, nx, 3)``,
-    the ``nn`` facet nodes then the fans of :func:`node_fans`; returns ``(n, nn, 3)``.
-
-    The nodal normal of ``a`` is the sum over its fan of the corner normals ``(s_i - a) x
-    (s_i+1 - a)``: each the unit normal of a facet around ``a`` weighted by the area of the
-    parallelogram its two edges at ``a`` span (twice a triangle's area; a bilinear
-    quadrilateral's area when it is a parallelogram), normalised.
-    """
-    n, slots = len(nodes), (nodes.shape[1] - nn) // nn
-    own = nodes[:, :nn]
-    fan = nodes[:, nn:].reshape(n, nn, slots, 3) - own[:, :, None]
-    normal = np.cross(fan[:, :, :-1], fan[:, :, 1:]).sum(axis=2)
-    return normal / np.linalg.norm(normal, axis=2, keepdims=True)
-
-
-def smoothed_normals_3d(xi: np.ndarray, nodes: np.ndarray, nn: int) -> np.ndarray:
-    """NumPy twin of :func:`contact_ufl.contact.kinematics.smoothed_normal_3d` for paired
-    points: ``xi (n, 2)``, ``nodes (n, nx, 3)`` (see :func:`fan_normals`); returns unit
-    normals ``(n, 3)``: the normalised interpolation of the nodal normals."""
-    N = shape_functions(nn, 3, xi)[0]
-    normal = np.einsum("pa,pad->pd", N, fan_normals(nodes, nn))
-    return normal / np.linalg.norm(normal, axis=1, keepdims=True)

@@ -19,7 +19,7 @@ import dolfinx
 import numpy as np
 import ufl
 
-from contact_ufl.contact.projection import Projection
+from contact_ufl.contact.search import Projection
 from contact_ufl.contact.slave import SlaveSurface
 
 
@@ -44,33 +44,43 @@ class NormalLaw:
         The slave surface (it carries ``lambda_N``).
     eps_N
         Normal augmentation parameter.
-    touching
+    round_off
         A length of round-off: a gap within it of zero counts as touching (:func:`macaulay`).
 
     Attributes
     ----------
-    closing
+    contact_threshold
         The length within which an open point counts as in contact (a constant of the
-        forms): ``touching``, except in a closing iterate (see
-        :meth:`nearest_open_gap` and :meth:`contact_ufl.newton.NewtonSolver.solve_step`).
+        forms): ``round_off``, except in a step strategy's iterate that moves it
+        (:meth:`count_in_contact_within`, :mod:`contact_ufl.strategies`).
     """
 
-    def __init__(self, slave: SlaveSurface, eps_N: float, touching: float):
+    def __init__(self, slave: SlaveSurface, eps_N: float, round_off: float):
         self.slave = slave
         self.L = slave.P1
         self.lambda_N = dolfinx.fem.Function(self.L, name="lambda_N")
         self.eps_N = dolfinx.fem.Constant(slave.V.mesh, float(eps_N))
-        self.touching = touching
-        self.closing = dolfinx.fem.Constant(slave.V.mesh, float(touching))
+        self.round_off = round_off
+        self.contact_threshold = dolfinx.fem.Constant(slave.V.mesh, float(round_off))
+
+    def count_in_contact_within(self, distance: float) -> None:
+        """Count the open points within ``distance`` of the master as in contact (a
+        closing iterate); a negative ``distance``: only the points that overlap it by more
+        than ``-distance`` (a first contact's predictor iterate). The forms see it at once."""
+        self.contact_threshold.value = distance
+
+    def restore_contact_threshold(self) -> None:
+        """Back to the contact law: within round-off of touching counts as in contact."""
+        self.contact_threshold.value = self.round_off
 
     def traction(self, gap: ufl.core.expr.Expr, mask: ufl.core.expr.Expr):
         """The normal contact traction ``t_N = <lambda_N + eps_N g>`` (0 where ``mask`` is 0)."""
-        return mask * macaulay(self._argument(gap), self.eps_N * self.closing)
+        return mask * macaulay(self._argument(gap), self.eps_N * self.contact_threshold)
 
     def in_contact_condition(self, gap: ufl.core.expr.Expr, mask: ufl.core.expr.Expr):
         """Where the bracket of :meth:`traction` counts as positive (a UFL condition; the
         forms' twin of :meth:`in_contact`)."""
-        positive = ufl.gt(self._argument(gap), -self.eps_N * self.closing)  # see macaulay
+        positive = ufl.gt(self._argument(gap), -self.eps_N * self.contact_threshold)  # see macaulay
         return ufl.And(ufl.gt(mask, 0.5), positive)
 
     def _argument(self, gap: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
@@ -100,8 +110,8 @@ class NormalLaw:
     def in_contact(self, proj: Projection, margin: float = 0.0) -> np.ndarray:
         """Mask of the owned points where the bracket counts as positive (:func:`macaulay`);
         with a ``margin`` (a length), also those within it of counting so."""
-        closing = float(self.closing.value) + margin
-        return self._bracket_argument(proj) > -float(self.eps_N.value) * closing
+        threshold = float(self.contact_threshold.value) + margin
+        return self._bracket_argument(proj) > -float(self.eps_N.value) * threshold
 
     def deepest_overlap(self, proj: Projection) -> float:
         """The largest proximity ``g`` (overlap with the master) of this rank's paired

@@ -54,7 +54,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from contact_ufl.contact.projection import Projection
+from contact_ufl.contact.search import Projection
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
 from contact_ufl.layout import StackedLayout
@@ -449,7 +449,7 @@ class ObstacleSlipReference:
         """None."""
         return []
 
-    def update_history(self, T, x, block_slice) -> None:
+    def follow(self, x, gathers: list) -> None:
         """Nothing to gather: ``y_n`` follows the pose constants."""
 
     def commit(self, x) -> None:

@@ -20,7 +20,8 @@ from contact_ufl.contact.obstacles import RigidCylinder, RigidObstacle, RigidSph
 from contact_ufl.errors import NonUniqueSolutionWarning
 from contact_ufl.membranes import MembraneNeoHookean
 from contact_ufl.problem import ContactProblem
-from contact_ufl.verification.scenes import curved_pair, on_meshes_of_their_own, with_membrane
+from contact_ufl.verification.scenes.membranes import with_membrane
+from contact_ufl.verification.scenes.pairs import curved_pair, on_meshes_of_their_own
 
 __all__ = [
     "CURVED_STATES",
@@ -73,10 +74,10 @@ def contact_state(
             c.friction.lambda_T.interpolate(
                 lambda x: tangential * np.vstack([np.sin(3.0 * x[0] + k) for k in range(gdim)])
             )
-    solver = problem.solver
-    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
-    solver.forget_state()
-    solver.evaluate_residual(solver.x)
+    operator = problem.operator
+    dolfinx.fem.petsc.assign(problem.unknowns, operator.x)
+    operator.forget_state()
+    operator.evaluate_residual(operator.x)
 
 
 def sliding_direction(
@@ -93,7 +94,7 @@ def sliding_direction(
         dl = dolfinx.fem.Function(c.normal.L)
         dl.interpolate(lambda x: multiplier * np.cos(4.0 * x[0] + 0.3))
         fields.append(dl)
-    dz = problem.solver.x.duplicate()
+    dz = problem.operator.x.duplicate()
     dolfinx.fem.petsc.assign(fields, dz)
     return dz
 
@@ -159,13 +160,13 @@ def curved_case(
         up = direction * np.eye(dim)[dim - 1]
         scene = with_membrane(scene, membrane, MembraneNeoHookean(1.0, 0.05), up)
     problem = taylor_problem(scene, degree=degree)
-    solver = problem.solver  # made at the reference state, the converged state of step 0
+    operator = problem.operator  # made at the reference state, the converged state of step 0
     state = CURVED_STATES[dim]
     tag = problem.bulks[0].bodies[0].tag
     shift = np.array(state["shift"])
     if mu > 0:
         contact_state(problem, tag, 0.5 * shift)
-        problem.contacts[0].commit(solver.x)
+        problem.contacts[0].commit(operator.x)
         problem.contacts[0].begin_step()
     contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
     direction = sliding_direction(problem, tag, np.array(state["slide"]))
@@ -226,14 +227,14 @@ def obstacle_case(dim: int, num_steps: int = 4, mu: float = 0.0, shape: str = "c
         scene.contacts[0], master=obstacle, mu=mu, search_radius=2.0
     )
     problem = taylor_problem(scene)
-    solver = problem.solver
+    operator = problem.operator
     state = CURVED_STATES[dim]
     tag = scene.bodies[0].tag
     shift = np.array(state["shift"])
     if mu > 0:
         problem.set_time(0.5)
         contact_state(problem, tag, 0.5 * shift)
-        problem.contacts[0].commit(solver.x)
+        problem.contacts[0].commit(operator.x)
         problem.contacts[0].begin_step()
     problem.set_time(1.0)
     contact_state(problem, tag, shift, tangential=0.01 if mu > 0 else 0.0)
@@ -248,7 +249,11 @@ def membrane_pressure_case(dim: int, num_steps: int = 4):
     a smooth field, at its full pressure; the direction another smooth field. Returns the
     problem at its state, the direction and the steps, as :func:`curved_case`."""
     from contact_ufl.scene import Scene
-    from contact_ufl.verification.scenes import PlatesSchedule, inflated_sphere, tube_for_plates
+    from contact_ufl.verification.scenes.membranes import (
+        PlatesSchedule,
+        inflated_sphere,
+        tube_for_plates,
+    )
 
     if dim == 3:
         scene = inflated_sphere(n=8, pressure=0.01)
@@ -256,14 +261,14 @@ def membrane_pressure_case(dim: int, num_steps: int = 4):
         schedule = PlatesSchedule(0.005, 2.0, 1.5)
         scene = Scene(domains=[tube_for_plates(schedule, dim=2, n=16)])
     problem = taylor_problem(scene)
-    solver = problem.solver
+    operator = problem.operator
     problem.set_time(1.0)
     (bulk,) = problem.bulks
     bulk.u.interpolate(lambda x: smooth_field(x, 0.05, dim))
     du = dolfinx.fem.Function(bulk.V)
     du.interpolate(lambda x: smooth_field(x, 0.05, dim, phase=0.7))
-    dolfinx.fem.petsc.assign(problem.unknowns, solver.x)
-    solver.forget_state()
-    direction = solver.x.duplicate()
+    dolfinx.fem.petsc.assign(problem.unknowns, operator.x)
+    operator.forget_state()
+    direction = operator.x.duplicate()
     dolfinx.fem.petsc.assign([du], direction)
     return problem, direction, [1e-2 * 2.0**-k for k in range(num_steps)]

@@ -297,8 +297,8 @@ def hertz_2d_driven(
     held). Where it passes through zero, which depends on the mesh and the master normal,
     the tangent is singular: Newton wanders along the rotation with the active set fixed,
     the step is cut back, and the disc tilts. Held, the scene needs no cut-back. A failed
-    step of the disc free to turn says so (:meth:`NewtonSolver.diagnose
-    <contact_ufl.newton.NewtonSolver.diagnose>`).
+    step of the disc free to turn says so (:meth:`StepSolver.diagnose
+    <contact_ufl.strategies.StepSolver.diagnose>`).
     """
     if driven_by not in ("force", "displacement"):
         raise ValueError(f"driven_by must be 'force' or 'displacement', not {driven_by!r}")

@@ -4,43 +4,59 @@ For every slave quadrature point the search finds the closest point on the maste
 the master facets of all ranks that can be within the search radius of this rank's slave
 points are exchanged (a bounding-box filter), put in a rank-independent order (so that ties
 between equidistant facets break the same way on any number of ranks), and projected onto
-by the vectorised kernels of :mod:`.projection`. Points whose closest point lies on the
+(:func:`.closest.closest_points`). Points whose closest point lies on the
 boundary of the master surface and off its normal are released (they are beyond the
 surface, not on it). On a self-contact surface (slave and master the same surface) a point
 pairs only with the facets that share no vertex with its own and face it, and of two facing
-facets only the one of lower vertex key is the slave (:func:`release_master_side`).
+facets only the one of lower vertex key is the slave (:func:`.release.release_master_side`).
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Protocol
 
 import dolfinx
 import numpy as np
-import scipy.sparse
 from mpi4py import MPI
 
-from contact_ufl.contact import compiled
-from contact_ufl.contact.facets import on_edges
-from contact_ufl.contact.master import (
-    MeshMaster,
-    smoothed_normals,
-    smoothed_normals_3d,
-    table_parts,
+from contact_ufl.contact.search import compiled
+from contact_ufl.contact.search.candidates import Candidates, MasterCandidates
+from contact_ufl.contact.search.closest import closest_points, compiled_backend
+from contact_ufl.contact.search.normals import smoothed_normals, smoothed_normals_3d
+from contact_ufl.contact.search.projection import Projection, SelfContact, non_finite
+from contact_ufl.contact.search.release import (
+    release_beside_own_facet,
+    release_beyond_boundary,
+    release_master_side,
 )
-from contact_ufl.contact.projection import (
-    Projection,
-    SelfContact,
-    TreeCache,
-    _compiled,
-    closest_points,
-    non_finite,
-)
+from contact_ufl.contact.search.trees import TreeCache
 from contact_ufl.contact.slave import SlaveSurface
 from contact_ufl.errors import collective_check
-from contact_ufl.keysets import unique
 from contact_ufl.layout import StackedLayout
+
+
+class MasterSurface(Protocol):
+    """What the search needs of a meshed master side
+    (:class:`~contact_ufl.contact.master.MeshMaster`)."""
+
+    #: nodes of a facet, of them vertices, and nodes gathered to a slave point (the facet's,
+    #: then with the smoothed normal its neighbours')
+    nn: int
+    nv: int
+    nx: int
+    #: whether the normal is smoothed; whether either side of the surface may be in contact
+    smoothed: bool
+    two_sided: bool
+    #: reference positions of the facets' nodes ``(nf, nn, gdim)``; sorted vertex input
+    #: indices of each facet ``(nf, nv)``
+    X_nodes: np.ndarray
+    keys: np.ndarray
+
+    def candidates(self, layout: StackedLayout) -> MasterCandidates:
+        """This rank's facets at the current displacement (collective)."""
+        ...
 
 
 @dataclass
@@ -55,10 +71,10 @@ class Pairing:
         Closest points (facet index ``-1`` where none).
     nodes
         Current positions of the gathered master nodes of each point's facet,
-        ``(np, nx, gdim)`` (zero where unpaired).
+        ``(np, master.nx, gdim)`` (zero where unpaired).
     columns
         Stacked index of the displacement unknown each of those coordinates gathers,
-        ``(np, nx, gdim)`` (``-1`` where unpaired).
+        ``(np, master.nx, gdim)`` (``-1`` where unpaired).
     flags
         (smoothed normal, 2D) whether the neighbours before / after the segment exist,
         ``(np, 2)``; else ``None``.
@@ -82,51 +98,6 @@ class Pairing:
         return self.projection.facet >= 0
 
 
-@dataclass
-class Candidates:
-    """The fixed data of the candidate facets a rank received, in the search order (that of
-    their vertex keys: rank-independent, so that ties between equidistant facets break the
-    same way on any number of ranks).
-
-    Attributes
-    ----------
-    table
-        The rows received (of :class:`~contact_ufl.contact.master.MasterCandidates`'s
-        table), in the order received.
-    order
-        The search order of the received rows.
-    keys, boundary, flags
-        Their vertex keys, boundary edges and (smoothed normal, 2D) neighbour flags, in the
-        search order.
-    gather
-        The stacked index of the unknown of every coordinate of every gathered node,
-        ``(ncand, nx, gdim)``.
-    fans, counts
-        The fan columns (:func:`fan_columns`) of each candidate and their numbers (the rest
-        of a row is ``-1``).
-    """
-
-    table: np.ndarray
-    order: np.ndarray
-    keys: np.ndarray
-    boundary: np.ndarray
-    flags: np.ndarray
-    gather: np.ndarray
-    fans: np.ndarray
-    counts: np.ndarray
-
-    @classmethod
-    def of(cls, table: np.ndarray, nx: int, nv: int, nn: int, gdim: int) -> Candidates:
-        """The data of the received rows ``table`` (``nx`` gathered nodes, ``nv`` vertices,
-        ``nn`` nodes a facet, in ``gdim``)."""
-        order = np.lexsort(table[:, nx : nx + nv].T[::-1])
-        columns, keys, boundary, flags = table_parts(table[order], nx, nv)
-        fans = fan_columns(columns, nn, np.arange(len(columns)))
-        counts = np.count_nonzero(fans >= 0, axis=1)
-        gather = columns[:, :, None] + np.arange(gdim)
-        return cls(table.copy(), order, keys, boundary, flags, gather, fans, counts)
-
-
 class ClosestPointSearch:
     """Closest points of the slave points of a pair on its meshed master surface.
 
@@ -142,20 +113,26 @@ class ClosestPointSearch:
     self_contact
         Whether slave and master are the same surface: a point then pairs only with the
         facets that share no vertex with its own facet and whose normal opposes its current
-        normal (:class:`~contact_ufl.contact.projection.SelfContact`; no tolerance).
+        normal (:class:`~contact_ufl.contact.search.SelfContact`; no tolerance).
+    backend
+        The back end of the closest-point search (``"compiled"`` or ``"numpy"``, see
+        :func:`~contact_ufl.contact.search.closest_points`); default: the environment
+        variable ``CONTACT_UFL_SEARCH`` at each search, else ``"compiled"``.
     """
 
     def __init__(
         self,
         slave: SlaveSurface,
-        master: MeshMaster,
+        master: MasterSurface,
         radius: float,
         touching: float,
         self_contact: bool = False,
+        backend: str | None = None,
     ):
         self.slave, self.master = slave, master
         self.radius, self.touching = radius, touching
         self.self_contact = self_contact
+        self.backend = backend
         self.comm = slave.V.mesh.comm
         self.gdim = slave.V.mesh.geometry.dim
         #: seconds spent in :meth:`pair` so far
@@ -165,7 +142,7 @@ class ClosestPointSearch:
         self._candidates: Candidates | None = None
         # the compiled kernel on every rank now: a rank with no slave points never builds
         # it, so a build error would otherwise be raised on the searching ranks only
-        if self.comm.allreduce(_compiled(master.nn, self.gdim), MPI.LOR):
+        if self.comm.allreduce(compiled_backend(backend, master.nn, self.gdim), MPI.LOR):
             compiled.require(self.comm)
 
     def exchange(self, master_nodes: np.ndarray, points: np.ndarray, payload=None):
@@ -210,12 +187,12 @@ class ClosestPointSearch:
 
     def candidates(self, table: np.ndarray) -> Candidates:
         """The fixed data of the received candidate facets (their rows of the master's
-        :class:`~contact_ufl.contact.master.MasterCandidates` table) in the search order:
+        :class:`~contact_ufl.contact.search.MasterCandidates` table) in the search order:
         those of the last search while the same rows are received in the same order (on one
         rank, always), else anew."""
         if self._candidates is None or not np.array_equal(self._candidates.table, table):
-            self._candidates = Candidates.of(table, self.master.nx, self.master.nv,
-                                             self.master.nn, self.gdim)  # fmt: skip
+            master = self.master
+            self._candidates = Candidates.of(table, master.nx, master.nv, master.nn, self.gdim)
         return self._candidates
 
     def check_facing(self, description: str) -> Projection:
@@ -230,7 +207,7 @@ class ClosestPointSearch:
         nodes, keys = self.exchange(self.master.X_nodes, x, keys)
         normals = np.repeat(self.slave.normals, self.slave.num_points, axis=0)
         rule = self._self_contact(keys, normals)
-        proj = closest_points(x, nodes, np.inf, self_contact=rule)
+        proj = closest_points(x, nodes, np.inf, self_contact=rule, backend=self.backend)
         # a slave point faces the master when it lies on the outer side of the master facet,
         # or inside it within the search radius (a press fit), and the two outward normals
         # oppose each other
@@ -279,7 +256,7 @@ class ClosestPointSearch:
             ``master.block``).
         """
         start = time.perf_counter()
-        gdim, nn = self.gdim, self.master.nn
+        gdim, nodes_per_facet = self.gdim, self.master.nn
         points = self.slave.positions(u).reshape(-1, gdim)
         mine = self.master.candidates(layout)
         nodes, table = self.exchange(mine.nodes, points, mine.table)
@@ -288,7 +265,9 @@ class ClosestPointSearch:
         rule = None
         if self.self_contact:  # the current normals only where the rule needs them
             rule = self._self_contact(candidates.keys, self.slave.current_normals(u))
-        proj = closest_points(points, nodes[:, :nn], self.radius, self.trees, rule)
+        proj = closest_points(
+            points, nodes[:, :nodes_per_facet], self.radius, self.trees, rule, self.backend
+        )
         if rule is not None:
             release_beside_own_facet(proj, points, rule, self.touching)
             release_master_side(proj, rule)
@@ -303,7 +282,7 @@ class ClosestPointSearch:
                 flags = np.zeros((len(points), 2))
                 flags[paired] = facet_flags
             else:
-                normal = smoothed_normals_3d(proj.xi[paired], facet_nodes, nn)
+                normal = smoothed_normals_3d(proj.xi[paired], facet_nodes, nodes_per_facet)
             proj.normal[paired] = normal
             proj.gap[paired] = -np.einsum("pd,pd->p", normal, points[paired] - proj.y[paired])
         gathered = _at_points(nodes, proj.facet, paired, 0.0)
@@ -336,7 +315,7 @@ def _overlapping(lo: np.ndarray, hi: np.ndarray, low: np.ndarray, high: np.ndarr
 
 
 def _node_bounds(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The smallest and largest coordinates of each facet's ``nodes`` ``(n, nn, gdim)``, a
+    """The smallest and largest coordinates of each facet's ``nodes`` ``(n, nodes, gdim)``, a
     node at a time (NumPy's reduction over the middle axis is several times slower)."""
     lo, hi = nodes[:, 0].copy(), nodes[:, 0].copy()
     for a in range(1, nodes.shape[1]):
@@ -354,143 +333,3 @@ def _non_finite(points: np.ndarray, nodes: np.ndarray | None) -> str | None:
     if nodes is not None and not np.isfinite(nodes).all():
         return non_finite("the master nodes", nodes)
     return None
-
-
-def fan_columns(columns: np.ndarray, nn: int, facets: np.ndarray) -> np.ndarray:
-    """The columns gathered by the candidate facets that share a side with each of ``facets``
-    (the facet included): a node of a segment (2D), an edge (two nodes) of a surface facet.
-
-    Parameters
-    ----------
-    columns
-        The gathered columns of the candidate facets, ``(ncand, nx)``, the facet's own
-        ``nn`` nodes first (``-1``: none).
-    nn
-        Nodes of a facet.
-    facets
-        Candidate indices.
-
-    Returns
-    -------
-    ``(len(facets), width)``: the distinct columns of each facet's fan, ``-1`` padded.
-    """
-    if len(facets) == 0 or len(columns) == 0:
-        return np.zeros((len(facets), 0), dtype=np.int64)
-    ids, inverse = np.unique(columns, return_inverse=True)
-    inverse = inverse.reshape(columns.shape)
-
-    def incidence(k: int) -> scipy.sparse.csr_array:
-        valid = columns[:, :k] >= 0
-        rows = np.nonzero(valid)[0]
-        data = np.ones(len(rows))
-        return scipy.sparse.csr_array(
-            (data, (rows, inverse[:, :k][valid])), shape=(len(columns), len(ids))
-        )
-
-    own, gathered = incidence(nn), incidence(columns.shape[1])
-    chosen, where = np.unique(facets, return_inverse=True)
-    shared = own[chosen] @ own.T  # nodes shared by a chosen facet and a candidate
-    shared.data = (shared.data >= (1 if nn == 2 else 2)).astype(float)
-    shared.eliminate_zeros()
-    fans = (shared @ gathered).tocsr()
-    fans.sort_indices()
-    counts = np.diff(fans.indptr)
-    out = np.full((len(chosen), counts.max()), -1, dtype=np.int64)
-    rows = np.repeat(np.arange(len(chosen)), counts)
-    out[rows, np.arange(len(rows)) - np.repeat(fans.indptr[:-1], counts)] = ids[fans.indices]
-    return out[where]
-
-
-def release_beyond_boundary(
-    proj: Projection, points: np.ndarray, boundary: np.ndarray, tolerance: float = 0.0
-) -> None:
-    """Unpair the points beyond the edge of the master surface (in place).
-
-    A point whose closest point is on an edge (2D: an end point) of the master *surface*
-    boundary, and off the normal through it by more than ``tolerance`` (a length: round-off),
-    lies beyond the surface: it is not in contact (the last facet is not a half-plane).
-    ``boundary``: boundary-edge flags per candidate.
-    """
-    paired = np.flatnonzero(proj.facet >= 0)
-    paired = paired[boundary.any(axis=1)[proj.facet[paired]]]  # on a facet at the boundary
-    if len(paired) == 0:
-        return
-    on_edge = on_edges(boundary.shape[1], proj.xi[paired])  # as many edges as nodes
-    paired = paired[(on_edge & boundary[proj.facet[paired]]).any(axis=1)]
-    d = points[paired] - proj.y[paired]
-    normal_part = np.einsum("pd,pd->p", d, proj.normal[paired])
-    off_normal = np.linalg.norm(d - normal_part[:, None] * proj.normal[paired], axis=1)
-    beyond = (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > tolerance)
-    released = paired[beyond]
-    proj.facet[released] = -1
-    proj.gap[released] = -np.inf
-
-
-def release_master_side(proj: Projection, rule: SelfContact) -> None:
-    """Keep one side of every self-contact interface as the slave (in place).
-
-    Two facing parts of a self-contact surface would each find the other: the constraint
-    would be imposed twice, by two multipliers whose split is undetermined (a singular
-    tangent). A pair (point of facet ``F``, facet ``f``) is kept only if the smallest vertex
-    key of ``F`` is below that of ``f`` (the two facets share no vertex, so the keys differ:
-    no tie, no tolerance, the same on any number of ranks): of two facing facets, the one of
-    lower key is the slave, the other the master. The closest point itself is not changed.
-    """
-    paired = np.flatnonzero(proj.facet >= 0)
-    own = rule.point_nodes[paired].min(axis=1)
-    partner = rule.facet_nodes[proj.facet[paired]].min(axis=1)
-    released = paired[partner < own]
-    proj.facet[released] = -1
-    proj.gap[released] = -np.inf
-
-
-def release_beside_own_facet(
-    proj: Projection, points: np.ndarray, rule: SelfContact, tolerance: float = 0.0
-) -> None:
-    """Unpair the self-contact points beyond the edge of their admissible facets (in place).
-
-    The facets around a point's own facet (those sharing a vertex with it) are excluded from
-    its search: the rest of the surface has there an edge, as a surface has at its boundary.
-    A point whose closest point is on the boundary of a facet that touches the excluded ones
-    (a vertex of the facet is a vertex of an excluded facet), off the facet's normal through
-    it by more than ``tolerance`` (round-off), lies beyond that edge: the surface continues
-    into the excluded facets there, and the point is not in contact with it (as in
-    :func:`release_beyond_boundary`).
-    """
-    paired = np.flatnonzero(proj.facet >= 0)
-    if len(paired) == 0:
-        return
-    facet = proj.facet[paired]
-    nn = rule.facet_nodes.shape[1]
-    on_boundary = on_edges(nn, proj.xi[paired]).any(axis=1)
-    d = points[paired] - proj.y[paired]
-    normal_part = np.einsum("pd,pd->p", d, proj.normal[paired])
-    off_normal = np.linalg.norm(d - normal_part[:, None] * proj.normal[paired], axis=1)
-    off = on_boundary & (off_normal > 1e-6 * np.linalg.norm(d, axis=1)) & (off_normal > tolerance)
-    # vertex pairs of the same facet, over the facets of the search (the excluded facets
-    # around a point's facet are among them: they are within a facet's size of the point)
-    pairs = unique(
-        np.concatenate(
-            [
-                _pair_codes(rule.facet_nodes[:, i], rule.facet_nodes[:, j])
-                for i in range(nn)
-                for j in range(nn)
-                if i != j
-            ]
-        )
-    )
-    own, theirs = rule.point_nodes[paired], rule.facet_nodes[facet]
-    touches = np.zeros(len(paired), dtype=bool)
-    for i in range(theirs.shape[1]):
-        for j in range(own.shape[1]):
-            code = _pair_codes(theirs[:, i], own[:, j])
-            pos = np.minimum(np.searchsorted(pairs, code), len(pairs) - 1)
-            touches |= pairs[pos] == code
-    released = paired[off & touches]
-    proj.facet[released] = -1
-    proj.gap[released] = -np.inf
-
-
-def _pair_codes(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """One integer per ordered pair of vertex keys (keys below 2^31)."""
-    return a.astype(np.int64) * (1 << 31) + b.astype(np.int64)

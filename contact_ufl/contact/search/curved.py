@@ -4,9 +4,9 @@ and 9-node quadrilaterals.
 A degree-2 displacement makes every master facet a quadratic one once deformed (and a
 degree-2 geometry makes it curved from the start): its current shape is
 ``y(xi) = sum_a N_a(xi) x_a`` with the quadratic Lagrange shape functions of its nodes,
-the vertices then the edge midpoints (see :func:`quadratic_shape_functions`). The kernels
-here are vectorised over (point, facet) pairs, like those of :mod:`.projection`, which uses
-them for the quadratic kinds:
+the vertices then the edge midpoints (see :func:`.shapes.quadratic_shape_functions`). The
+kernels here are vectorised over (point, facet) pairs, like those of :mod:`.numpy_facets`,
+which uses them for the quadratic kinds:
 
 * :func:`curve_closest`: the closest point of a quadratic curve (a 3-node segment, or an
   edge of a 6-node triangle): projected Newton on ``u`` in ``[0, 1]`` from the projection on
@@ -32,9 +32,12 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-FloatArray = npt.NDArray[np.float64]
+from contact_ufl.contact.search.kinds import FloatArray
+from contact_ufl.contact.search.shapes import quadratic_shape_functions
 
 _ITERATIONS = 25
+
+
 _TOL = 1e-13  # on the reference-coordinate step
 
 #: Newton settled outside a facet is restarted from other points (an interior minimum may
@@ -43,86 +46,24 @@ _TOL = 1e-13  # on the reference-coordinate step
 #: have a second minimum on it.
 RESTART_CURVATURE = 0.2
 
+
 #: The edges of a 6-node triangle: start vertex, end vertex, midpoint node (node order
 #: ``v0, v1, v2, m01, m12, m02``), in the order of the straight triangle's edges.
 TRIANGLE6_EDGES = ((0, 1, 3), (1, 2, 4), (0, 2, 5))
+
 
 #: The edges of a 9-node quadrilateral (node order: the basix vertices ``v0 (0, 0), v1 (1,
 #: 0), v2 (0, 1), v3 (1, 1)``, the midpoints of the edges 01, 13, 23, 02, then the centre),
 #: in the order of the bilinear quadrilateral's edges.
 QUADRILATERAL9_EDGES = ((0, 1, 4), (1, 3, 5), (2, 3, 6), (0, 2, 7))
 
+
 #: The edges of each quadratic facet kind of two reference dimensions.
 CURVED_EDGES = {"triangle6": TRIANGLE6_EDGES, "quadrilateral9": QUADRILATERAL9_EDGES}
 
-#: The 1D index (0: start, 1: end, 2: middle) of the nodes of a 9-node quadrilateral in s and t.
-_Q9 = ((0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (1, 2), (2, 1), (0, 2), (2, 2))
-
-
-def quadratic_shape_functions(
-    kind: str, xi: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Shape functions of a quadratic facet and their first and second derivatives.
-
-    ``kind``: ``"segment3"`` (nodes: the two ends, then the midpoint; ``xi`` in ``[0, 1]``)
-    or ``"triangle6"`` (the vertices, then the midpoints of the edges 01, 12 and 02; with the
-    barycentric ``L = (1 - xi1 - xi2, xi1, xi2)``: ``N_i = L_i (2 L_i - 1)``,
-    ``N_ij = 4 L_i L_j``) or ``"quadrilateral9"`` (the tensor product of the 1D functions;
-    node order of :data:`QUADRILATERAL9_EDGES`). Shapes as
-    :func:`.projection.shape_functions`.
-    """
-    npts = xi.shape[0]
-    if kind == "quadrilateral9":
-        return _quadrilateral9(xi)
-    if kind == "segment3":
-        u = xi[:, 0]
-        N = np.stack([(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)], axis=1)
-        dN = np.stack([4 * u - 3, 4 * u - 1, 4 - 8 * u], axis=1)[:, :, None]
-        d2N = np.broadcast_to(np.array([4.0, 4.0, -8.0])[:, None, None], (npts, 3, 1, 1))
-        return N, dN, d2N.copy()
-    L = np.stack([1.0 - xi[:, 0] - xi[:, 1], xi[:, 0], xi[:, 1]], axis=1)
-    dL = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])  # dL_i / dxi^alpha
-    pairs = ((0, 1), (1, 2), (0, 2))
-    N = np.empty((npts, 6))
-    dN = np.empty((npts, 6, 2))
-    d2N = np.empty((npts, 6, 2, 2))
-    for i in range(3):
-        N[:, i] = L[:, i] * (2 * L[:, i] - 1)
-        dN[:, i] = (4 * L[:, i] - 1)[:, None] * dL[i]
-        d2N[:, i] = 4 * np.outer(dL[i], dL[i])
-    for k, (i, j) in enumerate(pairs):
-        N[:, 3 + k] = 4 * L[:, i] * L[:, j]
-        dN[:, 3 + k] = 4 * (L[:, j, None] * dL[i] + L[:, i, None] * dL[j])
-        d2N[:, 3 + k] = 4 * (np.outer(dL[i], dL[j]) + np.outer(dL[j], dL[i]))
-    return N, dN, d2N
-
-
-def _line(u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """1D quadratic Lagrange functions (start, end, middle) at ``u`` and their derivatives,
-    ``(3, n)`` each."""
-    one = np.ones_like(u)
-    values = np.stack([(1 - u) * (1 - 2 * u), u * (2 * u - 1), 4 * u * (1 - u)])
-    dl = np.stack([4 * u - 3, 4 * u - 1, 4 - 8 * u])
-    d2l = np.stack([4 * one, 4 * one, -8 * one])
-    return values, dl, d2l
-
-
-def _quadrilateral9(xi: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Tensor-product quadratic functions of the 9-node quadrilateral (node order of
-    :data:`QUADRILATERAL9_EDGES`)."""
-    (ls, dls, d2ls), (lt, dlt, d2lt) = _line(xi[:, 0]), _line(xi[:, 1])
-    i, j = np.array(_Q9).T
-    N = (ls[i] * lt[j]).T
-    dN = np.stack([(dls[i] * lt[j]).T, (ls[i] * dlt[j]).T], axis=2)
-    st = (dls[i] * dlt[j]).T
-    d2N = np.stack(
-        [np.stack([(d2ls[i] * lt[j]).T, st], 2), np.stack([st, (ls[i] * d2lt[j]).T], 2)], 2
-    )
-    return N, dN, d2N
-
 
 def bernstein_hull(kind: str, nodes: FloatArray) -> FloatArray:
-    """The Bernstein control points of quadratic facets ``nodes (nf, nn, gdim)``: the
+    """The Bernstein control points of quadratic facets ``nodes (nf, nodes, gdim)``: the
     vertices, and for an edge ``ij`` of midpoint node ``m`` the point ``2 m - (x_i + x_j)/2``.
     Every point of the facet is a convex combination of them."""
     hull = nodes.copy()
@@ -261,7 +202,7 @@ def _restart(kind, nodes, dist, good, settled):
 
 
 def curvature(kind: str, nodes: FloatArray) -> FloatArray:
-    """A curvature scale of quadratic facets ``nodes (P, nn, 3)`` of two reference
+    """A curvature scale of quadratic facets ``nodes (P, nodes, 3)`` of two reference
     dimensions: ``8 |delta| / L^2`` (that of a parabola of height ``|delta|`` over a chord
     ``L``), with ``delta`` the largest offset of a midpoint node from its chord's midpoint
     (of the centre node of a 9-node quadrilateral from the centre of the 8-node one through
