@@ -465,7 +465,7 @@ class StepSolver:
         residual = self.operator.evaluate_residual(self.x).array_r
         contacts = self.problem.contacts
         counts = self.comm.allreduce(np.array([c.active().sum() for c in contacts]), MPI.SUM)
-        atol = self.newton.tolerances[0]
+        atol = self.newton.tolerances[1]
         loose = set()
         for piece, on in pieces:
             if np.any(counts[on] > 0):
