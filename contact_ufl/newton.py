@@ -150,7 +150,7 @@ class NewtonDriver:
         self.on_iterate: Callable[[float], None] | None = None
         self.on_not_finite: Callable[[], None] | None = None
         self._in_solve = False
-        self._callback_error: Exception | None = None
+        self._callback_error: BaseException | None = None
         self.snes = PETSc.SNES().create(comm)
         self.snes.setOptionsPrefix(prefix)
         if options.get("pc_type") == "fieldsplit" and field_splits is None:
@@ -300,10 +300,12 @@ class NewtonDriver:
     @contextlib.contextmanager
     def _holding_errors(self) -> Iterator[None]:
         """Inside a solve, keep an exception of a callback (raised by :meth:`solve` once
-        SNES has returned and unlocked its vectors)."""
+        SNES has returned and unlocked its vectors), Ctrl-C's ``KeyboardInterrupt``
+        included: through PETSc it would come back as a failed linear solve, and the step
+        would be cut back instead of stopped."""
         try:
             yield
-        except Exception as error:
+        except BaseException as error:
             if not self._in_solve:
                 raise
             self._callback_error = error

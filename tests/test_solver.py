@@ -475,6 +475,45 @@ def test_an_error_in_a_callback_is_raised_and_leaves_the_problem_usable(monkeypa
     assert problem.contact_force()[1] != 0.0 and not problem.history.cutbacks
 
 
+def test_ctrl_c_in_a_solve_stops_it_and_leaves_the_problem_usable(monkeypatch, verification):
+    """SIGINT (Ctrl-C) inside a Newton solve raises ``KeyboardInterrupt`` from the solve (it
+    came back through PETSc as a failed linear solve, and the step was cut back eight times
+    instead); the steps accepted before are kept, the interrupted step is undone, and
+    solving on gives the force of a run never interrupted (consistency)."""
+    import os
+    import signal
+
+    scene = scenes.hertz_2d(h_contact=0.05, depth=0.01).scene
+    problem = ContactProblem(scene, verbose=False)
+    problem.solve(num_steps=2, t_end=0.5)
+    operator, calls = problem.operator, []
+    update = operator.update_pairing
+
+    def interrupted(x):
+        calls.append(1)
+        if len(calls) == 3:  # inside the second Newton iterate of the third step
+            os.kill(os.getpid(), signal.SIGINT)
+        update(x)
+
+    monkeypatch.setattr(operator, "update_pairing", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        problem.solve(num_steps=2, t_end=1.0)
+    assert problem.t == 0.5 and len(problem.history.steps) == 2
+    assert not problem.history.cutbacks
+    monkeypatch.setattr(operator, "update_pairing", update)
+    problem.solve(num_steps=2, t_end=1.0)
+    reference = ContactProblem(scene, verbose=False)
+    reference.solve(num_steps=2, t_end=0.5)
+    reference.solve(num_steps=2, t_end=1.0)
+    error = difference(problem.contact_force()[1], reference.contact_force()[1])
+    case = "Hertz 2D, Neo-Hookean, h_contact = 0.05, depth 0.01"
+    source = "the same steps never interrupted"
+    quantity = "relative difference of F_y after a Ctrl-C in the third step"
+    tol = 0.0 if problem.comm.size == 1 else TOL_BY_HAND
+    verification(case, quantity, error, 0.0, tol, source, kind="consistency")
+    assert error <= tol
+
+
 @pytest.mark.parametrize("mu", [0.0, 0.3])
 def test_unknown_blocks_assembled_straight_give_the_chain_rule_tangent(mu, verification):
     """The solver matrix holds the tangent's blocks between unknowns assembled straight and
