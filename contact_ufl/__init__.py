@@ -42,7 +42,12 @@ from contact_ufl import (
 )
 from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSphere
 from contact_ufl.control import VolumeControl
-from contact_ufl.errors import ContactInputError, ConvergenceError, NonUniqueSolutionWarning
+from contact_ufl.errors import (
+    ContactInputError,
+    ConvergenceError,
+    CrackWarning,
+    NonUniqueSolutionWarning,
+)
 from contact_ufl.loads import (
     BodyForce,
     DeadForce,
@@ -85,6 +90,7 @@ __all__ = [
     "ContactPair",
     "ContactProblem",
     "ConvergenceError",
+    "CrackWarning",
     "DeadForce",
     "DeadTraction",
     "Dirichlet",

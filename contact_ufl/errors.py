@@ -14,6 +14,11 @@ class NonUniqueSolutionWarning(UserWarning):
     arbitrary (it may differ between runs and numbers of ranks)."""
 
 
+class CrackWarning(UserWarning):
+    """Distinct nodes of one body at the same place: the body is cut there (a crack), which
+    is rarely meant (a mesh of pieces not merged: gmsh ``Coherence``, ``fragment``)."""
+
+
 class ConvergenceError(RuntimeError):
     """A load step could not be converged, even after cutting it back."""
 

@@ -8,10 +8,13 @@ with the dimension ``d`` of ``F`` so that they equal the 3D energy in plane stra
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 
 import ufl
+
+from contact_ufl.errors import ContactInputError
 
 #: Poisson's ratio above which a solid is nearly incompressible (see :func:`lame_parameters`)
 NEARLY_INCOMPRESSIBLE = 0.45
@@ -36,11 +39,14 @@ def warn_if_nearly_incompressible(nu: float) -> None:
 
 
 def lame_parameters(E: float, nu: float) -> tuple[float, float]:
-    """Shear modulus and first Lame parameter of Young's modulus ``E`` and Poisson ratio ``nu``."""
-    if not E > 0.0:
-        raise ValueError(f"Young's modulus must be positive, got E = {E}")
+    """Shear modulus and first Lame parameter of Young's modulus ``E`` and Poisson ratio ``nu``;
+    a :class:`~contact_ufl.errors.ContactInputError` for ``E`` not positive and finite or
+    ``nu`` outside ``(-1, 0.5)`` (NaN included). Every rank makes the same material, so every
+    rank raises."""
+    if not 0.0 < E < math.inf:
+        raise ContactInputError(f"Young's modulus must be positive and finite, got E = {E}")
     if not -1.0 < nu < 0.5:
-        raise ValueError(f"Poisson's ratio must lie in (-1, 0.5), got nu = {nu}")
+        raise ContactInputError(f"Poisson's ratio must lie in (-1, 0.5), got nu = {nu}")
     mu = E / (2.0 * (1.0 + nu))
     lmbda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     return mu, lmbda

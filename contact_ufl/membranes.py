@@ -386,9 +386,11 @@ def in_plane_invariant(u: Expr, n0: Expr) -> Expr:
 
 
 def _check_positive(**values: float) -> None:
+    """A :class:`~contact_ufl.errors.ContactInputError` unless every value is positive and
+    finite (every rank makes the same law, so every rank raises)."""
     for name, value in values.items():
         if not 0.0 < value < float("inf"):
-            raise ValueError(f"{name} must be positive, got {name} = {value}")
+            raise ContactInputError(f"{name} must be positive and finite, got {name} = {value}")
 
 
 @dataclass(frozen=True)

@@ -35,6 +35,7 @@ import ufl
 from petsc4py import PETSc
 
 from contact_ufl import jit
+from contact_ufl.errors import ContactInputError
 from contact_ufl.loads import deformation_gradient
 from contact_ufl.materials import lame_parameters, warn_if_nearly_incompressible
 
@@ -61,10 +62,15 @@ class J2Plasticity:
     def __post_init__(self) -> None:
         lame_parameters(self.E, self.nu)
         warn_if_nearly_incompressible(self.nu)
-        if not self.yield_stress > 0.0:
-            raise ValueError(f"the yield stress must be positive, got {self.yield_stress}")
-        if not self.hardening >= 0.0:
-            raise ValueError(f"the hardening modulus must be >= 0, got {self.hardening}")
+        if not 0.0 < self.yield_stress < np.inf:
+            raise ContactInputError(
+                f"the yield stress must be positive and finite, got yield_stress = "
+                f"{self.yield_stress}"
+            )
+        if not 0.0 <= self.hardening < np.inf:
+            raise ContactInputError(
+                f"the hardening modulus must be >= 0 and finite, got hardening = {self.hardening}"
+            )
 
     @property
     def mu(self) -> float:

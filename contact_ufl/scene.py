@@ -19,6 +19,7 @@ model in one call.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -28,6 +29,7 @@ import dolfinx
 import numpy as np
 from mpi4py import MPI
 
+from contact_ufl import mesh_checks
 from contact_ufl.contact import ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.control import VolumeControl
@@ -235,9 +237,10 @@ class Domain:
         if key not in self.groups:
             names = self.group_names()
             where = f" of {self.name}" if self.name else ""
+            wanted = [n for n, (d, _) in self.groups.items() if d in (dim, -1)]
             raise ContactInputError(
                 f"{what}: no physical group{where} is named {key!r}; cell groups: "
-                f"{names['cell']}, facet groups: {names['facet']}"
+                f"{names['cell']}, facet groups: {names['facet']}{_suggest(key, wanted)}"
             )
         group_dim, tag = self.groups[key]
         if group_dim not in (dim, -1):
@@ -295,7 +298,8 @@ class Domain:
             collective_check(
                 comm,
                 count > 0,
-                f"{where}body {body.name or body.tag}: cell tag {body.tag} has no cells",
+                f"{where}body {body.name or body.tag}: cell tag {body.tag}"
+                f"{self._group_of(body.tag, tdim)} has no cells",
             )
         facet_values = comm.allreduce(set(np.unique(self.facet_tags.values).tolist()), MPI.BOR)
         cell_values = comm.allreduce(set(np.unique(self.cell_tags.values).tolist()), MPI.BOR)
@@ -304,8 +308,8 @@ class Domain:
             collective_check(
                 comm,
                 item.tag in facet_values,
-                f"{where}{type(item).__name__}: facet tag {item.tag} does not exist "
-                f"(facet tags: {sorted(facet_values)})",
+                f"{where}{type(item).__name__}: facet tag {item.tag} does not exist or has no "
+                f"facets{self._group_of(item.tag, tdim - 1)} (facet tags: {sorted(facet_values)})",
             )
         for bc in self.dirichlet:
             what = f"{where}Dirichlet {self._describe(bc.tag, tdim - 1)}"
@@ -321,10 +325,52 @@ class Domain:
                 collective_check(
                     comm,
                     load.tag in cell_values,
-                    f"{where}{type(load).__name__}: cell tag {load.tag} does not exist "
-                    f"(cell tags: {sorted(cell_values)})",
+                    f"{where}{type(load).__name__}: cell tag {load.tag} does not exist or has "
+                    f"no cells{self._group_of(load.tag, tdim)} (cell tags: {sorted(cell_values)})",
                 )
-            _validate_load(comm, load, gdim, where)
+            dim = tdim if self.on_cells(load) else tdim - 1
+            _validate_load(comm, load, gdim, where, self._describe(load.tag, dim))
+        self._check_geometry(where)
+
+    def _check_geometry(self, where: str) -> None:
+        """Finite node coordinates; of a solid mesh, cells that are neither flat nor turned
+        inside out, and no crack within a body (a warning). Vectorised over the cells; on
+        every rank."""
+        mesh, comm = self.mesh, self.mesh.comm
+        gdim = mesh.geometry.dim
+        x = mesh.geometry.x[:, :gdim]
+        owned = mesh.geometry.index_map().size_local
+        bad = np.flatnonzero(~np.isfinite(x[:owned]).all(axis=1))
+        count = comm.allreduce(bad.size, MPI.SUM)
+        first = ""
+        if bad.size:
+            node = int(mesh.geometry.index_map().local_to_global(bad[:1])[0])
+            first = f", node {node} at {x[bad[0]].tolist()}"
+        collective_check(
+            comm,
+            count == 0,
+            f"{where}{count} mesh nodes have non-finite coordinates (NaN or infinity){first}",
+        )
+        if self.membrane:
+            return
+        mesh_checks.check_cells(mesh, where)
+        mesh_checks.check_folds(mesh, where)
+        mesh_checks.warn_of_cracks(mesh, self.cell_tags, self._body_labels(), where)
+
+    def _body_labels(self) -> dict[int, str]:
+        """Each body's cell tag -> how messages name it."""
+        tdim = self.mesh.topology.dim
+        return {
+            int(b.tag): f"body {b.name!r} ({self._describe(b.tag, tdim)})"
+            if b.name
+            else f"body {self._describe(b.tag, tdim)}"
+            for b in self.bodies
+        }
+
+    def _group_of(self, tag: int, dim: int) -> str:
+        """`` (physical group 'top')`` where the tag has a group's name, else ``""``."""
+        names = [n for n, (d, t) in self.groups.items() if t == tag and d in (dim, -1)]
+        return f" (physical group {names[0]!r})" if names else ""
 
     def _describe(self, tag: int, dim: int) -> str:
         """A tag by its physical group's name where the domain has one (``'top' (tag 3)``)."""
@@ -542,9 +588,10 @@ class Scene:
                         f"named {key!r}: name the domain (a contact pair's slave_domain or "
                         "master_domain)"
                     )
+                everywhere = [n for group in names.values() for n in group]
                 raise ContactInputError(
                     f"{what}: no domain of the scene has a {kind} group named {key!r}; "
-                    f"{kind} groups: {names}"
+                    f"{kind} groups: {names}{_suggest(key, everywhere)}"
                 )
             (k,) = holders
         else:
@@ -600,7 +647,20 @@ class Scene:
         )
         for part in parts:
             part.validate()
-        for pair in self.contacts:
+        for k, pair in enumerate(self.contacts):
+            for side in ("slave", "master"):
+                key, domain = getattr(pair, side), getattr(pair, f"{side}_domain")
+                if isinstance(key, RigidObstacle) or domain is None:
+                    continue
+                part = parts[domain]
+                count = comm.allreduce(len(part.surface_tags.find(key)), MPI.SUM)
+                kind = "cell" if part.membrane else "facet"
+                collective_check(
+                    comm,
+                    count > 0,
+                    f"contact pair {k}, {side} surface: {kind} tag {key}"
+                    f"{part._group_of(key, part.surface_dim)} is empty or does not exist",
+                )
             pair.validate(comm)
 
 
@@ -660,9 +720,10 @@ def _is_tag(key: Any) -> bool:
     return isinstance(key, str | int | np.integer)
 
 
-def _validate_load(comm: MPI.Comm, load: Load, gdim: int, where: str) -> None:
+def _validate_load(comm: MPI.Comm, load: Load, gdim: int, where: str, label: str) -> None:
     """Check a load's value (a vector of the mesh's dimension for a dead load, a scalar
-    magnitude for a follower load) and a follower force's direction (on every rank)."""
+    magnitude for a follower load; finite at t = 0) and a follower force's direction (on
+    every rank); ``label`` names its tag (:meth:`Domain._describe`)."""
     if not isinstance(load, FollowerPressure | FollowerForce | VolumeControl):
         try:
             shape = evaluate(load.value, 0.0).shape
@@ -682,11 +743,22 @@ def _validate_load(comm: MPI.Comm, load: Load, gdim: int, where: str) -> None:
             f"{where}{type(load).__name__} on facet tag {load.tag}: the value is a scalar "
             f"magnitude, got shape {shape}",
         )
+    if not isinstance(load, VolumeControl):
+        try:
+            value = evaluate(load.value, 0.0)
+        except Exception:  # a value that cannot be evaluated: refused above
+            value = np.zeros(0)
+        collective_check(
+            comm,
+            bool(np.all(np.isfinite(value))),
+            f"{where}{type(load).__name__} {label}: the value at t = 0 is not finite: "
+            f"{value.tolist()}",
+        )
     if isinstance(load, FollowerForce):
         d0 = np.asarray(load.direction, dtype=float)
         collective_check(
             comm,
-            d0.shape == (gdim,) and bool(np.linalg.norm(d0) > 0.0),
+            d0.shape == (gdim,) and bool(np.isfinite(d0).all() and np.linalg.norm(d0) > 0.0),
             f"{where}FollowerForce on facet tag {load.tag}: direction must be a nonzero "
             f"vector of dimension {gdim}, got {tuple(d0.tolist())}",
         )
@@ -726,6 +798,13 @@ def _validate_dirichlet(comm: MPI.Comm, bc: Dirichlet, gdim: int, what: str) -> 
         elif not np.all(np.isfinite(value)):
             problem = f"the value at t = 0 is not finite: {value.tolist()}"
     collective_check(comm, problem is None, f"{what}: {problem}")
+
+
+def _suggest(key: str, names: Sequence[str]) -> str:
+    """``; did you mean 'name'?`` for the existing name closest to a mistyped ``key``
+    (:func:`difflib.get_close_matches`), or ``""`` where none is close."""
+    close = difflib.get_close_matches(key, sorted(set(names)), n=1)
+    return f"; did you mean {close[0]!r}?" if close else ""
 
 
 def _kind(dim: int, tdim: int) -> str:

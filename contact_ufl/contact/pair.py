@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from mpi4py import MPI
@@ -199,7 +200,9 @@ class ContactPair:
         )
         if self.eps_N is not None:
             check_positive(comm, eps_N=self.eps_N)
-        collective_check(comm, self.mu >= 0.0, f"mu must be >= 0, got mu = {self.mu}")
+        collective_check(
+            comm, bool(0.0 <= self.mu < math.inf), f"mu must be >= 0 and finite, got mu = {self.mu}"
+        )
         if self.eps_T is not None:
             check_positive(comm, eps_T=self.eps_T)
         if self.search_radius is not None:

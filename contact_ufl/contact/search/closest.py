@@ -32,6 +32,7 @@ from contact_ufl.contact.search.numpy_search import search_numpy
 from contact_ufl.contact.search.projection import FIELDS, Projection, SelfContact, non_finite
 from contact_ufl.contact.search.shapes import centre_normal
 from contact_ufl.contact.search.trees import TreeCache
+from contact_ufl.errors import ContactInputError
 
 #: The back ends of the search, by the name ``backend`` and ``CONTACT_UFL_SEARCH`` give.
 BACKENDS = ("compiled", "numpy")
@@ -157,22 +158,28 @@ def closest_points(
     straight edges. A strongly warped quadrilateral seen from beyond its radius of curvature
     can have several interior local minima; the one found is then not guaranteed global.
     """
-    nodes = np.asarray(nodes, dtype=np.float64)
+    nodes = _array("nodes", nodes)
     if nodes.ndim != 3:
-        raise ValueError(f"nodes must have shape (nf, nodes_per_facet, gdim), got {nodes.shape}")
+        raise ContactInputError(
+            f"nodes must have shape (nf, nodes_per_facet, gdim), got {nodes.shape}"
+        )
     nf, nodes_per_facet, gdim = nodes.shape
-    facet_kind(nodes_per_facet, gdim)
-    resolve_backend(backend)
-    points = np.asarray(points, dtype=np.float64)
+    try:
+        facet_kind(nodes_per_facet, gdim)
+        resolve_backend(backend)
+    except ValueError as error:
+        raise ContactInputError(str(error)) from None
+    points = _array("points", points)
     if points.size == 0:
         points = points.reshape(0, gdim)
     if points.ndim != 2 or points.shape[1] != gdim:
-        raise ValueError(f"points must have shape (np, {gdim}), got {points.shape}")
+        raise ContactInputError(f"points must have shape (np, {gdim}), got {points.shape}")
     radius = float(radius)
     if not radius >= 0.0:
-        raise ValueError(f"radius must be non-negative, got {radius}")
-    if not np.isfinite(points).all():
-        raise ValueError(non_finite("the slave points", points))
+        raise ContactInputError(f"radius must be non-negative, got {radius}")
+    for what, values in (("the slave points", points), ("the master nodes", nodes)):
+        if not np.isfinite(values).all():
+            raise ContactInputError(non_finite(what, values))
     npts, fdim = points.shape[0], gdim - 1
     out = Projection(
         facet=np.full(npts, -1, dtype=np.int64),
@@ -193,6 +200,15 @@ def closest_points(
             return out
     _search(points, nodes, radius, trees, self_contact, out, backend)
     return out
+
+
+def _array(name: str, values: npt.ArrayLike) -> FloatArray:
+    """``values`` as an array of floats; a :class:`ContactInputError` naming ``name`` for
+    what is not one (ragged rows, no numbers)."""
+    try:
+        return np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise ContactInputError(f"{name} must be an array of numbers: {error}") from None
 
 
 def resolve_backend(backend: str | None = None) -> str:
