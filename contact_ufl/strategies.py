@@ -34,8 +34,8 @@ from contact_ufl.timings import NewtonTimings
 PREDICTOR_GROWTH = 10.0
 
 
-class SteppedProblem(Protocol):
-    """What a step solver asks of the problem it steps."""
+class SolvedProblem(Protocol):
+    """What a step solver asks of the problem it solves a step of."""
 
     t: float
     contacts: list
@@ -358,7 +358,7 @@ class StepSolver:
 
     def __init__(
         self,
-        problem: SteppedProblem,
+        problem: SolvedProblem,
         operator: ContactOperator,
         newton: NewtonDriver,
         diagnosis: StepDiagnosis,
