@@ -448,7 +448,7 @@ class StepSolver:
         self.operator.forget_state()
         self.operator.set_state(self.x)
         contacts = self.problem.contacts
-        counts = self.comm.allreduce(np.array([c.active().sum() for c in contacts]), MPI.SUM)
+        counts = self._points_in_contact()
         return [c for c, n in zip(contacts, counts, strict=True) if n == 0]
 
     def loose_pairs(self) -> list:
@@ -464,7 +464,7 @@ class StepSolver:
         self.operator.forget_state()  # the search at the step's time (a rigid obstacle moves)
         residual = self.operator.evaluate_residual(self.x).array_r
         contacts = self.problem.contacts
-        counts = self.comm.allreduce(np.array([c.active().sum() for c in contacts]), MPI.SUM)
+        counts = self._points_in_contact()
         atol = self.newton.tolerances[1]
         loose = set()
         for piece, on in pieces:
@@ -473,6 +473,11 @@ class StepSolver:
             if self.problem.net_free_load(residual, piece) > atol:
                 loose.update(on)
         return [c for k, c in enumerate(contacts) if k in loose]
+
+    def _points_in_contact(self) -> np.ndarray:
+        """How many slave points of each contact pair are in contact, over all ranks."""
+        contacts = self.problem.contacts
+        return self.comm.allreduce(np.array([c.active().sum() for c in contacts]), MPI.SUM)
 
     def closing_iterate(self, pairs: list) -> None:
         """One Newton iterate from :attr:`x` in which the open points of ``pairs`` within
