@@ -40,6 +40,7 @@ from contact_ufl import (
     output,
     results,
 )
+from contact_ufl.checkpoint import Checkpoints
 from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSphere
 from contact_ufl.control import VolumeControl
 from contact_ufl.errors import (
@@ -97,6 +98,7 @@ __all__ = [
     "Domain",
     "FollowerForce",
     "FollowerPressure",
+    "Checkpoints",
     "History",
     "J2Plasticity",
     "LinearElastic",

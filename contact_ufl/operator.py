@@ -183,6 +183,15 @@ class ContactOperator:
         self.update_pairing(x)
         self._state = x.copy()
 
+    def replan(self) -> None:
+        """Forget the pairings met: the chain operator, the sparsity plan and the solver
+        matrix are made anew at the next :meth:`update_pairing` and tangent, as a new
+        operator makes them (a restart point)."""
+        self.pattern = SolverPattern(self.comm, self.pattern.superset, self.pattern.slack)
+        self._T = self._T_coupled = self._T_pattern = self._chained_tangent = None
+        self._gather_columns = self._gathers = self._state = None
+        self._fixed_blocks_stale = True
+
     def forget_state(self) -> None:
         """Make the next evaluation redo the search even at an unchanged state."""
         self._state = None

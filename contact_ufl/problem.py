@@ -17,6 +17,7 @@ import functools
 import operator
 import warnings
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import NamedTuple
 
 import dolfinx
@@ -27,6 +28,7 @@ from petsc4py import PETSc
 
 from contact_ufl import free_bodies, jit, keysets
 from contact_ufl.bulk import Bulk
+from contact_ufl.checkpoint import Checkpoints, restart
 from contact_ufl.contact import ContactInterface, ContactPair
 from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.control import VolumeConstraint, VolumeControl
@@ -208,6 +210,8 @@ class ContactProblem:
         self._solver: StepSolver | None = None
         self._stepper: LoadStepper | None = None
         self._closed = False
+        #: the checkpoint this problem restarted from: (folder, step, t), or None
+        self.restored_from: tuple[Path, int, float] | None = None
 
     def _interface(self, pair: ContactPair, parts: list) -> ContactInterface:
         """The contact interface of ``pair`` between the bulks that hold its surfaces."""
@@ -478,9 +482,10 @@ class ContactProblem:
         ``T^T r`` and the tangent ``T^T K T``."""
         return self.solver.operator
 
-    def _make_solver(self) -> StepSolver:
-        """The operator at the current state, committed as the converged state of step 0,
-        the Newton driver over its callbacks, and the step strategies (collective)."""
+    def _make_solver(self, committed: bool = False) -> StepSolver:
+        """The operator at the current state, committed as the converged state of step 0
+        (``committed``: a restored state, committed already), the Newton driver over its
+        callbacks, and the step strategies (collective)."""
         dirichlet = DirichletRows(
             self.dirichlet_rows, self.dirichlet_scale, lambda: self.prescribed(self.t)
         )
@@ -497,10 +502,9 @@ class ContactProblem:
             len(self.bulks),
         )
         operator = ContactOperator(system, pattern_superset=self.gdim == 2)
-        operator.update_pairing(operator.x)
-        self.commit(operator.x)  # the initial state is the converged state of step 0
-        self.begin_step()
-        operator.update_pairing(operator.x)
+        # the initial state is the converged state of step 0; a restored one was committed
+        # but for the contacts' slip references, which come from a search there
+        self._settle(operator, self.contacts if committed else self._parts_with_history())
         operator.first_tangent()
         # a force scale: 1e-11 of E_max L^(d-1) with L the scene's diameter
         size, E = self.scales()
@@ -521,6 +525,63 @@ class ContactProblem:
             self.comm, self.contacts, self.free_pieces, lambda: inverted_cell_centres(self)
         )
         return StepSolver(self, operator, newton, diagnosis)
+
+    def _settle(self, operator: ContactOperator, parts: list) -> None:
+        """The pairing at the operator's state, ``parts`` committed there, the next step
+        begun, and the pairing again (with the slip references' gathers)."""
+        operator.update_pairing(operator.x)
+        for part in parts:
+            part.commit(operator.x)
+        self.begin_step()
+        operator.update_pairing(operator.x)
+
+    @property
+    def has_solver(self) -> bool:
+        """Whether :attr:`solver` was made."""
+        return self._solver is not None
+
+    def resume_solver(self) -> StepSolver:
+        """Make :attr:`solver` at the current fields, taken as the committed state of a step
+        (a restart: the histories hold that state already; collective)."""
+        if self._solver is not None:
+            raise RuntimeError("this problem has a solver already")
+        self._solver = self._make_solver(committed=True)
+        return self._solver
+
+    def fresh_start(self) -> None:
+        """Continue from the committed state as a restart from it would: the pairings met
+        forgotten (chain operator, sparsity plan, solver matrix and factorisation made anew)
+        and the slip references from a search there (collective). Done at every checkpoint,
+        so that a run and its restart solve the same systems: bit for bit on one rank."""
+        operator = self.solver.operator
+        laws = [c.friction for c in self.contacts if c.friction]
+        inspected = [(law.last_slip, law.last_stick, law.last_weak_slip) for law in laws]
+        for law in laws:
+            law.forget_reference()
+        operator.replan()
+        self._settle(operator, self.contacts)
+        for law, (slip, stick, weak) in zip(laws, inspected, strict=True):
+            # those of the step's own commit (a new reference knows no slip)
+            law.last_slip, law.last_stick, law.last_weak_slip = slip, stick, weak
+        operator.first_tangent()
+        self.solver.newton.reset_factorisation()
+
+    def restart(self, folder: str | Path, step: int | None = None) -> float:
+        """Continue from a checkpoint (collective).
+
+        Sets the fields, histories, pseudo-time, step records and the schedule of the solve
+        under way to those of the checkpoint of ``step`` (default: the last complete one) in
+        ``folder``, written by :meth:`solve` with ``checkpoint=`` on any number of ranks;
+        the next :meth:`solve` with the same ``num_steps`` and ``t_end`` goes on where that
+        one stopped, and a solve that ended before is skipped, so the script that wrote the
+        checkpoints restarts by calling this before its solves. Call it on a problem made
+        anew from the same scene, before any solve.
+
+        Returns
+        -------
+        The pseudo-time of the checkpoint.
+        """
+        return restart(self, folder, step)
 
     def net_free_load(self, residual: np.ndarray, piece: free_bodies.Piece) -> float:
         """The load of the residual (a vector of the unknowns) along the free rigid modes of
@@ -562,18 +623,23 @@ class ContactProblem:
         t_end: float = 1.0,
         max_cutbacks: int = 8,
         callback: Callable[[ContactProblem, StepRecord], None] | None = None,
+        checkpoint: Checkpoints | str | Path | None = None,
     ) -> History:
         """Load stepping from the current pseudo-time to ``t_end`` in ``num_steps`` steps.
 
         A convenience: :meth:`LoadStepper.solve <contact_ufl.stepping.LoadStepper.solve>`
         of :attr:`stepper` (cut-back of failed steps, :class:`ConvergenceError
-        <contact_ufl.errors.ConvergenceError>` when cut-backs run out).
+        <contact_ufl.errors.ConvergenceError>` when cut-backs run out). ``checkpoint``: a
+        :class:`~contact_ufl.checkpoint.Checkpoints` or its folder (a checkpoint at every
+        step), from which :meth:`restart` continues.
 
         Returns
         -------
         The :attr:`history` of all solves of this problem.
         """
-        return self.stepper.solve(num_steps, t_end, max_cutbacks, callback)
+        if isinstance(checkpoint, str | Path):
+            checkpoint = Checkpoints(checkpoint)
+        return self.stepper.solve(num_steps, t_end, max_cutbacks, callback, checkpoint)
 
     # -- results --------------------------------------------------------------------
     @collective

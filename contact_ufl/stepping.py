@@ -12,13 +12,16 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import NamedTuple, Protocol
+from typing import TYPE_CHECKING, NamedTuple, Protocol
 
 import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.errors import ContactInputError, ConvergenceError
 from contact_ufl.strategies import StepSolver
+
+if TYPE_CHECKING:
+    from contact_ufl.checkpoint import Checkpoints
 
 
 class SteppedProblem(Protocol):
@@ -39,6 +42,8 @@ class SteppedProblem(Protocol):
     def active_points(self) -> int: ...
 
     def contact_force(self) -> np.ndarray: ...
+
+    def fresh_start(self) -> None: ...
 
 
 @dataclass
@@ -98,6 +103,25 @@ class Cutback(NamedTuple):
 
 
 @dataclass
+class Schedule:
+    """The load steps of a solve: from ``t_start`` to ``t_end`` in ``num_steps`` steps of
+    ``(t_end - t_start) / num_steps``; the size ``dt`` of the next step (smaller after a
+    cut-back) and how many steps in a row converged since (``streak``: at 2 the step grows
+    back)."""
+
+    t_start: float
+    t_end: float
+    num_steps: int
+    dt: float
+    streak: int = 0
+
+    @property
+    def dt0(self) -> float:
+        """The step of the plan, the largest."""
+        return (self.t_end - self.t_start) / self.num_steps
+
+
+@dataclass
 class History:
     """Accepted steps and cut-backs of a run.
 
@@ -140,6 +164,31 @@ class LoadStepper:
         self.solver = solver
         self.verbose = verbose
         self.history = History()
+        self.schedule: Schedule | None = None  # that of the solve under way (or the last)
+        self._resumed: tuple[Schedule, float] | None = None
+
+    def resume(self, schedule: Schedule, t: float) -> None:
+        """Continue the solve that ``schedule`` belongs to, from pseudo-time ``t`` (a
+        restart): the next :meth:`solve` to the same ``t_end`` in the same ``num_steps``
+        takes its steps where that one would have; a solve that ended at or before ``t``
+        is skipped (a script run again from the top passes it)."""
+        self._resumed = (schedule, t)
+
+    def _schedule(self, num_steps: int, t_end: float) -> Schedule | None:
+        """The schedule of a solve: the resumed one where it is that solve's, ``None`` where
+        a restart is past the solve's end."""
+        t = self.problem.t
+        if self._resumed is not None:
+            resumed, t_restart = self._resumed
+            if t_end <= t_restart + 1e-12 * max(1.0, abs(t_restart)):
+                self._print(f"  solve to t = {t_end:.5g}: done before the restart (t = {t:.5g})")
+                return None
+            self._resumed = None
+            if resumed.num_steps == num_steps and abs(resumed.t_end - t_end) <= 1e-12 * max(
+                1.0, abs(t_end)
+            ):
+                return resumed
+        return Schedule(t, t_end, num_steps, (t_end - t) / num_steps)
 
     def solve(
         self,
@@ -147,6 +196,7 @@ class LoadStepper:
         t_end: float = 1.0,
         max_cutbacks: int = 8,
         callback: Callable[[SteppedProblem, StepRecord], None] | None = None,
+        checkpoints: Checkpoints | None = None,
     ) -> History:
         """Load stepping from the current pseudo-time to ``t_end`` in ``num_steps`` steps.
 
@@ -155,7 +205,9 @@ class LoadStepper:
         initial one halved ``max_cutbacks`` times raises :class:`ConvergenceError
         <contact_ufl.errors.ConvergenceError>`, which names the step. Accepted steps are in
         :attr:`history` (and were passed to ``callback(problem, record)``, e.g. a
-        :class:`~contact_ufl.output.ResultWriter`) whatever happens later.
+        :class:`~contact_ufl.output.ResultWriter`) whatever happens later. With
+        ``checkpoints`` (:class:`~contact_ufl.checkpoint.Checkpoints`) the state is written at
+        the steps it says, and the solver starts afresh from it (as a restart would).
 
         Returns
         -------
@@ -164,6 +216,9 @@ class LoadStepper:
         problem, solver = self.problem, self.solver
         if not (isinstance(num_steps, int | np.integer) and num_steps >= 1):
             raise ContactInputError(f"num_steps must be a whole number >= 1, got {num_steps!r}")
+        plan = self._schedule(num_steps, t_end)
+        if plan is None:
+            return self.history
         if not t_end > problem.t + 1e-12 * max(1.0, abs(problem.t)):
             raise ContactInputError(
                 f"t_end = {t_end!r} does not advance the pseudo-time beyond t = {problem.t:.6g}: "
@@ -171,9 +226,10 @@ class LoadStepper:
                 "functions of t that go back (e.g. lambda t: d * min(t, 2 - t)) and solve to a "
                 "later t_end (see the user guide, Supports, loads and pseudo-time)"
             )
-        dt0 = (t_end - problem.t) / num_steps
-        dt, streak = dt0, 0
+        self.schedule = plan
+        dt0 = plan.dt0
         while problem.t < t_end - 1e-12 * abs(t_end):
+            dt = plan.dt
             t_prev, t_new = problem.t, min(problem.t + dt, t_end)
             saved = [f.x.array.copy() for f in problem.unknowns]
             start = time.perf_counter()
@@ -188,8 +244,8 @@ class LoadStepper:
                 self._restore(saved, t_prev)
                 self.history.cutbacks.append(Cutback(t_new, reason, why))
                 self._print(f"  step to t = {t_new:.5g} failed ({reason}; {why}): cutting back")
-                dt, streak = 0.5 * dt, 0
-                if dt < dt0 * 0.5**max_cutbacks * (1.0 - 1e-9):
+                plan.dt, plan.streak = 0.5 * dt, 0
+                if plan.dt < dt0 * 0.5**max_cutbacks * (1.0 - 1e-9):
                     raise ConvergenceError(
                         f"load step {len(self.history.steps) + 1}, from t = {t_prev:.6g} to "
                         f"t = {t_new:.6g}, did not converge ({reason}: {why}) after "
@@ -210,11 +266,15 @@ class LoadStepper:
             problem.commit(solver.x)
             solver.operator.forget_state()
             self._print(_format(record))
+            plan.streak += 1
+            if plan.streak >= 2 and plan.dt < dt0:
+                plan.dt, plan.streak = min(2.0 * plan.dt, dt0), 0
             if callback is not None:
                 callback(problem, record)
-            streak += 1
-            if streak >= 2 and dt < dt0:
-                dt, streak = min(2.0 * dt, dt0), 0
+            finished = problem.t >= t_end - 1e-12 * abs(t_end)
+            if checkpoints is not None and checkpoints.due(record.step, finished):
+                checkpoints.write(problem, self.history, plan)
+                problem.fresh_start()
         return self.history
 
     def _restore(self, saved: list[np.ndarray], t: float) -> None:

@@ -83,6 +83,18 @@ class Predictor:
         increment.axpy(-1.0, start)
         self._last = (t_from, t_to, x.copy(), increment)
 
+    @property
+    def last(self) -> tuple[float, float, PETSc.Vec] | None:
+        """The last converged step: its start and end time and its increment (``None``
+        before any)."""
+        return None if self._last is None else (self._last[0], self._last[1], self._last[3])
+
+    def resume(self, t_from: float, t_to: float, x: PETSc.Vec, increment: PETSc.Vec) -> None:
+        """Take the last converged step from a checkpoint: from ``t_from`` to ``t_to``, ending
+        at ``x``, by ``increment`` (copied)."""
+        self.close()
+        self._last = (t_from, t_to, x.copy(), increment.copy())
+
     def predict(self, x: PETSc.Vec, t0: float, t: float) -> bool:
         """Move ``x``, the start of the step from ``t0`` to ``t``, to ``x + (t - t0) /
         (t_to - t_from) dx``, where the last converged step ended at this start

@@ -226,6 +226,16 @@ class MeshKinematics:
         self._neighbourhood = None
         self._build()
 
+    @property
+    def sides(self) -> np.ndarray:
+        """The side of a two-sided master each owned slave point faced when last paired
+        (``-1`` or ``1``; ``0``: never paired), the memory of its search."""
+        return self._side
+
+    @sides.setter
+    def sides(self, values: np.ndarray) -> None:
+        self._side = np.array(values, dtype=float)
+
     def nodes(self, f) -> ufl.core.expr.Expr:
         """The gathered nodes of a point field of ``xhat``'s shape, as an ``(nx, gdim)``
         UFL matrix."""
@@ -487,6 +497,11 @@ class MeshSlipReference:
         self.mask_n.x.array[:] = mask
         self.xhat_n.x.array[:] = xhat
         self._committed = None
+
+    def forget(self) -> None:
+        """Back to the state of a new reference: nothing committed, nothing gathered."""
+        self._gather_n = self._x_commit = self._xhat_n_commit = None
+        self._work = self._committed = None
 
     def y_n_at_points(self) -> np.ndarray:
         """``y_n`` at the owned slave points, ``(n, gdim)``."""
