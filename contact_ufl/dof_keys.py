@@ -30,7 +30,7 @@ def entity_keys(V: dolfinx.fem.FunctionSpace) -> np.ndarray:
     topology = basix.topology(element.cell_type)
     nv = len(topology[0])
     geometry = mesh.geometry
-    vertex_keys = geometry.input_global_indices[geometry.dofmap[:, :nv]].astype(np.int64)
+    vertex_keys = geometry.input_global_indices[geometry.dofmaps[0][:, :nv]].astype(np.int64)
     dofs = V.dofmap.list
     imap = V.dofmap.index_map
     keys = np.full((imap.size_local + imap.num_ghosts, nv), -2, dtype=np.int64)

@@ -295,7 +295,8 @@ class NewtonDriver:
     def _monitor(self, snes, its: int, norm: float) -> None:
         self.norms.append(float(norm))
         if self.on_iterate is not None:
-            self.on_iterate(float(norm))
+            with self._holding_errors():  # the next residual stops the solve
+                self.on_iterate(float(norm))
 
     @contextlib.contextmanager
     def _holding_errors(self) -> Iterator[None]:

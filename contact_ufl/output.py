@@ -8,6 +8,7 @@ is also shown inline.
 from __future__ import annotations
 
 import os
+import re
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -43,6 +44,11 @@ class ResultWriter:
     contact_surfaces
         Also write ``contact_surface_<k>.pvd`` for each pair ``k``: its slave points at
         every step (:class:`ContactSurfaceWriter`).
+
+    A problem restarted from the checkpoint of step ``n`` (:meth:`ContactProblem.restart
+    <contact_ufl.problem.ContactProblem.restart>`) writes its VTX files beside the first
+    run's, named ``<name>_from_step_<n>.bp`` (those of the first run are kept), and goes on
+    with the ``.pvd`` series after its step ``n``.
     """
 
     def __init__(self, problem, folder: str | Path, contact_surfaces: bool = True):
@@ -57,16 +63,19 @@ class ResultWriter:
             if len(bulks) == 1
             else [f"displacement_{k}" for k in range(len(bulks))]
         )
+        restored = getattr(problem, "restored_from", None)
+        suffix = "" if restored is None else f"_from_step_{restored[1]}"
         self.writers = [
-            dolfinx.io.VTXWriter(comm, folder / f"{name}.bp", [b.u])
+            dolfinx.io.VTXWriter(comm, folder / f"{name}{suffix}.bp", [b.u])
             for name, b in zip(names, bulks, strict=True)
         ]
         for k, c in enumerate(problem.contacts):
             multipliers = [c.lambda_N] + ([c.friction.lambda_T] if c.friction else [])
-            self.writers.append(dolfinx.io.VTXWriter(comm, folder / f"contact_{k}.bp", multipliers))
+            path = folder / f"contact_{k}{suffix}.bp"
+            self.writers.append(dolfinx.io.VTXWriter(comm, path, multipliers))
         self.histories = [h for b in bulks for h in b.histories.values()]
         for tag, h in ((tag, h) for b in bulks for tag, h in b.histories.items()):
-            path = folder / f"plastic_strain_{tag}.bp"
+            path = folder / f"plastic_strain_{tag}{suffix}.bp"
             self.writers.append(dolfinx.io.VTXWriter(comm, path, [h.plastic_strain]))
         self.surfaces = [
             ContactSurfaceWriter(problem, folder / f"contact_surface_{k}.pvd", k)
@@ -134,6 +143,9 @@ class ContactSurfaceWriter:
         self.path = Path(path).with_suffix(".pvd")
         self.folder = self.path.with_suffix("")
         self.steps: list[tuple[float, str]] = []
+        restored = getattr(problem, "restored_from", None)
+        if restored is not None:  # go on after the restart's step, drop the later ones
+            self.steps = [(t, f) for t, f in _series(self.path) if t <= restored[2]]
         if problem.comm.rank == 0:
             self.folder.mkdir(parents=True, exist_ok=True)
         problem.comm.barrier()
@@ -166,6 +178,15 @@ class ContactSurfaceWriter:
     def __call__(self, problem, record) -> None:
         """Use as the ``callback`` of :meth:`ContactProblem.solve`."""
         self.write(record.t)
+
+
+def _series(path: Path) -> list[tuple[float, str]]:
+    """The steps of a ``.pvd`` series written by :class:`ContactSurfaceWriter` (none if
+    there is no such file)."""
+    if not path.is_file():
+        return []
+    entries = re.findall(r'timestep="([^"]*)"[^>]*file="([^"]*)"', path.read_text())
+    return [(float(t), file) for t, file in entries]
 
 
 def say(text: str, comm=None) -> None:

@@ -504,7 +504,10 @@ class ContactProblem:
         operator = ContactOperator(system, pattern_superset=self.gdim == 2)
         # the initial state is the converged state of step 0; a restored one was committed
         # but for the contacts' slip references, which come from a search there
-        self._settle(operator, self.contacts if committed else self._parts_with_history())
+        if committed:
+            self._settle(operator, self.contacts, replan=True)
+        else:
+            self._settle(operator, self._parts_with_history())
         operator.first_tangent()
         # a force scale: 1e-11 of E_max L^(d-1) with L the scene's diameter
         size, E = self.scales()
@@ -526,13 +529,16 @@ class ContactProblem:
         )
         return StepSolver(self, operator, newton, diagnosis)
 
-    def _settle(self, operator: ContactOperator, parts: list) -> None:
+    def _settle(self, operator: ContactOperator, parts: list, replan: bool = False) -> None:
         """The pairing at the operator's state, ``parts`` committed there, the next step
-        begun, and the pairing again (with the slip references' gathers)."""
+        begun, and the pairing again (with the slip references' gathers; ``replan``: on
+        which the operator plans its pattern from nothing, as :meth:`fresh_start` does)."""
         operator.update_pairing(operator.x)
         for part in parts:
             part.commit(operator.x)
         self.begin_step()
+        if replan:
+            operator.replan()
         operator.update_pairing(operator.x)
 
     @property
@@ -549,20 +555,14 @@ class ContactProblem:
         return self._solver
 
     def fresh_start(self) -> None:
-        """Continue from the committed state as a restart from it would: the pairings met
-        forgotten (chain operator, sparsity plan, solver matrix and factorisation made anew)
-        and the slip references from a search there (collective). Done at every checkpoint,
-        so that a run and its restart solve the same systems: bit for bit on one rank."""
+        """Go on from the state of a begun step as a restart from its start would: the
+        pairings met forgotten, the chain operator, sparsity plan, solver matrix and
+        factorisation made anew there (collective). The load stepper does it at the start
+        of the step after each checkpoint, so that a run and its restart solve the same
+        systems: bit for bit on one rank."""
         operator = self.solver.operator
-        laws = [c.friction for c in self.contacts if c.friction]
-        inspected = [(law.last_slip, law.last_stick, law.last_weak_slip) for law in laws]
-        for law in laws:
-            law.forget_reference()
         operator.replan()
-        self._settle(operator, self.contacts)
-        for law, (slip, stick, weak) in zip(laws, inspected, strict=True):
-            # those of the step's own commit (a new reference knows no slip)
-            law.last_slip, law.last_stick, law.last_weak_slip = slip, stick, weak
+        operator.update_pairing(operator.x)
         operator.first_tangent()
         self.solver.newton.reset_factorisation()
 

@@ -166,6 +166,7 @@ class LoadStepper:
         self.history = History()
         self.schedule: Schedule | None = None  # that of the solve under way (or the last)
         self._resumed: tuple[Schedule, float] | None = None
+        self._fresh_start_due = False  # a checkpoint was written: a restart point
 
     def resume(self, schedule: Schedule, t: float) -> None:
         """Continue the solve that ``schedule`` belongs to, from pseudo-time ``t`` (a
@@ -207,7 +208,8 @@ class LoadStepper:
         :attr:`history` (and were passed to ``callback(problem, record)``, e.g. a
         :class:`~contact_ufl.output.ResultWriter`) whatever happens later. With
         ``checkpoints`` (:class:`~contact_ufl.checkpoint.Checkpoints`) the state is written at
-        the steps it says, and the solver starts afresh from it (as a restart would).
+        the steps it says, and the next step starts afresh from it (as a restart would:
+        :meth:`~contact_ufl.problem.ContactProblem.fresh_start`).
 
         Returns
         -------
@@ -235,6 +237,9 @@ class LoadStepper:
             start = time.perf_counter()
             try:
                 problem.begin_step()
+                if self._fresh_start_due:  # the first step after a checkpoint
+                    problem.fresh_start()
+                    self._fresh_start_due = False
                 ok, its, reason = solver.solve_step(t_new)
             except BaseException:  # an error or Ctrl-C inside the step: back to t_prev
                 self._restore(saved, t_prev)
@@ -274,7 +279,7 @@ class LoadStepper:
             finished = problem.t >= t_end - 1e-12 * abs(t_end)
             if checkpoints is not None and checkpoints.due(record.step, finished):
                 checkpoints.write(problem, self.history, plan)
-                problem.fresh_start()
+                self._fresh_start_due = True
         return self.history
 
     def _restore(self, saved: list[np.ndarray], t: float) -> None:

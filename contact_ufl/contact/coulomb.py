@@ -208,10 +208,6 @@ class CoulombLaw:
         a step cut back and tried again starts from the same reference)."""
         self.reference.begin_step()
 
-    def forget_reference(self) -> None:
-        """Make the slip reference as new (before a restart point commits it again)."""
-        self.reference.forget()
-
     # -- inspection -------------------------------------------------------------------
     def slip_at_points(self) -> np.ndarray:
         """Slip increment s_T since the last converged step at the owned slave points."""

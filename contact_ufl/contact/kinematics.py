@@ -498,11 +498,6 @@ class MeshSlipReference:
         self.xhat_n.x.array[:] = xhat
         self._committed = None
 
-    def forget(self) -> None:
-        """Back to the state of a new reference: nothing committed, nothing gathered."""
-        self._gather_n = self._x_commit = self._xhat_n_commit = None
-        self._work = self._committed = None
-
     def y_n_at_points(self) -> np.ndarray:
         """``y_n`` at the owned slave points, ``(n, gdim)``."""
         k, slave, gdim = self.kinematics, self.kinematics.slave, self.kinematics.gdim

@@ -468,10 +468,6 @@ class ObstacleSlipReference:
         self.kinematics.slave.set_at_points(self.mask_n, mask)
         self._committed = None
 
-    def forget(self) -> None:
-        """Back to the state of a new reference: nothing committed."""
-        self._committed = None
-
     def y_n_at_points(self) -> np.ndarray:
         """``y_n`` at the owned slave points, ``(n, gdim)``."""
         p, Q = self.kinematics.pose

@@ -1,0 +1,182 @@
+"""Checkpoints and restart: a run continued from a checkpoint ends where the run never
+stopped ends (consistency): bit for bit on one rank, to the run-to-run spread of the
+distributed direct solver on two, and to solver tolerance on another number of ranks; on
+the frictional ironing (slip references), a plastic indentation (quadrature-point history)
+and a membrane inflated by its volume against a plane (the pressure unknown).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import across_ranks
+from mpi4py import MPI
+
+import contact_ufl as cu
+from contact_ufl.control import VolumeControl
+from contact_ufl.verification import scenes
+
+#: two runs of MUMPS on two ranks differ in the last bits (measured: 1e-16 relative in the
+#: unknowns, run to run, the same code and input): restarts there agree to that spread
+SPREAD = 1e-10
+#: SNES stops at rtol 1e-9: runs on different numbers of ranks may stop an iterate apart
+#: (measured: 1e-15 relative in the forces)
+ACROSS_RANKS = 1e-8
+SOURCE = "the same run never stopped"
+
+
+def _ironing(comm):
+    return scenes.ironing(mu=0.3, h_punch=0.05, h_block=0.2, comm=comm)
+
+
+def _plastic(comm):
+    return scenes.plastic_indentation(comm=comm)
+
+
+def _balloon(comm):
+    """The inflated sphere octant (coarse), its volume controlled, against a rigid plane."""
+    (domain,) = scenes.inflated_sphere(n=8, comm=comm).domains
+    growth = 1.3**3 - 1.0
+    control = VolumeControl("membrane", lambda t: 1.0 + growth * t)
+    domain = dataclasses.replace(domain, loads=[control])
+    plane = cu.RigidPlane((0.0, 0.0, 1.12), (0.0, 0.0, -1.0))
+    return cu.Scene(domains=[domain], contacts=[cu.ContactPair("membrane", plane, mu=0.3)])
+
+
+#: scene, the solves (num_steps, t_end), the checkpoint restarted from, and its description
+CASES = {
+    "ironing": (_ironing, [(10, 1.0), (4, 1.08)], 9, "2D frictional ironing, mu = 0.3, quick"),
+    "plastic": (_plastic, [(4, 1.0), (4, 2.0)], 5, "plastic indentation, in and out"),
+    "balloon": (_balloon, [(6, 1.0)], 4, "balloon under volume control on a plane, mu = 0.3"),
+}
+
+
+def _shared_folder(comm) -> Path:
+    """A new folder, the same on every rank of ``comm``."""
+    name = tempfile.mkdtemp(prefix="contact_ufl_restart_") if comm.rank == 0 else None
+    return Path(comm.bcast(name, root=0))
+
+
+def _problem(case: str, comm) -> cu.ContactProblem:
+    options = {"snes_max_it": 40}
+    return cu.ContactProblem(CASES[case][0](comm), verbose=False, petsc_options=options)
+
+
+def _run(case: str, comm, folder: Path | None, restart: int | None = None, every: int = 1):
+    problem = _problem(case, comm)
+    if restart is not None:
+        problem.restart(folder, restart)
+    checkpoints = None if folder is None else cu.Checkpoints(folder, every=every, keep=None)
+    for num_steps, t_end in CASES[case][1]:
+        problem.solve(num_steps=num_steps, t_end=t_end, checkpoint=checkpoints)
+    return problem
+
+
+def _state(problem) -> dict[str, np.ndarray]:
+    """This rank's unknowns and histories."""
+    state = {"x": problem.solver.x.array.copy()}
+    for b in problem.bulks:
+        for tag, h in b.histories.items():
+            state[f"Cp_inv {tag}"] = h.Cp_inv.x.array.copy()
+            state[f"alpha {tag}"] = h.alpha.x.array.copy()
+    return state
+
+
+def _records(problem) -> list[tuple]:
+    return [(s.step, s.t, s.newton_iterations, s.active_points) for s in problem.history.steps]
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_restart_continues_the_run(case, verification):
+    """A problem made anew and restarted from a checkpoint in the middle of the run (the
+    friction's slip references, the plastic history, the pressure unknown, the schedule of
+    the solve under way all from the checkpoint) ends in the state of the run that wrote it,
+    with the same step records."""
+    comm = MPI.COMM_WORLD
+    folder = _shared_folder(comm)
+    whole = _run(case, comm, folder)
+    restart = CASES[case][2]
+    # writing checkpoints leaves the results those of the last step
+    assert np.array_equal(whole.contact_force(), whole.history.steps[-1].contact_force)
+    # the script run again from the top, restarted: it writes its checkpoints again
+    restarted = _run(case, comm, folder, restart=restart)
+    t = whole.history.steps[restart - 1].t
+    assert restarted.restored_from == (folder / f"step_{restart:06d}", restart, t)
+    assert _records(restarted) == _records(whole)
+    assert len(restarted.history.steps) == len(whole.history.steps)
+    reference, state = _state(whole), _state(restarted)
+    worst = 0.0
+    for name, values in reference.items():
+        scale = max(np.abs(values).max(initial=0.0), 1e-300)
+        worst = max(worst, np.abs(state[name] - values).max(initial=0.0) / scale)
+    worst = comm.allreduce(worst, op=MPI.MAX)
+    tol = 0.0 if comm.size == 1 else SPREAD
+    quantity = f"largest relative difference of the unknowns and histories, from step {restart}"
+    verification(CASES[case][3], quantity, worst, 0.0, tol, SOURCE, kind="consistency")
+    assert worst <= tol
+    whole.close()
+    restarted.close()
+
+
+def _summary(problem) -> dict[str, np.ndarray]:
+    """Quantities of the final state that do not depend on the partition: the contact
+    force, the norm of each displacement, the sum of each history's equivalent plastic
+    strain over its points, the controls' pressures."""
+    comm = problem.comm
+    summary = {"contact force": problem.contact_force()}
+    for k, b in enumerate(problem.bulks):
+        owned = b.V.dofmap.index_map.size_local * b.V.dofmap.index_map_bs
+        summary[f"|u_{k}|"] = np.sqrt(comm.allreduce(np.sum(b.u.x.array[:owned] ** 2)))
+        for tag, h in b.histories.items():
+            points = h.alpha.function_space.dofmap.index_map.size_local
+            summary[f"sum alpha {tag}"] = comm.allreduce(h.alpha.x.array[:points].sum())
+    for k, control in enumerate(problem.controls):
+        summary[f"pressure {k}"] = control.pressure
+    return summary
+
+
+def _difference(problem, reference) -> float:
+    """The largest relative difference of the :func:`_summary` quantities."""
+    ours, theirs = _summary(problem), _summary(reference)
+    worst = 0.0
+    for name, value in theirs.items():
+        scale = max(np.abs(value).max(), 1e-300)
+        worst = max(worst, np.abs(np.asarray(ours[name]) - value).max() / scale)
+    return worst
+
+
+@across_ranks
+@pytest.mark.parametrize("case", list(CASES))
+def test_restart_on_another_number_of_ranks(case, verification):
+    """Checkpoints written on one rank restart on two, and those of two ranks on one; the
+    restarted runs end in the state of the run never stopped (contact force, displacement
+    norms, plastic strain, pressure), to solver tolerance."""
+    world, alone = MPI.COMM_WORLD, MPI.COMM_SELF
+    restart = CASES[case][2]
+    own = Path(tempfile.mkdtemp(prefix="contact_ufl_single_"))  # each rank's
+    single = _run(case, alone, own)
+    distributed = _problem(case, world)
+    distributed.restart(world.bcast(own, root=0), restart)  # rank 0's
+    for num_steps, t_end in CASES[case][1]:
+        distributed.solve(num_steps=num_steps, t_end=t_end)
+    one_to_two = _difference(distributed, single)
+    from_one = _shared_folder(world)
+    shared = _run(case, world, from_one)
+    restarted_alone = _problem(case, alone)
+    restarted_alone.restart(from_one, restart)
+    for num_steps, t_end in CASES[case][1]:
+        restarted_alone.solve(num_steps=num_steps, t_end=t_end)
+    two_to_one = _difference(restarted_alone, shared)
+    for quantity, value in (
+        ("largest relative difference of the final state, 1 rank -> 2 ranks", one_to_two),
+        ("largest relative difference of the final state, 2 ranks -> 1 rank", two_to_one),
+    ):
+        verification(CASES[case][3], quantity, value, 0.0, ACROSS_RANKS, SOURCE, kind="consistency")
+    assert one_to_two < ACROSS_RANKS and two_to_one < ACROSS_RANKS
+    assert _records(distributed) == _records(single)
+    for p in (single, distributed, shared, restarted_alone):
+        p.close()
