@@ -262,10 +262,13 @@ def _check_meshes(problem, meta: dict, path: Path) -> None:
             now["coordinate_sum"], then["coordinate_sum"], rtol=1e-9, atol=1e-12
         )
         if not same:
+            counts = (then["nodes"], then["cells"], then["dofs"])
+            moved = counts == (now["nodes"], now["cells"], now["dofs"])
             raise ContactInputError(
                 f"{path} was written for another mesh {k} or degree: it had {then['nodes']} "
                 f"nodes, {then['cells']} cells and {then['dofs']} displacement dofs, this one "
                 f"{now['nodes']}, {now['cells']} and {now['dofs']}"
+                + (" (the same numbers, but its nodes elsewhere)" if moved else "")
             )
 
 

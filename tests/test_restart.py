@@ -8,6 +8,7 @@ and a membrane inflated by its volume against a plane (the pressure unknown).
 from __future__ import annotations
 
 import dataclasses
+import re
 import tempfile
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from mpi4py import MPI
 
 import contact_ufl as cu
 from contact_ufl.control import VolumeControl
+from contact_ufl.errors import ContactInputError
 from contact_ufl.verification import scenes
 
 #: two runs of MUMPS on two ranks differ in the last bits (measured: 1e-16 relative in the
@@ -180,3 +182,84 @@ def test_restart_on_another_number_of_ranks(case, verification):
     assert _records(distributed) == _records(single)
     for p in (single, distributed, shared, restarted_alone):
         p.close()
+
+
+def test_checkpoints_refuse_bad_input():
+    """Bad input names the problem, on every rank, before any work."""
+    for options, message in (
+        ({"every": 0}, "every must be a whole number"),
+        ({"every": 1.5}, "every must be a whole number"),
+        ({"keep": 0}, "keep must be a whole number"),
+    ):
+        with pytest.raises(ContactInputError, match=message):
+            cu.Checkpoints("unused", **options)
+
+
+def test_restart_refuses_what_it_cannot_continue():
+    """A missing folder or step, a problem that solved already, a checkpoint of another mesh
+    or of another format: each a :class:`ContactInputError` naming it, on every rank; a
+    partial checkpoint (a write cut short) is not one."""
+    comm = MPI.COMM_WORLD
+    folder = _shared_folder(comm)
+    written = cu.ContactProblem(scenes.patch(comm=comm), verbose=False)
+    written.solve(num_steps=2, checkpoint=cu.Checkpoints(folder, keep=1))
+    assert cu.Checkpoints(folder).steps() == [2]  # keep=1: the last one only
+    if comm.rank == 0:
+        (folder / "step_000003.partial").mkdir()
+    comm.barrier()
+    assert cu.Checkpoints(folder).steps() == [2]
+    with pytest.raises(ContactInputError, match="no complete checkpoint in"):
+        cu.ContactProblem(scenes.patch(comm=comm), verbose=False).restart(folder / "none")
+    with pytest.raises(ContactInputError, match=r"no complete checkpoint of step 1 .*\[2\]"):
+        cu.ContactProblem(scenes.patch(comm=comm), verbose=False).restart(folder, 1)
+    with pytest.raises(ContactInputError, match="restart a problem just made"):
+        written.restart(folder)
+    other = cu.ContactProblem(scenes.patch(comm=comm, height=0.6), verbose=False)  # moved nodes
+    with pytest.raises(ContactInputError, match="written for another mesh 0"):
+        other.restart(folder)
+    comm.barrier()
+    if comm.rank == 0:
+        meta = folder / "step_000002" / "meta.json"
+        meta.write_text(meta.read_text().replace('"format": 1', '"format": 99'))
+    comm.barrier()
+    with pytest.raises(ContactInputError, match="has format 99"):
+        cu.ContactProblem(scenes.patch(comm=comm), verbose=False).restart(folder)
+    written.close()
+
+
+def test_result_files_go_on_after_a_restart():
+    """A restarted run writes its VTX files beside the first run's (named from its step)
+    and goes on with the contact surface's ``.pvd`` series after the checkpoint's step
+    (the steps after it, written by the first run, replaced)."""
+    comm = MPI.COMM_WORLD
+    folder = _shared_folder(comm)
+    first = cu.ContactProblem(scenes.patch(comm=comm), verbose=False)
+    writer = cu.ResultWriter(first, folder / "out")
+    first.solve(num_steps=3, callback=writer, checkpoint=folder / "checkpoints")
+    writer.close()
+    again = cu.ContactProblem(scenes.patch(comm=comm), verbose=False)
+    again.restart(folder / "checkpoints", 2)
+    writer = cu.ResultWriter(again, folder / "out")
+    again.solve(num_steps=3, callback=writer)
+    writer.close()
+    names = sorted(p.name for p in (folder / "out").glob("*.bp"))
+    assert names == [
+        "contact_0.bp",
+        "contact_0_from_step_2.bp",
+        "displacement_0.bp",
+        "displacement_0_from_step_2.bp",
+        "displacement_1.bp",
+        "displacement_1_from_step_2.bp",
+    ] or names == [
+        "contact_0.bp",
+        "contact_0_from_step_2.bp",
+        "displacement.bp",
+        "displacement_from_step_2.bp",
+    ]
+    series = (folder / "out" / "contact_surface_0.pvd").read_text()
+    times = [float(t) for t in re.findall(r'timestep="([^"]*)"', series)]
+    files = re.findall(r'file="([^"]*)"', series)
+    assert times == pytest.approx([1 / 3, 2 / 3, 1.0])
+    assert files == [f"contact_surface_0/step_{k:05d}.vtu" for k in range(3)]
+    first.close()
+    again.close()
