@@ -83,14 +83,17 @@ class Checkpoints:
         rank 0, which writes them into a partial folder and then renames it."""
         comm = problem.comm
         step = len(history.steps)
-        arrays = {}
-        kinds = {}
-        for name, kind, keys, values in _state(problem):
-            gathered = comm.gather((keys, values), root=0)
-            kinds[name] = kind
-            if comm.rank == 0:
-                arrays[f"{name}.keys"] = np.concatenate([k for k, _ in gathered])
-                arrays[f"{name}.values"] = np.concatenate([v for _, v in gathered])
+        arrays, kinds = {}, {}
+        for name, kind, key_name, keys, values in _state(problem):
+            kinds[name] = [kind, key_name]
+            if f"{key_name}.keys" not in arrays:  # fields on one space share their keys
+                gathered = comm.gather(keys, root=0)
+                arrays[f"{key_name}.keys"] = (
+                    _compact(np.concatenate(gathered)) if gathered else None
+                )
+            gathered = comm.gather(values, root=0)
+            arrays[f"{name}.values"] = np.concatenate(gathered) if gathered else None
+        arrays = {k: v for k, v in arrays.items() if v is not None}
         meta = _meta(problem, history, schedule, kinds)
         final = self.path(step)
         error = None
@@ -154,12 +157,13 @@ def _unknown_fields(problem) -> Iterator[tuple[str, dolfinx.fem.Function]]:
         yield f"unknown_{i}", f
 
 
-def _point_fields(problem) -> Iterator[tuple[str, dolfinx.fem.Function]]:
-    """The plastic histories (quadrature functions on the bulk meshes)."""
+def _point_fields(problem) -> Iterator[tuple[str, str, dolfinx.fem.Function]]:
+    """The plastic histories (quadrature functions on the bulk meshes): name, name of their
+    points, field."""
     for k, b in enumerate(problem.bulks):
         for tag, h in b.histories.items():
-            yield f"plastic_{k}_{tag}_Cp_inv", h.Cp_inv
-            yield f"plastic_{k}_{tag}_alpha", h.alpha
+            yield f"plastic_{k}_{tag}_Cp_inv", f"plastic_{k}_{tag}", h.Cp_inv
+            yield f"plastic_{k}_{tag}_alpha", f"plastic_{k}_{tag}", h.alpha
 
 
 def _slave_arrays(problem) -> Iterator[tuple[str, object, str]]:
@@ -172,26 +176,36 @@ def _slave_arrays(problem) -> Iterator[tuple[str, object, str]]:
             yield f"contact_{k}_last_stick", c.friction, "last_stick"
 
 
-def _state(problem) -> Iterator[tuple[str, str, np.ndarray, np.ndarray]]:
-    """Every field of the committed state: name, kind of key (``entity`` or ``point``),
-    keys and values of this rank's owned dofs or points."""
+def _state(problem) -> Iterator[tuple[str, str, str, np.ndarray, np.ndarray]]:
+    """Every field of the committed state: name, kind of key (``entity`` or ``point``), the
+    name of its keys (shared by the fields of one space), keys and values of this rank's
+    owned dofs or points."""
+    keys = {}
     for name, f in _unknown_fields(problem):
         owned = f.function_space.dofmap.index_map.size_local
-        yield name, "entity", entity_keys(f.function_space)[:owned], _owned(f)
+        keys[name] = entity_keys(f.function_space)[:owned]
+        yield name, "entity", name, keys[name], _owned(f)
     last = problem.solver.predictor.last
     if last is not None:
         increments = [f.copy() for f in problem.unknowns]
         fem_petsc.assign(last[2], increments)
-        for (name, f), d in zip(_unknown_fields(problem), increments, strict=True):
-            owned = f.function_space.dofmap.index_map.size_local
-            yield f"increment_{name}", "entity", entity_keys(f.function_space)[:owned], _owned(d)
-    for name, f in _point_fields(problem):
-        yield name, "point", quadrature_positions(f.function_space), _owned(f)
+        for (name, _), d in zip(_unknown_fields(problem), increments, strict=True):
+            yield f"increment_{name}", "entity", name, keys[name], _owned(d)
+    for name, points, f in _point_fields(problem):
+        yield name, "point", points, quadrature_positions(f.function_space), _owned(f)
     for name, holder, attribute in _slave_arrays(problem):
-        c = problem.contacts[int(name.split("_")[1])]
+        k = int(name.split("_")[1])
+        c = problem.contacts[k]
         positions = c.slave.X.reshape(-1, c.gdim)
         values = np.asarray(getattr(holder, attribute), dtype=float)
-        yield name, "point", positions, values.reshape(len(positions), -1)
+        yield name, "point", f"contact_{k}_points", positions, values.reshape(len(positions), -1)
+
+
+def _compact(keys: np.ndarray) -> np.ndarray:
+    """Entity keys as 32-bit integers where they fit (positions as they are)."""
+    if keys.dtype.kind == "i" and (len(keys) == 0 or np.abs(keys).max() < 2**31):
+        return keys.astype(np.int32)
+    return keys
 
 
 def _fingerprints(problem) -> list[dict]:
@@ -305,9 +319,9 @@ def restart(problem, folder: str | Path, step: int | None = None) -> float:
         def values(name: str, wanted: np.ndarray, kind: str) -> np.ndarray:
             if name not in meta["fields"]:
                 raise ContactInputError(f"{path} holds no {name}: it was written for another scene")
-            stored = data[f"{name}.keys"]
+            stored = data[f"{meta['fields'][name][1]}.keys"]
             if kind == "entity":
-                at = find_keys(stored, wanted, name)
+                at = find_keys(stored.astype(np.int64), wanted, name)
             else:
                 at = find_points(stored, wanted, 1e-9 * size, name)
             return data[f"{name}.values"][at]
@@ -318,7 +332,7 @@ def restart(problem, folder: str | Path, step: int | None = None) -> float:
 
         for name, f in _unknown_fields(problem):
             _set_owned(f, entity_values(name, f))
-        for name, f in _point_fields(problem):
+        for name, _, f in _point_fields(problem):
             _set_owned(f, values(name, quadrature_positions(f.function_space), "point"))
         slave_data = {}
         for name, holder, attribute in _slave_arrays(problem):
