@@ -32,6 +32,11 @@ class ResultWriter:
     ParaView opens both kinds; pyvista (and VTK without ADIOS2) reads only the ``.pvd``
     series.
 
+    A problem restarted from the checkpoint of step ``n`` (:meth:`ContactProblem.restart
+    <contact_ufl.problem.ContactProblem.restart>`) writes its VTX files beside the first
+    run's, named ``<name>_from_step_<n>.bp`` (those of the first run are kept), and goes on
+    with the ``.pvd`` series after its step ``n``.
+
     Parameters
     ----------
     problem
@@ -44,11 +49,6 @@ class ResultWriter:
     contact_surfaces
         Also write ``contact_surface_<k>.pvd`` for each pair ``k``: its slave points at
         every step (:class:`ContactSurfaceWriter`).
-
-    A problem restarted from the checkpoint of step ``n`` (:meth:`ContactProblem.restart
-    <contact_ufl.problem.ContactProblem.restart>`) writes its VTX files beside the first
-    run's, named ``<name>_from_step_<n>.bp`` (those of the first run are kept), and goes on
-    with the ``.pvd`` series after its step ``n``.
     """
 
     def __init__(self, problem, folder: str | Path, contact_surfaces: bool = True):
