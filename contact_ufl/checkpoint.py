@@ -20,6 +20,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 import dolfinx
+import dolfinx.io
 import numpy as np
 from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
@@ -94,6 +95,7 @@ class Checkpoints:
             gathered = comm.gather(values, root=0)
             arrays[f"{name}.values"] = np.concatenate(gathered) if gathered else None
         arrays = {k: v for k, v in arrays.items() if v is not None}
+        self._write_meshes(problem)
         meta = _meta(problem, history, schedule, kinds)
         final = self.path(step)
         error = None
@@ -107,6 +109,31 @@ class Checkpoints:
         if error is not None:
             raise OSError(error)
         return final
+
+    def _write_meshes(self, problem) -> None:
+        """Write the meshes and their tags once, as XDMF (``meshes/mesh_<k>.xdmf``), for
+        a look at the run without its script; a restart reads the script's meshes and
+        checks them against the fingerprints of each checkpoint (collective)."""
+        comm = problem.comm
+        final = self.folder / "meshes"
+        if comm.bcast(final.is_dir() if comm.rank == 0 else None, root=0):
+            return
+        partial = self.folder / "meshes.partial"
+        if comm.rank == 0:
+            shutil.rmtree(partial, ignore_errors=True)
+            partial.mkdir(parents=True)
+        comm.barrier()
+        for k, b in enumerate(problem.bulks):
+            mesh, domain = b.V.mesh, b.domain
+            with dolfinx.io.XDMFFile(comm, partial / f"mesh_{k}.xdmf", "w") as f:
+                f.write_mesh(mesh)
+                mesh.topology.create_connectivity(mesh.topology.dim - 1, mesh.topology.dim)
+                f.write_meshtags(domain.cell_tags, mesh.geometry)
+                f.write_meshtags(domain.facet_tags, mesh.geometry)
+        comm.barrier()
+        if comm.rank == 0:
+            partial.rename(final)
+        comm.barrier()
 
     def _write_files(self, final: Path, arrays: dict, meta: dict) -> None:
         partial = final.with_name(final.name + ".partial")

@@ -263,3 +263,26 @@ def test_result_files_go_on_after_a_restart():
     assert files == [f"contact_surface_0/step_{k:05d}.vtu" for k in range(3)]
     first.close()
     again.close()
+
+
+def test_meshes_are_written_once_with_their_tags():
+    """The checkpoint folder holds each mesh and its tags once, as XDMF, readable by
+    DOLFINx on any number of ranks (the same cells and tagged entities)."""
+    import dolfinx.io
+
+    comm = MPI.COMM_WORLD
+    folder = _shared_folder(comm)
+    problem = cu.ContactProblem(scenes.patch(comm=comm), verbose=False)
+    problem.solve(num_steps=2, checkpoint=folder)
+    for k, b in enumerate(problem.bulks):
+        mesh, tags = b.V.mesh, b.domain.cell_tags
+        with dolfinx.io.XDMFFile(comm, folder / "meshes" / f"mesh_{k}.xdmf", "r") as f:
+            read = f.read_mesh(name=mesh.name)
+            read_tags = f.read_meshtags(read, name=tags.name)
+        cells = read.topology.index_map(read.topology.dim).size_global
+        assert cells == mesh.topology.index_map(mesh.topology.dim).size_global
+        owned = mesh.topology.index_map(mesh.topology.dim).size_local
+        read_owned = read.topology.index_map(read.topology.dim).size_local
+        count = comm.allreduce(int(np.sum(tags.indices < owned)))
+        assert comm.allreduce(int(np.sum(read_tags.indices < read_owned))) == count
+    problem.close()
