@@ -22,9 +22,10 @@ from contact_ufl.control import VolumeControl
 from contact_ufl.errors import ContactInputError
 from contact_ufl.verification import scenes
 
-#: two runs of MUMPS on two ranks differ in the last bits (measured: 1e-16 relative in the
-#: unknowns, run to run, the same code and input): restarts there agree to that spread
-SPREAD = 1e-10
+#: two runs of MUMPS on two ranks differ in the last bits (measured: 1e-16 relative in a
+#: solve, up to 1.1e-13 of the largest unknown after the ironing's 14 steps, the same code
+#: and input): restarts there agree to that spread (the final state, of forces and norms)
+SPREAD = 1e-12
 #: SNES stops at rtol 1e-9: runs on different numbers of ranks may stop an iterate apart
 #: (measured: 1e-15 relative in the forces)
 ACROSS_RANKS = 1e-8
@@ -36,7 +37,7 @@ def _ironing(comm):
 
 
 def _plastic(comm):
-    return scenes.plastic_indentation(comm=comm)
+    return scenes.plastic_indentation(h_contact=0.02, comm=comm)
 
 
 def _balloon(comm):
@@ -52,7 +53,7 @@ def _balloon(comm):
 #: scene, the solves (num_steps, t_end), the checkpoint restarted from, and its description
 CASES = {
     "ironing": (_ironing, [(10, 1.0), (4, 1.08)], 9, "2D frictional ironing, mu = 0.3, quick"),
-    "plastic": (_plastic, [(4, 1.0), (4, 2.0)], 5, "plastic indentation, in and out"),
+    "plastic": (_plastic, [(3, 1.0), (3, 2.0)], 4, "plastic indentation, in and out"),
     "balloon": (_balloon, [(6, 1.0)], 4, "balloon under volume control on a plane, mu = 0.3"),
 }
 
@@ -92,12 +93,13 @@ def _records(problem) -> list[tuple]:
     return [(s.step, s.t, s.newton_iterations, s.active_points) for s in problem.history.steps]
 
 
+@pytest.mark.serial  # on two ranks: test_restart_on_any_number_of_ranks
 @pytest.mark.parametrize("case", list(CASES))
 def test_restart_continues_the_run(case, verification):
     """A problem made anew and restarted from a checkpoint in the middle of the run (the
     friction's slip references, the plastic history, the pressure unknown, the schedule of
     the solve under way all from the checkpoint) ends in the state of the run that wrote it,
-    with the same step records."""
+    bit for bit, with the same step records (one rank)."""
     comm = MPI.COMM_WORLD
     folder = _shared_folder(comm)
     whole = _run(case, comm, folder)
@@ -116,10 +118,9 @@ def test_restart_continues_the_run(case, verification):
         scale = max(np.abs(values).max(initial=0.0), 1e-300)
         worst = max(worst, np.abs(state[name] - values).max(initial=0.0) / scale)
     worst = comm.allreduce(worst, op=MPI.MAX)
-    tol = 0.0 if comm.size == 1 else SPREAD
     quantity = f"largest relative difference of the unknowns and histories, from step {restart}"
-    verification(CASES[case][3], quantity, worst, 0.0, tol, SOURCE, kind="consistency")
-    assert worst <= tol
+    verification(CASES[case][3], quantity, worst, 0.0, 0.0, SOURCE, kind="consistency")
+    assert worst == 0.0
     whole.close()
     restarted.close()
 
@@ -153,10 +154,11 @@ def _difference(problem, reference) -> float:
 
 @across_ranks
 @pytest.mark.parametrize("case", list(CASES))
-def test_restart_on_another_number_of_ranks(case, verification):
-    """Checkpoints written on one rank restart on two, and those of two ranks on one; the
-    restarted runs end in the state of the run never stopped (contact force, displacement
-    norms, plastic strain, pressure), to solver tolerance."""
+def test_restart_on_any_number_of_ranks(case, verification):
+    """Checkpoints written on one rank restart on two, and those of two ranks on one and on
+    two; the restarted runs end in the state of the run never stopped (contact force,
+    displacement norms, plastic strain, pressure): to solver tolerance on another number of
+    ranks, to MUMPS's run-to-run spread on the same."""
     world, alone = MPI.COMM_WORLD, MPI.COMM_SELF
     restart = CASES[case][2]
     own = Path(tempfile.mkdtemp(prefix="contact_ufl_single_"))  # each rank's
@@ -173,14 +175,19 @@ def test_restart_on_another_number_of_ranks(case, verification):
     for num_steps, t_end in CASES[case][1]:
         restarted_alone.solve(num_steps=num_steps, t_end=t_end)
     two_to_one = _difference(restarted_alone, shared)
-    for quantity, value in (
-        ("largest relative difference of the final state, 1 rank -> 2 ranks", one_to_two),
-        ("largest relative difference of the final state, 2 ranks -> 1 rank", two_to_one),
+    restarted = _run(case, world, from_one, restart=restart)
+    two_to_two = _difference(restarted, shared)
+    prefix = "largest relative difference of the final state"
+    for quantity, value, tol in (
+        (f"{prefix}, 1 rank -> 2 ranks", one_to_two, ACROSS_RANKS),
+        (f"{prefix}, 2 ranks -> 1 rank", two_to_one, ACROSS_RANKS),
+        (f"{prefix}, 2 ranks -> 2 ranks", two_to_two, SPREAD),
     ):
-        verification(CASES[case][3], quantity, value, 0.0, ACROSS_RANKS, SOURCE, kind="consistency")
-    assert one_to_two < ACROSS_RANKS and two_to_one < ACROSS_RANKS
+        verification(CASES[case][3], quantity, value, 0.0, tol, SOURCE, kind="consistency")
+        assert value < tol
     assert _records(distributed) == _records(single)
-    for p in (single, distributed, shared, restarted_alone):
+    assert _records(restarted) == _records(shared)
+    for p in (single, distributed, shared, restarted_alone, restarted):
         p.close()
 
 
