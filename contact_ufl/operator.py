@@ -184,9 +184,9 @@ class ContactOperator:
         self._state = x.copy()
 
     def replan(self) -> None:
-        """Forget the pairings met: the chain operator, the sparsity plan and the solver
-        matrix are made anew at the next :meth:`update_pairing` and tangent, as a new
-        operator makes them (a restart point)."""
+        """Forget the pairings met: the chain operator and the sparsity plan are made anew
+        at the next :meth:`update_pairing`, the solver matrix at the next tangent (a
+        restart point)."""
         self.pattern = SolverPattern(self.comm, self.pattern.superset, self.pattern.slack)
         self._T = self._T_coupled = self._T_pattern = self._chained_tangent = None
         self._gather_columns = self._gathers = self._state = None
@@ -389,6 +389,7 @@ class ContactOperator:
         pairing left it (a ``new`` matrix: on that pattern only). Its pattern holds
         ``T^T K T``'s: ``T`` is within the superset operator."""
         plan = self.pattern
+        new = new or plan.product_keys is None  # a plan without its matrix yet
         if not (plan.must_grow or new):
             return self.matrix
         product = None  # the gathered blocks' T^T K T over the superset operator

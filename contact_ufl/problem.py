@@ -508,7 +508,7 @@ class ContactProblem:
             self._settle(operator, self.contacts, replan=True)
         else:
             self._settle(operator, self._parts_with_history())
-        operator.first_tangent()
+        operator.first_tangent()  # the driver's first matrix
         # a force scale: 1e-11 of E_max L^(d-1) with L the scene's diameter
         size, E = self.scales()
         options = {"snes_atol": 1e-11 * E * size ** (self.gdim - 1)} | self.petsc_options
@@ -527,6 +527,9 @@ class ContactProblem:
         diagnosis = StepDiagnosis(
             self.comm, self.contacts, self.free_pieces, lambda: inverted_cell_centres(self)
         )
+        if committed:  # as fresh_start leaves a run: the plan without its matrix
+            operator.replan()
+            operator.update_pairing(operator.x)
         return StepSolver(self, operator, newton, diagnosis)
 
     def _settle(self, operator: ContactOperator, parts: list, replan: bool = False) -> None:
@@ -556,15 +559,13 @@ class ContactProblem:
 
     def fresh_start(self) -> None:
         """Go on from the state of a begun step as a restart from its start would: the
-        pairings met forgotten, the chain operator, sparsity plan, solver matrix and
-        factorisation made anew there (collective). The load stepper does it at the start
-        of the step after each checkpoint, so that a run and its restart solve the same
-        systems: bit for bit on one rank."""
+        pairings met forgotten, the chain operator and sparsity plan made anew there, the
+        solver matrix (and its factorisation's analysis) at the next tangent (collective).
+        The load stepper does it at the start of the step after each checkpoint, so that a
+        run and its restart solve the same systems: bit for bit on one rank."""
         operator = self.solver.operator
         operator.replan()
         operator.update_pairing(operator.x)
-        operator.first_tangent()
-        self.solver.newton.reset_factorisation()
 
     def restart(self, folder: str | Path, step: int | None = None) -> float:
         """Continue from a checkpoint (collective).

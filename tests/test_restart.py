@@ -293,3 +293,53 @@ def test_meshes_are_written_once_with_their_tags():
         count = comm.allreduce(int(np.sum(tags.indices < owned)))
         assert comm.allreduce(int(np.sum(read_tags.indices < read_owned))) == count
     problem.close()
+
+
+@pytest.mark.serial
+def test_checkpoints_leave_the_run_as_it_was(verification):
+    """Writing checkpoints (each step after one a restart point) changes the run by
+    round-off only: the same Newton iterations, the same contact forces at every step."""
+    comm = MPI.COMM_WORLD
+    plain = _run("ironing", comm, None)
+    written = _run("ironing", comm, _shared_folder(comm))
+    assert [s.newton_iterations for s in written.history.steps] == [
+        s.newton_iterations for s in plain.history.steps
+    ]
+    forces = np.array([s.contact_force for s in plain.history.steps])
+    difference = np.abs(np.array([s.contact_force for s in written.history.steps]) - forces)
+    worst = float(difference.max() / np.abs(forces).max())
+    bound = 1e-14  # measured: 6e-16
+    case, quantity = CASES["ironing"][3], "largest relative change of a step's contact force"
+    source = "the same run without checkpoints"
+    verification(case, quantity, worst, 0.0, bound, source, kind="consistency")
+    assert worst < bound
+    assert np.array_equal(written.contact_force(), written.history.steps[-1].contact_force)
+
+
+@pytest.mark.slow
+def test_restart_in_3d_is_bit_for_bit(verification):
+    """The 3D frictional ironing (coarse), restarted during the slide: the same unknowns,
+    bit for bit, as the run that wrote the checkpoints (one rank; in 3D the solver matrix's
+    pattern is the union of the pairings met, which a restart point starts anew)."""
+    comm = MPI.COMM_SELF
+    folder = Path(tempfile.mkdtemp(prefix="contact_ufl_restart_3d_"))
+
+    def run(restart=None):
+        problem = cu.ContactProblem(
+            scenes.ironing_3d(mu=0.3, h_die=0.6, h_slab=0.75, comm=comm), verbose=False
+        )
+        if restart is not None:
+            problem.restart(folder, restart)
+        checkpoints = cu.Checkpoints(folder, every=3, keep=None)
+        problem.solve(num_steps=6, t_end=1.0, checkpoint=checkpoints)
+        problem.solve(num_steps=4, t_end=1.2, checkpoint=checkpoints)
+        return problem
+
+    whole = run()
+    restarted = run(restart=6)
+    worst = float(np.abs(restarted.solver.x.array - whole.solver.x.array).max())
+    case = "3D frictional ironing, mu = 0.3, h = 0.6 / 0.75"
+    quantity = "largest difference of the unknowns, restarted from step 6"
+    verification(case, quantity, worst, 0.0, 0.0, SOURCE, kind="consistency")
+    assert worst == 0.0
+    assert _records(restarted) == _records(whole)

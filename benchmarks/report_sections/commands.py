@@ -6,6 +6,8 @@ rebuilt from the repository's history).
 #: the history); a run's stamp has its own
 COMMANDS = {
     "cattaneo_mindlin.json": "python benchmarks/cattaneo_mindlin.py --json {path}",
+    "checkpoint.json": "python benchmarks/checkpoint.py --json {path}",
+    "checkpoint_quick.json": "python benchmarks/checkpoint.py --quick --json {path}",
     "eps_default_2d.json": "python benchmarks/eps_default.py --json {path}",
     "eps_default_2d_p2.json": "python benchmarks/eps_default.py --degree 2 --json {path}",
     "eps_default_3d.json": "python benchmarks/eps_default.py --dim 3 --json {path}",
