@@ -34,6 +34,7 @@ from contact_ufl.contact.obstacles import RigidObstacle
 from contact_ufl.control import VolumeConstraint, VolumeControl
 from contact_ufl.diagnosis import StepDiagnosis
 from contact_ufl.errors import NonUniqueSolutionWarning
+from contact_ufl.estimate import ErrorEstimate, error_estimate
 from contact_ufl.layout import StackedLayout
 from contact_ufl.mpi import collective, global_bounds, global_diameter
 from contact_ufl.newton import NewtonDriver
@@ -643,6 +644,13 @@ class ContactProblem:
         return self.stepper.solve(num_steps, t_end, max_cutbacks, callback, checkpoint)
 
     # -- results --------------------------------------------------------------------
+    @collective
+    def error_estimate(self) -> ErrorEstimate:
+        """The residual error indicators and estimate of the converged state
+        (:func:`contact_ufl.estimate.error_estimate`): per-cell indicators, the estimate in
+        the energy norm and its parts."""
+        return error_estimate(self)
+
     @collective
     def reaction(
         self, tag: int | str | Sequence[int | str], domain: int | str | None = None

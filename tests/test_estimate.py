@@ -1,0 +1,129 @@
+"""The residual error estimate (:mod:`contact_ufl.estimate`): it vanishes with the error
+where the exact solution is discrete (the patch test), falls under refinement and points at
+the contact zone (Hertz), and is the same on any number of ranks."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import dolfinx
+import numpy as np
+import pytest
+from conftest import across_ranks
+from mpi4py import MPI
+
+import contact_ufl as cu
+from contact_ufl.estimate import TERMS, ErrorEstimate
+from contact_ufl.results import contact_samples
+from contact_ufl.verification import scenes
+
+TIGHT = {"snes_rtol": 1e-13, "snes_atol": 1e-15}
+
+
+def _patch(quadrature_degree, subdivisions, comm=MPI.COMM_WORLD):
+    scene = scenes.patch(quadrature_degree=quadrature_degree, subdivisions=subdivisions, comm=comm)
+    problem = cu.ContactProblem(scene, verbose=False, petsc_options=TIGHT)
+    problem.solve(num_steps=1)
+    return problem
+
+
+@pytest.mark.serial
+def test_the_estimate_of_the_patch_test_vanishes_with_its_error(verification):
+    """The patch test's exact solution is uniform, in the discrete space: what the estimate
+    sees is the contact integrals' quadrature error (the multipliers off the pressure), and
+    it falls with it as the slave facets' rule is refined."""
+    relative, deviation = [], []
+    for degree, subdivisions in ((None, 1), (3, 8), (3, 32)):
+        problem = _patch(degree, subdivisions)
+        estimate = problem.error_estimate()
+        lam = problem.contacts[0].lambda_N.x.array
+        deviation.append(float(np.abs(lam / 0.01 - 1.0).max()))
+        relative.append(estimate.relative)
+        assert estimate.parts["bulk"] == 0.0  # Div P of a cellwise constant stress
+        problem.close()
+    case = "patch test 2D, contact rules: default, 2-point Gauss on 8 and on 32 sub-segments"
+    quantity = "relative estimate on the 32-sub-segment rule"
+    source = "the exact solution, uniform (the estimate of an exact solution is zero)"
+    verification(case, quantity, relative[-1], 0.0, "< 1e-3", source)
+    assert relative[-1] < 1e-3
+    # measured 1.3e-2, 1.1e-3, 2.6e-4 with the multipliers off by 3e-2, 5e-4, 3e-5
+    assert relative[0] > 5 * relative[1] and relative[1] > 2 * relative[2]
+    assert deviation[0] > deviation[1] > deviation[2]
+
+
+@pytest.fixture(scope="module")
+def hertz():
+    """2D Hertz on three meshes, each twice finer near the contact."""
+    out = []
+    for h in (0.04, 0.02, 0.01):
+        problem = cu.ContactProblem(
+            scenes.hertz_2d(h_contact=h, h_far=0.2, depth=0.02).scene, verbose=False
+        )
+        problem.solve(num_steps=2)
+        out.append((h, problem, problem.error_estimate()))
+    return out
+
+
+@pytest.mark.serial
+def test_the_estimate_falls_under_refinement(hertz):
+    """Halving the mesh size near the contact lowers the estimate (measured: 5.2e-3, 3.3e-3,
+    2.5e-3 of an energy norm of 1.0e-2) and every term is finite and non-negative."""
+    etas = [e.estimate for _, _, e in hertz]
+    assert etas[0] > etas[1] > etas[2] > 0.0
+    for _, _, e in hertz:
+        assert set(e.parts) == set(TERMS)
+        assert all(np.isfinite(v) and v >= 0.0 for v in e.parts.values())
+        assert e.parts["jump"] > e.parts["traction"] > 0.0
+
+
+@pytest.mark.serial
+def test_the_indicators_point_at_the_contact_zone(hertz):
+    """The cells of the largest indicators (the top 2%) lie near the contact zone: within
+    four half-widths of its centre."""
+    _, problem, estimate = hertz[-1]
+    samples = contact_samples(problem)
+    active = samples.X[samples.lambda_N > 0]
+    centre = active.mean(axis=0)
+    half_width = 0.5 * np.ptp(active[:, 0])
+    (eta,) = estimate.indicators
+    mesh = eta.function_space.mesh
+    owned = mesh.topology.index_map(mesh.topology.dim).size_local
+    values = eta.x.array[:owned]
+    top = values >= np.quantile(values, 0.98)
+    midpoints = dolfinx.mesh.compute_midpoints(mesh, mesh.topology.dim, np.flatnonzero(top))
+    distance = np.linalg.norm(midpoints[:, : mesh.geometry.dim] - centre, axis=1)
+    assert distance.max() < 4.0 * half_width
+
+
+@across_ranks
+def test_the_estimate_is_the_same_on_any_number_of_ranks(verification):
+    """The estimate and its parts on two ranks equal those of one rank to round-off."""
+    world = _patch(None, 1, MPI.COMM_WORLD).error_estimate()
+    alone = _patch(None, 1, MPI.COMM_SELF).error_estimate()
+    difference = abs(world.estimate / alone.estimate - 1.0)
+    case = "patch test 2D, default contact rule"
+    source = "the same estimate on one rank"
+    verification(
+        case,
+        "relative difference of the estimate",
+        difference,
+        0.0,
+        "< 1e-10",
+        source,
+        kind="consistency",
+    )
+    assert difference < 1e-10
+    for name in TERMS:
+        assert world.parts[name] == pytest.approx(alone.parts[name], rel=1e-8, abs=1e-30)
+
+
+def test_the_estimate_says_what_it_does_not_cover():
+    """A membrane or an elastoplastic body: a NotImplementedError naming it."""
+    (domain,) = scenes.inflated_sphere(n=4).domains
+    membrane = cu.ContactProblem(cu.Scene(domains=[domain]), verbose=False)
+    with pytest.raises(NotImplementedError, match="hyperelastic solids only"):
+        membrane.error_estimate()
+    plastic = cu.ContactProblem(scenes.plastic_indentation(h_contact=0.05), verbose=False)
+    with pytest.raises(NotImplementedError, match="hyperelastic solids only"):
+        plastic.error_estimate()
+    assert dataclasses.is_dataclass(ErrorEstimate)
