@@ -19,6 +19,11 @@ RANKS = pytest.mark.parametrize("ranks", [1, 2], ids=["1 rank", "2 ranks"])
 RANKS_SLOW_2 = pytest.mark.parametrize(
     "ranks", [1, pytest.param(2, marks=pytest.mark.slow)], ids=["1 rank", "2 ranks"]
 )
+#: the beams demo as the README and ``make demo`` run it, on 2 ranks; on 1 rank with the
+#: slow tests
+RANKS_SLOW_1 = pytest.mark.parametrize(
+    "ranks", [pytest.param(1, marks=pytest.mark.slow), 2], ids=["1 rank", "2 ranks"]
+)
 
 
 def run_demo(
@@ -65,7 +70,7 @@ def test_hertz_demo_runs(tmp_path, ranks):
 
 
 @pytest.mark.serial
-@RANKS
+@RANKS_SLOW_1
 def test_beams_demo_runs(tmp_path, ranks):
     args = ["--divisions", "3", "--mu", "0", "--load", "2", "--steps", "8"]
     stdout, out = run_demo("beams.py", args, tmp_path, timeout=600, ranks=ranks)

@@ -27,6 +27,7 @@ def solved(scene):
     return problem
 
 
+@pytest.mark.serial  # the default eps, not the partition
 @pytest.mark.parametrize("E_flat", [1.0, 0.25])
 def test_default_eps_is_softer_modulus_over_slave_size(E_flat):
     hertz = scenes.hertz_2d(h_contact=0.02, depth=0.02, E_flat=E_flat)

@@ -226,6 +226,7 @@ def test_pressed_from_touching_on_any_number_of_ranks():
     assert np.array_equal(world[1], alone[1])
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 def test_points_beyond_the_master_surface_are_released(verification):
     """The pushed block slides past the end of the lower block: its overhanging part is not
     in contact (the last master facet is not an infinite line)."""

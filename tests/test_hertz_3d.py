@@ -311,6 +311,7 @@ def test_p2_same_answer_on_any_number_of_ranks(p2_on_block, verification):
     assert record_ranks(verification, case, e, alone) < 1e-8, (e, alone)
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 def test_p2_curved_master(p2_on_block, verification):
     """The roles swapped, P2, h = 0.05: the block's flat top is the slave and the curved
     6-node facets of the ball are the master facets the search must find. The contact

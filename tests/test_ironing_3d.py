@@ -266,6 +266,7 @@ def test_no_published_numbers_are_invented():
 PLANE = "the same problem solved in 2D (plane strain) by this code"
 
 
+@pytest.mark.serial  # the plane-strain equations, not the partition
 def test_extruded_ironing_equals_the_plane_one(verification):
     """The 2D shallow ironing (mu = 0.3) on its quick quadrilateral mesh, pressed in five
     steps, in 2D and extruded through 0.1 by one layer of hexahedra with u_z = 0 on both

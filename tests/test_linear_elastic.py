@@ -104,6 +104,7 @@ def linear_hertz(h_contact=0.005, depth=0.005, steps=4):
     return problem, hertz, history
 
 
+@pytest.mark.serial  # a material's accuracy, not the partition's
 def test_hertz_linear_elastic(verification):
     """2D Hertz at a/h = 10 with linear-elastic bodies: the half-width within 0.5%, the
     bound of the Neo-Hookean run of the same mesh (test_hertz, +0.20%), that is the

@@ -143,6 +143,7 @@ def test_closest_points_on_a_moved_obstacle(obstacle, verification):
     assert errors[0] < 1e-14 and errors[1] < 1e-14
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 def test_hertz_on_a_rigid_flat(verification):
     """The half disc of the Hertz scene pressed onto a RigidPlane: a and p0 within 1% of
     Hertz with E* = E / (1 - nu^2) at a/h = 10, as the elastic flat of test_hertz, and the

@@ -155,10 +155,10 @@ def _difference(problem, reference) -> float:
 @across_ranks
 @pytest.mark.parametrize("case", list(CASES))
 def test_restart_on_any_number_of_ranks(case, verification):
-    """Checkpoints written on one rank restart on two, and those of two ranks on one and on
-    two; the restarted runs end in the state of the run never stopped (contact force,
-    displacement norms, plastic strain, pressure): to solver tolerance on another number of
-    ranks, to MUMPS's run-to-run spread on the same."""
+    """Checkpoints written on one rank restart on two, and those of two ranks on one (and,
+    for the ironing, on two); the restarted runs end in the state of the run never stopped
+    (contact force, displacement norms, plastic strain, pressure): to solver tolerance on
+    another number of ranks, to MUMPS's run-to-run spread on the same."""
     world, alone = MPI.COMM_WORLD, MPI.COMM_SELF
     restart = CASES[case][2]
     own = Path(tempfile.mkdtemp(prefix="contact_ufl_single_"))  # each rank's
@@ -175,19 +175,22 @@ def test_restart_on_any_number_of_ranks(case, verification):
     for num_steps, t_end in CASES[case][1]:
         restarted_alone.solve(num_steps=num_steps, t_end=t_end)
     two_to_one = _difference(restarted_alone, shared)
-    restarted = _run(case, world, from_one, restart=restart)
-    two_to_two = _difference(restarted, shared)
     prefix = "largest relative difference of the final state"
-    for quantity, value, tol in (
+    checks = [
         (f"{prefix}, 1 rank -> 2 ranks", one_to_two, ACROSS_RANKS),
         (f"{prefix}, 2 ranks -> 1 rank", two_to_one, ACROSS_RANKS),
-        (f"{prefix}, 2 ranks -> 2 ranks", two_to_two, SPREAD),
-    ):
+    ]
+    problems = [single, distributed, shared, restarted_alone]
+    if case == "ironing":  # the same count (2 -> 2) once: the others' keys are those of 1 -> 2
+        restarted = _run(case, world, from_one, restart=restart)
+        checks.append((f"{prefix}, 2 ranks -> 2 ranks", _difference(restarted, shared), SPREAD))
+        assert _records(restarted) == _records(shared)
+        problems.append(restarted)
+    for quantity, value, tol in checks:
         verification(CASES[case][3], quantity, value, 0.0, tol, SOURCE, kind="consistency")
         assert value < tol
     assert _records(distributed) == _records(single)
-    assert _records(restarted) == _records(shared)
-    for p in (single, distributed, shared, restarted_alone, restarted):
+    for p in problems:
         p.close()
 
 

@@ -63,6 +63,7 @@ def difference(ours, theirs) -> float:
     return comm.allreduce(np.abs(ours - theirs).max(initial=0.0), MPI.MAX) / scale
 
 
+@pytest.mark.serial  # the stepper's logic, not the partition's
 def test_diverging_step_is_cut_back(verification):
     """Three Newton iterations cannot do the whole load in one step: the step is halved
     (no predicted try, which would add its iterations to the steps after a failed try); the
@@ -95,6 +96,7 @@ def test_cutbacks_run_out_with_a_clear_error():
     assert problem.t == pytest.approx(accepted[-1].t)  # state restored to the last accepted
 
 
+@pytest.mark.serial  # the stepper's logic, not the partition's
 def test_solver_and_stepping_made_by_hand(verification):
     """``problem.solve`` is the solver and the load stepping composed: made by hand they give
     the same steps, Newton iterations and forces (to the last bit on one rank; on two, MUMPS's
@@ -243,6 +245,7 @@ def test_a_failed_first_try_is_tried_again_from_the_predicted_state(verification
     assert max(errors) <= TOL_PREDICTOR
 
 
+@pytest.mark.serial  # the stepper's logic, not the partition's
 def test_a_solve_at_its_start_time_predicts_nothing(verification):
     """A converged solve at the time it starts from (``solve_step(problem.t)``: a step of
     length zero) leaves no increment to scale: the next step starts from the converged
