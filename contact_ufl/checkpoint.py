@@ -193,14 +193,20 @@ def _point_fields(problem) -> Iterator[tuple[str, str, dolfinx.fem.Function]]:
             yield f"plastic_{k}_{tag}_alpha", f"plastic_{k}_{tag}", h.alpha
 
 
-def _slave_arrays(problem) -> Iterator[tuple[str, object, str]]:
-    """The point data of the slave surfaces: contact and attribute name."""
+def _slave_arrays(problem) -> Iterator[tuple[str, int, object, str]]:
+    """The point data of the slave surfaces: name, pair, its holder and attribute."""
     for k, c in enumerate(problem.contacts):
         if c.master_two_sided:
-            yield f"contact_{k}_sides", c.kinematics, "sides"
+            yield f"contact_{k}_sides", k, c.kinematics, "sides"
         if c.friction:
-            yield f"contact_{k}_last_slip", c.friction, "last_slip"
-            yield f"contact_{k}_last_stick", c.friction, "last_stick"
+            yield f"contact_{k}_last_slip", k, c.friction, "last_slip"
+            yield f"contact_{k}_last_stick", k, c.friction, "last_stick"
+
+
+def _slave_points(problem, k: int) -> np.ndarray:
+    """The reference positions of the owned slave points of pair ``k``, ``(n, gdim)``."""
+    c = problem.contacts[k]
+    return c.slave.X.reshape(-1, c.gdim)
 
 
 def _state(problem) -> Iterator[tuple[str, str, str, np.ndarray, np.ndarray]]:
@@ -220,10 +226,8 @@ def _state(problem) -> Iterator[tuple[str, str, str, np.ndarray, np.ndarray]]:
             yield f"increment_{name}", "entity", name, keys[name], _owned(d)
     for name, points, f in _point_fields(problem):
         yield name, "point", points, quadrature_positions(f.function_space), _owned(f)
-    for name, holder, attribute in _slave_arrays(problem):
-        k = int(name.split("_")[1])
-        c = problem.contacts[k]
-        positions = c.slave.X.reshape(-1, c.gdim)
+    for name, k, holder, attribute in _slave_arrays(problem):
+        positions = _slave_points(problem, k)
         values = np.asarray(getattr(holder, attribute), dtype=float)
         yield name, "point", f"contact_{k}_points", positions, values.reshape(len(positions), -1)
 
@@ -362,13 +366,8 @@ def restart(problem, folder: str | Path, step: int | None = None) -> float:
         for name, _, f in _point_fields(problem):
             _set_owned(f, values(name, quadrature_positions(f.function_space), "point"))
         slave_data = {}
-        for name, holder, attribute in _slave_arrays(problem):
-            c = problem.contacts[int(name.split("_")[1])]
-            slave_data[name] = (
-                holder,
-                attribute,
-                values(name, c.slave.X.reshape(-1, c.gdim), "point"),
-            )
+        for name, k, holder, attribute in _slave_arrays(problem):
+            slave_data[name] = (holder, attribute, values(name, _slave_points(problem, k), "point"))
         increments = None
         if meta["predictor"] is not None:
             increments = [f.copy() for f in problem.unknowns]

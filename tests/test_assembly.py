@@ -131,7 +131,12 @@ def _move_off(operator) -> None:
 @pytest.mark.parametrize(
     "make, fixed, case",
     [
-        (scenes.hertz_3d, 1, "Hertz 3D, linear-elastic bulk, depth 0.01"),
+        pytest.param(
+            scenes.hertz_3d,
+            1,
+            "Hertz 3D, linear-elastic bulk, depth 0.01",
+            marks=pytest.mark.serial,  # 2 ranks: the 2D scene (the same assembly)
+        ),
         (scenes.hertz_2d, 0, "Hertz 2D, Neo-Hookean bulk, depth 0.01"),
     ],
     ids=["hertz_3d", "hertz_2d"],

@@ -170,7 +170,7 @@ def test_same_result_on_any_number_of_ranks(mu):
     ]
 
 
-@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks (slow tier)
 def test_large_rotations_and_equilibrium(showcase, verification):
     """20 steps without a cut-back, a large rotation, and equilibrium. The two balances
     hold by construction (equilibrium of any converged solve, to the solver tolerance):
@@ -198,7 +198,7 @@ def test_large_rotations_and_equilibrium(showcase, verification):
         assert mismatch < REACTION_TOL
 
 
-@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks (slow tier)
 @pytest.mark.parametrize("mu", [0.0, 0.3])
 def test_final_state_snapshot(showcase, mu, verification):
     """The final state against a snapshot of this code's output (a regression check, to its
@@ -233,7 +233,7 @@ def test_final_state_snapshot(showcase, mu, verification):
         assert value == pytest.approx(snapshot, abs=tolerance), quantity
 
 
-@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks (slow tier)
 @pytest.mark.parametrize("mu", [0.0, 0.3])
 def test_distributed_contact_zone(showcase, mu, verification):
     """The upper beam's underside lies on the lower beam over a length, not on its tip
@@ -266,7 +266,7 @@ def test_distributed_contact_zone(showcase, mu, verification):
         assert value > bound, quantity
 
 
-@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks (slow tier)
 def test_coulomb_law_at_every_step(showcase, verification):
     """|lambda_T| <= mu lambda_N at every point in contact (lambda_N above FLOOR of its
     peak) of every step; where a point slips, |lambda_T| = mu lambda_N and the slip runs
@@ -296,7 +296,7 @@ def test_coulomb_law_at_every_step(showcase, verification):
     assert 1.0 - alignment < ALIGNMENT_TOL
 
 
-@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks gives one rank's state
+@pytest.mark.serial  # 2 ranks: test_showcase_on_any_number_of_ranks (slow tier)
 def test_friction_changes_the_final_state(showcase, verification):
     """The upper beam slides along the lower one towards the clamps (+x): friction holds it
     back (the Coulomb law: the frictional force opposes the slip), with a force that is a
@@ -321,6 +321,7 @@ def test_friction_changes_the_final_state(showcase, verification):
     assert change > 0.05
 
 
+@pytest.mark.slow  # the rank comparison of the default suite: the near pair, mu = 0 and 0.3
 @across_ranks
 def test_showcase_on_any_number_of_ranks(showcase):
     """Under MPI: the showcase (mu = 0) solved on one rank gives the same state."""
