@@ -19,8 +19,8 @@ RANKS = pytest.mark.parametrize("ranks", [1, 2], ids=["1 rank", "2 ranks"])
 RANKS_SLOW_2 = pytest.mark.parametrize(
     "ranks", [1, pytest.param(2, marks=pytest.mark.slow)], ids=["1 rank", "2 ranks"]
 )
-#: the beams demo as the README and ``make demo`` run it, on 2 ranks; on 1 rank with the
-#: slow tests
+#: the beams and Hertz demos on 2 ranks (as the README runs the beams); on 1 rank with the
+#: slow tests (tests/test_notebooks.py runs the Hertz demo on one rank as a notebook)
 RANKS_SLOW_1 = pytest.mark.parametrize(
     "ranks", [pytest.param(1, marks=pytest.mark.slow), 2], ids=["1 rank", "2 ranks"]
 )
@@ -60,7 +60,7 @@ def assert_written(out: Path, pictures: list[str], directories: list[str]) -> No
 
 
 @pytest.mark.serial
-@RANKS
+@RANKS_SLOW_1
 def test_hertz_demo_runs(tmp_path, ranks):
     stdout, out = run_demo("hertz.py", ["--h", "0.01"], tmp_path, ranks=ranks)
     assert "half-width" in stdout
@@ -91,7 +91,8 @@ def test_plastic_indentation_demo_runs(tmp_path, ranks):
 
 
 @pytest.mark.serial
-@RANKS_SLOW_2
+@pytest.mark.slow  # one rank: tests/test_notebooks.py runs this demo as a notebook
+@RANKS
 def test_membrane_demo_runs(tmp_path, ranks):
     stdout, out = run_demo("membrane.py", ["--mu", "0.3"], tmp_path, ranks=ranks)
     assert "12 steps, 0 cut-backs" in stdout

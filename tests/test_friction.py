@@ -47,6 +47,7 @@ def test_frictional_taylor_second_order(dim, mu, state, verification):
     check_slopes(verification, case, result)
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 #: the frictionless curved pair leaves the rotation about the circles' centre free (the
 #: problem warns of it when made); only its unknowns are looked at here
 @pytest.mark.filterwarnings("ignore::contact_ufl.errors.NonUniqueSolutionWarning")
@@ -78,6 +79,7 @@ def test_no_nan_where_q_vanishes():
     assert np.isfinite(R.norm()) and np.isfinite(J.norm())
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 def test_block_sticks_then_slides(verification):
     """A block pressed on a flat and pushed: stuck while the tangential force is below
     mu N (no slip, in the weak sense of the multiplier equation), sliding above it (every

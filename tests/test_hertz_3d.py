@@ -135,6 +135,7 @@ def on_rigid_flat():
     return solve(flat="rigid", h_contact=0.0125, h_edge=0.004)
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 def test_on_rigid_flat_within_2_percent(on_rigid_flat, verification):
     """On a rigid flat the model is Hertz's linear problem (the flat's gap and normal at a
     slave point do not depend on its tangential motion): a and p0 within 2% (-1.1% and

@@ -257,6 +257,7 @@ def test_tube_between_plates_on_any_number_of_ranks(verification):
     assert iterations[0] == iterations[1]
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 @pytest.mark.parametrize("mu", [0.0, 0.3])
 def test_string_held_at_its_ends_on_a_plane(mu, verification):
     """A pre-tensioned string on a rigid plane, pressed by a pressure, its ends held in both

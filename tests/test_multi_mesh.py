@@ -66,6 +66,7 @@ def hertz_own_meshes():
     return _hertz_on_own_meshes()
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 def test_two_meshes_have_their_own_fields(patch_pair):
     _, two = patch_pair
     assert len(two.bulks) == 2

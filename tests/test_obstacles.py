@@ -196,6 +196,7 @@ def test_obstacle_reaction_balances_the_support(verification):
         problem.obstacle_reaction(cu.RigidPlane((0.0, 0.0), (0.0, 1.0)))
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 def test_block_dragged_on_a_rigid_plane_sticks_then_slips(verification):
     """A block pressed onto a RigidPlane and dragged: it sticks while the tangential force
     is below mu times the normal force, and where it slips |lambda_T| = mu lambda_N (the
@@ -326,6 +327,7 @@ def test_no_smoothed_normal_on_an_obstacle():
         ContactProblem(dataclasses.replace(scene, contacts=[pair]), verbose=False)
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 @pytest.mark.parametrize("dim", [2, 3])
 def test_slip_follows_the_obstacle(dim, verification):
     """A slave body carried along with the obstacle's rigid motion (translation and rotation)

@@ -311,16 +311,16 @@ def test_refit_measures_the_change_and_knows_an_unchanged_master():
 
 @pytest.mark.serial  # it starts Python processes of its own
 def test_build_cache_and_concurrent_builds(tmp_path):
-    """Four processes building the kernel at once into an empty cache directory: all load
+    """Two processes building the kernel at once into an empty cache directory: both load
     it, one library named by the source hash remains, no temporary file is left."""
     env = {**os.environ, "CONTACT_UFL_CACHE_DIR": str(tmp_path)}
     code = "from contact_ufl.contact.search import compiled; compiled.kernel(); print('ok')"
     runs = [
         subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE, text=True)
-        for _ in range(4)
+        for _ in range(2)
     ]
     outputs = [run.communicate(timeout=300)[0].strip() for run in runs]
-    assert outputs == ["ok"] * 4
+    assert outputs == ["ok"] * 2
     files = sorted(p.name for p in tmp_path.iterdir())
     assert len(files) == 1 and files[0].startswith("search_kernel_") and files[0].endswith(".so")
 

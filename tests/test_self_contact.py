@@ -563,6 +563,7 @@ def _slot_mesh_3d(comm: MPI.Comm, nx: int = 20, ny: int = 2, nz: int = 10) -> do
     return _mesh_from_rank_0(comm, cells, x, "hexahedron")
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 def test_slot_closes_on_itself_in_3d(verification):
     """The slot through a 3D block (plane strain by u_y = 0 on the sides y = 0, 0.2) pressed
     shut: quadratic Newton; equilibrium, property (e) and symmetric tractions about x = 1

@@ -258,6 +258,7 @@ def test_default_master_normal_rule():
         ContactPair(1, 2, master_normal="nodal").validate(MPI.COMM_WORLD)
 
 
+@pytest.mark.serial  # on 2 ranks: this file's rank comparisons
 @pytest.mark.parametrize("dim, expected", [(2, "smoothed"), (3, "facet")])
 def test_default_master_normal_of_a_problem(dim, expected):
     """A problem resolves the default: its pair has the smoothed normal in 2D (gathering the
