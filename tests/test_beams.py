@@ -152,7 +152,9 @@ def test_two_cantilevers_in_series(verification):
         assert abs(error) < SPRINGS_TOL[key], (key, error)
 
 
-@pytest.mark.parametrize("mu", [0.0, 0.3], ids=["mu=0", "mu=0.3"])
+@pytest.mark.parametrize(
+    "mu", [pytest.param(0.0, marks=pytest.mark.slow), 0.3], ids=["mu=0", "mu=0.3"]
+)  # frictionless: the other scenes' rank comparisons, and this one in the slow tier
 @across_ranks
 def test_same_result_on_any_number_of_ranks(mu):
     """The distributed solve equals the solve on one rank (each rank redoes it alone), with

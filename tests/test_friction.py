@@ -30,7 +30,7 @@ def check_slopes(verification, case, result, slope=2.0, tol=5e-4, source=TAYLOR)
     assert np.all(np.abs(result.slopes - slope) < tol), result.slopes
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [pytest.param(2, marks=pytest.mark.serial), 3])  # 2 ranks: 3D
 @pytest.mark.parametrize("mu, state", [(0.3, "slip"), (100.0, "stick")])
 def test_frictional_taylor_second_order(dim, mu, state, verification):
     """The tangent of the frictional residual in slip (every point) and in stick (every

@@ -205,7 +205,7 @@ def test_taylor_quadratic_2d(order, verification):
 @pytest.mark.parametrize(
     "dim, order, cell",
     [
-        (2, 2, "triangle"),
+        pytest.param(2, 2, "triangle", marks=pytest.mark.serial),  # 2 ranks: 3D
         (3, 1, "tetrahedron"),
         pytest.param(3, 1, "hexahedron", marks=pytest.mark.slow),
     ],
@@ -410,6 +410,7 @@ def _nodal_profile(comm, f) -> tuple[np.ndarray, np.ndarray]:
     return x[order], values[order]
 
 
+@pytest.mark.serial  # 2 ranks: the 3D variants (the same gathers)
 def test_hertz_quadratic_2d(verification):
     """P2 on the curved (degree-2) mesh, P1 multipliers, linear elastic, one load step,
     h = 0.02 (12,613 unknowns, a / h = 2.5), the default contact rule: p0 of the nominal
@@ -526,6 +527,7 @@ def test_iso_multipliers_of_a_pair(scene):
     assert nodes == 2 * segments + 1
 
 
+@pytest.mark.serial  # 2 ranks: the 3D variants (the same gathers)
 def test_patch_iso_2d(verification):
     """P2 displacement, P1-iso-P2 multipliers, 2D: the force exact, the pressure uniform
     to 1.1e-3 with the composite rule of 8 subdivisions (P1 multipliers: 3.4e-4, each
@@ -559,6 +561,7 @@ def test_patch_iso_3d(verification):
     assert force < 1e-10
 
 
+@pytest.mark.serial  # 2 ranks: the 3D variants (the same gathers)
 @pytest.mark.parametrize("mu", [0.0, 0.05])
 def test_taylor_iso_2d(mu, verification):
     """P1-iso-P2 multipliers on the curved 2D pair (curved geometry), frictionless and in

@@ -219,6 +219,7 @@ def test_rebuilt_solver_pattern_gives_the_same_solution(verification):
     assert error <= TOL_REBUILT
 
 
+@pytest.mark.serial  # the stepper's logic, not the partition's
 def test_a_failed_first_try_is_tried_again_from_the_predicted_state(verification):
     """Hertz in steps of 0.25, Newton held to 3 iterations after the first step: from the
     converged state the steps to 0.5 and 1.0 need 4 and are cut back without the predicted
@@ -273,6 +274,7 @@ def test_an_unknown_predictor_is_refused():
         default_strategies(predictor="linear")
 
 
+@pytest.mark.serial  # 2 ranks: the field split with friction
 def test_field_split_solver_gives_the_same_solution(verification):
     """The package's ``FIELD_SPLIT_PETSC_OPTIONS`` (a ``fieldsplit``: the solver gives it
     the splits ``u`` and ``lambda``, also after the resets of a new pattern; GMRES with a
