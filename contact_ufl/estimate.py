@@ -245,9 +245,7 @@ def _contact_forms(bulk, c) -> dict[str, dolfinx.fem.Form]:
         excess = ufl.max_value(ufl.sqrt(ufl.dot(t_T, t_T)) - c.friction.mu * c.t_N, 0.0)
         forms["cone"] = h / E * excess**2 * w * ds
     maps = [c.slave.entity_map]
-    return {
-        name: jit.form(form, entity_maps=maps) for name, form in forms.items() if _linear(form)
-    }
+    return {name: jit.form(form, entity_maps=maps) for name, form in forms.items() if _linear(form)}
 
 
 def _linear(form) -> bool:

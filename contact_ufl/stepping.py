@@ -12,16 +12,13 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, NamedTuple, Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.errors import ContactInputError, ConvergenceError
 from contact_ufl.strategies import StepSolver
-
-if TYPE_CHECKING:
-    from contact_ufl.checkpoint import Checkpoints
 
 
 class SteppedProblem(Protocol):
@@ -137,6 +134,16 @@ class History:
     cutbacks: list[Cutback] = field(default_factory=list)
 
 
+class CheckpointWriter(Protocol):
+    """What the load stepper asks of its checkpoints
+    (:class:`~contact_ufl.checkpoint.Checkpoints`): whether a step is written, and the
+    writing."""
+
+    def due(self, step: int, last: bool) -> bool: ...
+
+    def write(self, problem, history: History, schedule: Schedule) -> object: ...
+
+
 class LoadStepper:
     """Load stepping with cut-back of a problem and its step solver.
 
@@ -197,7 +204,7 @@ class LoadStepper:
         t_end: float = 1.0,
         max_cutbacks: int = 8,
         callback: Callable[[SteppedProblem, StepRecord], None] | None = None,
-        checkpoints: Checkpoints | None = None,
+        checkpoints: CheckpointWriter | None = None,
     ) -> History:
         """Load stepping from the current pseudo-time to ``t_end`` in ``num_steps`` steps.
 
