@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -58,10 +59,33 @@ CASES = {
 }
 
 
+#: the folders a test made: (path, whether its ranks share it), removed after the test
+_MADE: list[tuple[Path, bool]] = []
+
+
+@pytest.fixture(autouse=True)
+def _remove_folders():
+    _MADE.clear()
+    yield
+    MPI.COMM_WORLD.barrier()  # every rank done with them
+    for path, shared in _MADE:
+        if not shared or MPI.COMM_WORLD.rank == 0:
+            shutil.rmtree(path, ignore_errors=True)
+
+
+def _own_folder() -> Path:
+    """A new folder of this rank."""
+    path = Path(tempfile.mkdtemp(prefix="contact_ufl_restart_"))
+    _MADE.append((path, False))
+    return path
+
+
 def _shared_folder(comm) -> Path:
     """A new folder, the same on every rank of ``comm``."""
     name = tempfile.mkdtemp(prefix="contact_ufl_restart_") if comm.rank == 0 else None
-    return Path(comm.bcast(name, root=0))
+    path = Path(comm.bcast(name, root=0))
+    _MADE.append((path, comm.size > 1))
+    return path
 
 
 def _problem(case: str, comm) -> cu.ContactProblem:
@@ -161,7 +185,7 @@ def test_restart_on_any_number_of_ranks(case, verification):
     another number of ranks, to MUMPS's run-to-run spread on the same."""
     world, alone = MPI.COMM_WORLD, MPI.COMM_SELF
     restart = CASES[case][2]
-    own = Path(tempfile.mkdtemp(prefix="contact_ufl_single_"))  # each rank's
+    own = _own_folder()
     single = _run(case, alone, own)
     distributed = _problem(case, world)
     distributed.restart(world.bcast(own, root=0), restart)  # rank 0's
@@ -325,7 +349,7 @@ def test_restart_in_3d_is_bit_for_bit(verification):
     bit for bit, as the run that wrote the checkpoints (one rank; in 3D the solver matrix's
     pattern is the union of the pairings met, which a restart point starts anew)."""
     comm = MPI.COMM_SELF
-    folder = Path(tempfile.mkdtemp(prefix="contact_ufl_restart_3d_"))
+    folder = _own_folder()
 
     def run(restart=None):
         problem = cu.ContactProblem(
