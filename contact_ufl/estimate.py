@@ -135,9 +135,10 @@ def error_estimate(problem) -> ErrorEstimate:
             for c in problem.contacts
             if not c.pair.on_obstacle and problem.bulk_of(c, "master") is bulk
         }
-        forms = {name: [form] for name, form in _bulk_forms(bulk, tags).items()}
+        P, E = _stress_field(bulk), _modulus(bulk)  # once a mesh, for all its terms
+        forms = {name: [form] for name, form in _bulk_forms(bulk, P, E, tags).items()}
         for c in contacts:
-            for name, form in _contact_forms(bulk, c).items():
+            for name, form in _contact_forms(bulk, P, E, c).items():
                 forms.setdefault(name, []).append(form)
         eta = dolfinx.fem.Function(dolfinx.fem.functionspace(bulk.V.mesh, ("DG", 0)))
         owned = eta.function_space.dofmap.index_map.size_local
@@ -175,15 +176,15 @@ def _exterior_facets(bulk) -> ufl.Measure:
     return ufl.Measure("ds", domain=mesh, subdomain_data=marked)
 
 
-def _bulk_forms(bulk, contact_tags: set[int]) -> dict[str, dolfinx.fem.Form]:
+def _bulk_forms(bulk, P, E, contact_tags: set[int]) -> dict[str, dolfinx.fem.Form]:
     """The bulk, jump and boundary terms of one mesh, each a form linear in a DG0 test
-    function (its vector: the cells' shares). ``contact_tags``: the facet groups of the
+    function (its vector: the cells' shares). ``P``, ``E``: the stress and modulus fields
+    (:func:`_stress_field`, :func:`_modulus`); ``contact_tags``: the facet groups of the
     contact surfaces on this mesh (no boundary term)."""
     mesh = bulk.V.mesh
     comm = mesh.comm
     gdim = mesh.geometry.dim
     w = ufl.TestFunction(dolfinx.fem.functionspace(mesh, ("DG", 0)))
-    P, E = _stress_field(bulk), _modulus(bulk)
     h = ufl.CellDiameter(mesh)
     N = ufl.FacetNormal(mesh)
     dx, ds = bulk.dx, _exterior_facets(bulk)
@@ -222,11 +223,11 @@ def _bulk_forms(bulk, contact_tags: set[int]) -> dict[str, dolfinx.fem.Form]:
     return {name: jit.form(form) for name, form in forms.items() if _linear(form)}
 
 
-def _contact_forms(bulk, c) -> dict[str, dolfinx.fem.Form]:
-    """The contact terms of the slave surface of pair ``c`` (on its slave's mesh)."""
+def _contact_forms(bulk, P, E, c) -> dict[str, dolfinx.fem.Form]:
+    """The contact terms of the slave surface of pair ``c`` (on its slave's mesh, of stress
+    and modulus fields ``P``, ``E``)."""
     mesh = bulk.V.mesh
     w = ufl.TestFunction(dolfinx.fem.functionspace(mesh, ("DG", 0)))
-    P, E = _stress_field(bulk), _modulus(bulk)
     h = ufl.CellDiameter(mesh)
     N = ufl.FacetNormal(mesh)
     ds = c.ds
