@@ -264,20 +264,7 @@ class LoadStepper:
                         f"{max_cutbacks} cut-backs; the state of t = {t_prev:.6g} is kept"
                     )
                 continue
-            record = StepRecord(
-                len(self.history.steps) + 1,
-                t_new,
-                its,
-                solver.residual_norm,
-                problem.active_points(),
-                problem.contact_force(),
-                time.perf_counter() - start,
-                reason,
-            )
-            self.history.steps.append(record)
-            problem.commit(solver.x)
-            solver.operator.forget_state()
-            self._print(_format(record))
+            record = self._accept(t_new, its, reason, start)
             plan.streak += 1
             if plan.streak >= 2 and plan.dt < dt0:
                 plan.dt, plan.streak = min(2.0 * plan.dt, dt0), 0
@@ -288,6 +275,56 @@ class LoadStepper:
                 checkpoints.write(problem, self.history, plan)
                 self._fresh_start_due = True
         return self.history
+
+    def equilibrate(self) -> StepRecord:
+        """Newton at the current pseudo-time from the current state, a step of no load
+        increment: equilibrium at the same load of a state made elsewhere (a solution moved
+        onto refined meshes, :mod:`contact_ufl.adapt`). Recorded as a step at the same ``t``.
+
+        Raises
+        ------
+        ConvergenceError
+            Newton did not converge (the state before it is kept; at a fixed load there is
+            no step to cut back).
+        """
+        problem, solver = self.problem, self.solver
+        t = problem.t
+        saved = [f.x.array.copy() for f in problem.unknowns]
+        start = time.perf_counter()
+        try:
+            problem.begin_step()
+            ok, its, reason = solver.solve_step(t)
+        except BaseException:
+            self._restore(saved, t)
+            raise
+        if not ok:
+            why = solver.diagnose()
+            self._restore(saved, t)
+            self.history.cutbacks.append(Cutback(t, reason, why))
+            raise ConvergenceError(
+                f"the equilibrium at t = {t:.6g} from the given state did not converge "
+                f"({reason}: {why}); the state is kept"
+            )
+        return self._accept(t, its, reason, start)
+
+    def _accept(self, t: float, its: int, reason: int, start: float) -> StepRecord:
+        """Record a converged step to ``t`` and commit it."""
+        problem, solver = self.problem, self.solver
+        record = StepRecord(
+            len(self.history.steps) + 1,
+            t,
+            its,
+            solver.residual_norm,
+            problem.active_points(),
+            problem.contact_force(),
+            time.perf_counter() - start,
+            reason,
+        )
+        self.history.steps.append(record)
+        problem.commit(solver.x)
+        solver.operator.forget_state()
+        self._print(_format(record))
+        return record
 
     def _restore(self, saved: list[np.ndarray], t: float) -> None:
         for f, a in zip(self.problem.unknowns, saved, strict=True):
