@@ -147,11 +147,13 @@ def refine_scene(
     onto it (collective).
     """
     parts = scene.parts
+    comm = parts[0].mesh.comm
     collective_check(
-        parts[0].mesh.comm,
+        comm,
         len(cells) == len(parts),
         f"refine_scene: {len(cells)} arrays of cells for a scene of {len(parts)} meshes",
     )
+    check_boundaries(scene, boundaries or {})
     refined = [_refine_domain(d, c, boundaries or {}) for d, c in zip(parts, cells, strict=True)]
     if scene.mesh is None:
         return dataclasses.replace(scene, domains=refined)
@@ -291,6 +293,39 @@ def has_history(scene: Scene) -> bool:
     return bool(frictional or plastic)
 
 
+def check_boundaries(scene: Scene, boundaries: Mapping[int | str, Boundary]) -> None:
+    """Raise :class:`~contact_ufl.errors.ContactInputError` (every rank) unless every key of
+    ``boundaries`` is a facet group of a mesh of ``scene`` and every value callable."""
+    names = {n for d in scene.parts for n, (dim, _) in d.groups.items() if dim == d.surface_dim}
+    tags = {t for d in scene.parts for n, (dim, t) in d.groups.items() if dim == d.surface_dim}
+    for key, surface in boundaries.items():
+        known = key in names if isinstance(key, str) else key in tags
+        if not known:
+            raise ContactInputError(
+                f"boundaries: {key!r} is not a facet group of the scene (its groups: "
+                f"{', '.join(sorted(names))})"
+            )
+        if not callable(surface):
+            raise ContactInputError(
+                f"boundaries[{key!r}] must be a function that moves points onto the surface, "
+                f"got {surface!r}"
+            )
+
+
+def _check_estimable(scene: Scene) -> None:
+    """Refuse, before any work, the bodies the error estimate does not cover yet."""
+    from contact_ufl.plasticity import J2Plasticity
+
+    for k, d in enumerate(scene.parts):
+        for body in d.bodies:
+            if body.membrane or isinstance(body.material, J2Plasticity):
+                kind = "a membrane" if body.membrane else "an elastoplastic body"
+                raise NotImplementedError(
+                    f"{d.name or f'mesh {k}'} has {kind} (tag {body.tag}): the error estimate, "
+                    "and so adaptive refinement, covers hyperelastic solids only"
+                )
+
+
 def check_refinable(scene: Scene) -> None:
     """Raise :class:`~contact_ufl.errors.ContactInputError` (every rank) unless every mesh of
     ``scene`` is made of simplices, which :func:`dolfinx.mesh.refine` refines."""
@@ -356,6 +391,8 @@ def refine_to_tolerance(
     options = dict(problem_options or {})
     _check_loop_input(comm, tolerance, max_unknowns, theta, max_levels)
     check_refinable(scene)
+    check_boundaries(scene, boundaries or {})
+    _check_estimable(scene)
     history = has_history(scene)
     problem = ContactProblem(scene, **options)
     _check_budget(problem, max_unknowns, first=True)

@@ -250,3 +250,42 @@ def test_quadrilaterals_are_refused_before_any_solve():
     with pytest.raises(ContactInputError, match="quadrilateral cells"):
         adapt.refine_to_tolerance(scene, calls.append, tolerance=0.1, max_unknowns=10_000)
     assert calls == []
+
+
+def test_an_unknown_boundary_is_refused_before_any_solve():
+    calls = []
+    with pytest.raises(ContactInputError, match="'arc' is not a facet group"):
+        adapt.refine_to_tolerance(
+            _hertz(), calls.append, 0.1, 10_000, boundaries={"arc": onto_circle}
+        )
+    assert calls == []
+
+
+@pytest.mark.serial
+def test_tetrahedra_are_refined_where_the_estimate_says():
+    """3D Hertz (quarter sphere on a block): the estimate falls with the level, the new
+    mesh starts from the moved solution, and the sphere's nodes stay on the sphere."""
+    centre = np.array([0.0, 0.0, 1.0])
+
+    def onto_sphere(x):
+        d = x - centre
+        return centre + d / np.linalg.norm(d, axis=1)[:, None]
+
+    scene = scenes.hertz_3d(h_contact=0.06, h_far=0.3, depth=0.01).scene
+    result = adapt.refine_to_tolerance(
+        scene,
+        lambda p: p.solve(num_steps=2),
+        tolerance=1e-6,
+        max_unknowns=100_000,
+        max_levels=2,
+        boundaries={"sphere_contact": onto_sphere},
+        problem_options={"verbose": False},
+    )
+    first, second = result.levels
+    assert second.estimate < 0.8 * first.estimate  # measured 0.65
+    assert second.start == "moved state" and second.newton_iterations <= 4  # measured 2
+    domain = result.problem.scene.parts[0]
+    surface = domain.facet_tags.find(domain.tags["sphere_contact"])
+    nodes = dolfinx.mesh.entities_to_geometry(domain.mesh, 2, surface).ravel()
+    radius = np.linalg.norm(domain.mesh.geometry.x[nodes] - centre, axis=1)
+    assert np.abs(radius - 1.0).max() < 1e-14
