@@ -40,6 +40,7 @@ from contact_ufl import (
     output,
     results,
 )
+from contact_ufl.adapt import refine_to_tolerance
 from contact_ufl.checkpoint import Checkpoints
 from contact_ufl.contact import ContactPair, RigidCylinder, RigidPlane, RigidSphere
 from contact_ufl.control import VolumeControl
@@ -125,6 +126,7 @@ __all__ = [
     "default_strategies",
     "output",
     "read_gmsh",
+    "refine_to_tolerance",
     "results",
     "taylor_test",
 ]
