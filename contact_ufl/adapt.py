@@ -186,6 +186,120 @@ def _refine_domain(domain: Domain, cells: np.ndarray, boundaries: Mapping) -> Do
     return out
 
 
+def slave_finer_than_master(
+    scene: Scene,
+    displacements: list[dolfinx.fem.Function] | None = None,
+    boundaries: Mapping[int | str, Boundary] | None = None,
+    max_passes: int = 4,
+) -> Scene:
+    """``scene`` with its slave surfaces refined until no slave facet is larger than a
+    master facet it faces (collective).
+
+    The multipliers live on the slave surface and its quadrature points carry the contact
+    force to the master: where the master is finer, its facets see the slave's points as
+    point loads and the pairing cycles (see the user guide, *Adaptive refinement*). Facing:
+    a master facet's midpoint within the slave facet's size of the slave facet's midpoint,
+    in the configuration displaced by ``displacements`` (one field per mesh of the scene,
+    on any mesh: moved by interpolation; ``None``: the reference configuration).
+    """
+    for _ in range(max_passes):
+        parts = scene.parts
+        current = [
+            _nodes_moved(d, displacements[k] if displacements else None)
+            for k, d in enumerate(parts)
+        ]
+        marked = [np.zeros(0, dtype=np.int32) for _ in parts]
+        for pair in scene.contacts:
+            if pair.on_obstacle:
+                continue
+            ks, km = _domain_index(pair.slave_domain), _domain_index(pair.master_domain)
+            cells = _coarser_slave_cells(
+                parts[ks], current[ks], pair.slave, parts[km], current[km], pair.master
+            )
+            marked[ks] = np.union1d(marked[ks], cells).astype(np.int32)
+        comm = parts[0].mesh.comm
+        if comm.allreduce(sum(len(m) for m in marked), MPI.SUM) == 0:
+            return scene
+        scene = refine_scene(scene, marked, boundaries)
+    return scene
+
+
+def _domain_index(index: int | None) -> int:
+    return 0 if index is None else int(index)
+
+
+def _nodes_moved(domain: Domain, u: dolfinx.fem.Function | None) -> np.ndarray:
+    """The geometry nodes of ``domain``'s mesh displaced by ``u`` (interpolated)."""
+    mesh = domain.mesh
+    x = mesh.geometry.x.copy()
+    if u is None:
+        return x
+    gdim = mesh.geometry.dim
+    degree = mesh.geometry.cmaps[0].degree
+    space = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (gdim,)))
+    moved = dolfinx.fem.Function(space)
+    if u.function_space.mesh is mesh:
+        moved.interpolate(u)
+    else:
+        _interpolate(moved, u, 1e-6 * _size(mesh))
+    # the space's dofs and the geometry's nodes follow the same element: cell by cell
+    nodes = mesh.geometry.dofmaps[0]
+    dofs = space.dofmap.list
+    values = moved.x.array.reshape(-1, gdim)
+    x[nodes.ravel(), :gdim] += values[dofs.ravel()]
+    return x
+
+
+def _size(mesh: dolfinx.mesh.Mesh) -> float:
+    x = mesh.geometry.x
+    low = np.min(mesh.comm.allgather(x.min(axis=0, initial=np.inf)), axis=0)
+    high = np.max(mesh.comm.allgather(x.max(axis=0, initial=-np.inf)), axis=0)
+    return float(np.linalg.norm(high - low))
+
+
+def _facet_shapes(
+    domain: Domain, x: np.ndarray, tag: int, owned_only: bool
+) -> tuple[np.ndarray, ...]:
+    """The facets of group ``tag`` (the owned ones, or all this rank holds), their midpoints
+    and sizes (largest edge) at the node positions ``x``."""
+    mesh = domain.mesh
+    fdim = mesh.topology.dim - 1
+    facets = domain.facet_tags.find(tag)
+    if owned_only:
+        facets = facets[facets < mesh.topology.index_map(fdim).size_local]
+    vertices = x[dolfinx.mesh.entities_to_geometry(mesh, fdim, facets)]
+    n = vertices.shape[1]
+    edges = [vertices[:, i] - vertices[:, j] for i in range(n) for j in range(i + 1, n)]
+    size = np.max([np.linalg.norm(e, axis=1) for e in edges], axis=0, initial=0.0)
+    size = size if len(facets) else np.zeros(0)
+    return facets, vertices.mean(axis=1), size
+
+
+def _coarser_slave_cells(slave, x_slave, slave_tag, master, x_master, master_tag) -> np.ndarray:
+    """The owned cells of the slave facets larger than a master facet they face."""
+    comm = slave.mesh.comm
+    tdim = slave.mesh.topology.dim
+    slave.mesh.topology.create_connectivity(tdim - 1, tdim)  # collective: on every rank
+    # every slave facet of an owned cell (owned or not), every master facet once
+    facets, mid, size = _facet_shapes(slave, x_slave, slave_tag, owned_only=False)
+    _, m_mid, m_size = _facet_shapes(master, x_master, master_tag, owned_only=True)
+    m_mid = np.concatenate(comm.allgather(m_mid.reshape(-1, 3)))
+    m_size = np.concatenate(comm.allgather(m_size))
+    if len(facets) == 0 or len(m_size) == 0:
+        return np.zeros(0, dtype=np.int32)
+    from scipy.spatial import cKDTree
+
+    k = min(16, len(m_size))
+    distance, index = cKDTree(m_mid).query(mid, k=k)
+    distance, index = distance.reshape(len(mid), k), index.reshape(len(mid), k)
+    facing = distance <= size[:, None]
+    finest = np.where(facing, m_size[np.minimum(index, len(m_size) - 1)], np.inf).min(axis=1)
+    coarse = facets[size > finest * (1.0 + 1e-9)]
+    cells = dolfinx.mesh.compute_incident_entities(slave.mesh.topology, coarse, tdim - 1, tdim)
+    owned = slave.mesh.topology.index_map(tdim).size_local
+    return cells[cells < owned].astype(np.int32)
+
+
 def _facet_tag(domain: Domain, key: int | str) -> int | None:
     """The integer of facet group ``key`` in ``domain`` (``None``: not a group of it)."""
     if isinstance(key, str):
@@ -427,7 +541,10 @@ def refine_to_tolerance(
             result.stopped_by = "levels"
             return result
         marked = doerfler_marking(estimate.indicators, theta, comm)
-        finer = ContactProblem(refine_scene(problem.scene, marked, boundaries), **options)
+        scene = refine_scene(problem.scene, marked, boundaries)
+        moved = [b.u for b in problem.bulks]
+        scene = slave_finer_than_master(scene, moved, boundaries)
+        finer = ContactProblem(scene, **options)
         if not _check_budget(finer, max_unknowns):
             finer.close()
             result.stopped_by = "budget"

@@ -1,0 +1,142 @@
+"""Speed against error of adaptive refinement, against uniform refinement and hand-graded
+meshes: the 2D Hertz problem of ``benchmarks/hertz.py`` (linear elastic, one load step, the
+default eps) from a coarse mesh.
+
+Each level of the loop (:func:`contact_ufl.refine_to_tolerance`) writes a record: unknowns,
+the estimate and its relative value, the errors of p0 and a (nominal: the multiplier at the
+reference positions, as the small-strain Hertz solution compares), the pressure L2 error,
+Newton iterations, the level's solve-and-estimate time ``wall_s`` and the loop's time so far
+``cumulative_s`` (solves, estimates, marking, refinement, the problems' set-up). ``uniform``
+records refine every cell at each level instead (``theta = 1``).
+
+    python benchmarks/adaptive.py --json benchmarks/results/adaptive.json [--quick]
+        [--degree 2] [--start 0.04] [--max-unknowns 60000]
+"""
+
+import argparse
+import dataclasses
+import time
+
+import numpy as np
+import resultfile
+from hertz import _pressure_l2_error
+from mpi4py import MPI
+
+from contact_ufl import adapt
+from contact_ufl.materials import LinearElastic
+from contact_ufl.results import contact_samples
+from contact_ufl.verification import scenes
+from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
+
+#: the disc of the 2D Hertz scene
+CENTRE = np.array([0.0, 1.0, 0.0])
+
+
+def onto_circle(x: np.ndarray) -> np.ndarray:
+    d = x - CENTRE
+    return CENTRE + d / np.linalg.norm(d, axis=1)[:, None]
+
+
+def hertz_scene(h: float, depth: float):
+    """The benchmark's 2D Hertz scene: linear elastic, the default eps."""
+    hertz = scenes.hertz_2d(h_contact=h, depth=depth)
+    scene = hertz.scene
+    scene.contacts[0] = dataclasses.replace(scene.contacts[0], eps_N=None)
+    scene.bodies = [
+        dataclasses.replace(b, material=LinearElastic(b.material.E, b.material.nu))
+        for b in scene.bodies
+    ]
+    return hertz, scene
+
+
+def hertz_errors(problem, hertz) -> dict:
+    """The errors of p0 and a (nominal and Cauchy) and of the pressure profile."""
+    samples = contact_samples(problem)
+    exact = Hertz2D(problem.contact_force()[1], hertz.radius, hertz.E_star)
+    a, p0, _ = fit_elliptic_profile(samples.x[:, 0], samples.pressure)
+    c = problem.contacts[0]
+    X = np.concatenate(problem.comm.allgather(c.slave.X.reshape(-1, 2)))
+    a_nominal, p0_nominal, _ = fit_elliptic_profile(X[:, 0], samples.lambda_N)
+    return {
+        "p0_error": p0 / exact.p0 - 1.0,
+        "a_error": a / exact.a - 1.0,
+        "p0_error_nominal": p0_nominal / exact.p0 - 1.0,
+        "a_error_nominal": a_nominal / exact.a - 1.0,
+        "pressure_l2_error": _pressure_l2_error(problem, samples, exact),
+        "a": exact.a,
+    }
+
+
+def run(
+    kind: str, start_h: float, depth: float, degree: int, max_unknowns: int, theta: float
+) -> list[dict]:
+    """The levels of one loop: ``kind`` ``"adaptive"`` (Doerfler, ``theta``) or
+    ``"uniform"`` (every cell refined)."""
+    hertz, scene = hertz_scene(start_h, depth)
+    records = []
+    begin = time.perf_counter()
+
+    def record(problem, level) -> None:
+        records.append(
+            {
+                "kind": kind,
+                "degree": degree,
+                "start_h": start_h,
+                "level": len(records),
+                "dofs": level.unknowns,
+                "cells": level.cells,
+                "estimate": level.estimate,
+                "relative_estimate": level.relative,
+                "newton_iterations": level.newton_iterations,
+                "newton_per_step": level.newton_iterations / len(problem.history.steps),
+                "start": level.start,
+                "wall_s": level.wall,
+                "cumulative_s": time.perf_counter() - begin,
+                "ranks": problem.comm.size,
+                **hertz_errors(problem, hertz),
+            }
+        )
+        r = records[-1]
+        if problem.comm.rank == 0:
+            print(
+                f"{kind:8s} {r['dofs']:8d} eta {r['relative_estimate']:.3e} "
+                f"p0 {r['p0_error_nominal']:+.3%} a {r['a_error_nominal']:+.3%} "
+                f"L2 {r['pressure_l2_error']:.3f} newton {r['newton_iterations']} "
+                f"wall {r['wall_s']:.2f} s cumulative {r['cumulative_s']:.2f} s",
+                flush=True,
+            )
+
+    adapt.refine_to_tolerance(
+        scene,
+        lambda p: p.solve(num_steps=1),
+        tolerance=1e-9,
+        max_unknowns=max_unknowns,
+        theta=1.0 if kind == "uniform" else theta,
+        max_levels=30,
+        boundaries={"cylinder_contact": onto_circle},
+        problem_options={"degree": degree, "verbose": False},
+        on_level=record,
+    )
+    return records
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--json", required=True, help="output file")
+    parser.add_argument("--quick", action="store_true", help="to 15,000 unknowns")
+    parser.add_argument("--degree", type=int, choices=(1, 2), default=1)
+    parser.add_argument("--start", type=float, default=0.04, help="h_contact of the start")
+    parser.add_argument("--depth", type=float, default=0.005)
+    parser.add_argument("--theta", type=float, default=0.5)
+    parser.add_argument("--max-unknowns", type=int, default=None)
+    args = parser.parse_args()
+    budget = args.max_unknowns or (15_000 if args.quick else 120_000)
+    records = []
+    for kind in ("adaptive", "uniform"):
+        records += run(kind, args.start, args.depth, args.degree, budget, args.theta)
+    if MPI.COMM_WORLD.rank == 0:
+        resultfile.write(args.json, records)
+
+
+if __name__ == "__main__":
+    main()
