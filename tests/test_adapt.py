@@ -113,11 +113,11 @@ def test_doerfler_marks_the_fewest_cells_that_carry_theta():
 
 @pytest.fixture(scope="module")
 def adaptive_hertz():
-    """The 2D Hertz scene from h_contact = 0.04 to a relative estimate of 0.2."""
+    """The 2D Hertz scene from h_contact = 0.04 to a relative estimate of 0.1."""
     return adapt.refine_to_tolerance(
         _hertz(),
         lambda p: p.solve(num_steps=2),
-        tolerance=0.2,
+        tolerance=0.1,
         max_unknowns=100_000,
         boundaries={"cylinder_contact": onto_circle},
         problem_options={"verbose": False},
@@ -133,7 +133,7 @@ def test_the_loop_reaches_its_tolerance_at_the_optimal_rate(adaptive_hertz, veri
     result = adaptive_hertz
     levels = result.levels
     assert result.reached and result.stopped_by == "tolerance"
-    assert levels[-1].relative <= 0.2 < levels[-2].relative
+    assert levels[-1].relative <= 0.1 < levels[-2].relative
     estimates = [lv.estimate for lv in levels]
     assert all(b < a for a, b in zip(estimates, estimates[1:], strict=False))
     n = np.array([lv.unknowns for lv in levels], dtype=float)
@@ -146,7 +146,7 @@ def test_the_loop_reaches_its_tolerance_at_the_optimal_rate(adaptive_hertz, veri
         "<= -0.45",
         "optimal rate of P1 in 2D (Cascon et al. 2008)",
     )
-    assert rate <= -0.45  # measured -0.53
+    assert rate <= -0.45  # measured -0.54
     assert [lv.start for lv in levels[1:]] == ["moved state"] * (len(levels) - 1)
     assert max(lv.newton_iterations for lv in levels[1:]) <= 4  # measured 2 to 3
     mesh = result.problem.bulks[0].V.mesh
@@ -173,7 +173,7 @@ def test_adaptive_meshes_beat_uniform_refinement(adaptive_hertz):
     log_eta = np.log([lv.estimate for lv in levels])
     # the estimate falls with the levels: interpolate log N in log eta, increasing
     needed = np.exp(np.interp(np.log(reference.estimate), log_eta[::-1], log_n[::-1]))
-    assert needed < 0.8 * n  # measured 0.66
+    assert needed < 0.8 * n  # measured 0.67
 
 
 @across_ranks
@@ -282,8 +282,8 @@ def test_tetrahedra_are_refined_where_the_estimate_says():
         problem_options={"verbose": False},
     )
     first, second = result.levels
-    assert second.estimate < 0.8 * first.estimate  # measured 0.65
-    assert second.start == "moved state" and second.newton_iterations <= 4  # measured 2
+    assert second.estimate < 0.8 * first.estimate  # measured 0.61
+    assert second.start == "moved state" and second.newton_iterations <= 6  # measured 4
     domain = result.problem.scene.parts[0]
     surface = domain.facet_tags.find(domain.tags["sphere_contact"])
     nodes = dolfinx.mesh.entities_to_geometry(domain.mesh, 2, surface).ravel()

@@ -9,8 +9,10 @@ import dataclasses
 import dolfinx
 import numpy as np
 import pytest
+import ufl
 from conftest import across_ranks
 from mpi4py import MPI
+from scipy.optimize import fsolve
 
 import contact_ufl as cu
 from contact_ufl.estimate import TERMS, ErrorEstimate
@@ -44,11 +46,64 @@ def test_the_estimate_of_the_patch_test_vanishes_with_its_error(verification):
     case = "patch test 2D, contact rules: default, 2-point Gauss on 8 and on 32 sub-segments"
     quantity = "relative estimate on the 32-sub-segment rule"
     source = "the exact solution, uniform (the estimate of an exact solution is zero)"
-    verification(case, quantity, relative[-1], 0.0, "< 1e-3", source)
-    assert relative[-1] < 1e-3
-    # measured 1.3e-2, 1.1e-3, 2.6e-4 with the multipliers off by 3e-2, 5e-4, 3e-5
+    verification(case, quantity, relative[-1], 0.0, "< 4e-4", source)
+    assert relative[-1] < 4e-4
+    # measured 7.8e-3, 7.9e-4, 1.8e-4 with the multipliers off by 3e-2, 5e-4, 3e-5
     assert relative[0] > 5 * relative[1] and relative[1] > 2 * relative[2]
     assert deviation[0] > deviation[1] > deviation[2]
+
+
+def _patch_stretch(pressure: float = 0.01, E: float = 1.0, nu: float = 0.3) -> np.ndarray:
+    """The patch test's exact deformation gradient ``diag(a, b)``: the plane-strain
+    Neo-Hookean law under the nominal uniaxial stress ``P_yy = -pressure``, ``P_xx = 0``."""
+    mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+
+    def stress(x):
+        a, b = x
+        log_J = np.log(a * b)
+        return [
+            mu * (a - 1 / a) + lmbda * log_J / a,
+            mu * (b - 1 / b) + lmbda * log_J / b + pressure,
+        ]
+
+    a, b = fsolve(stress, [1.0, 1.0], xtol=1e-15)
+    assert max(abs(r) for r in stress((a, b))) < 1e-15
+    return np.diag([a, b])
+
+
+def energy_norm_of_error(problem, F: np.ndarray) -> float:
+    """``(int Grad e : C : Grad e)^1/2`` of ``e = (F - I) X - u_h`` over all meshes, ``C``
+    the linear elasticity of each body."""
+    total = 0.0
+    for bulk in problem.bulks:
+        mesh = bulk.V.mesh
+        eps = ufl.sym(ufl.as_matrix((F - np.eye(2)).tolist()) - ufl.grad(bulk.u))
+        for body in bulk.bodies:
+            m = body.material
+            density = 2.0 * m.mu * ufl.inner(eps, eps) + m.lmbda * ufl.tr(eps) ** 2
+            form = dolfinx.fem.form(density * bulk.dx(body.tag))
+            total += mesh.comm.allreduce(dolfinx.fem.assemble_scalar(form), MPI.SUM)
+    return float(np.sqrt(total))
+
+
+@pytest.mark.serial
+def test_the_estimate_of_the_patch_test_is_within_a_factor_3_of_its_error(verification):
+    """The patch test's exact solution is a closed form (a uniform stretch): the estimate
+    over the energy norm of the true error (the multipliers' quadrature error) lies in
+    [1, 3], as calibrated (the benchmark report: 1.6 to 1.8 on the patch test, 2D Hertz and
+    Cattaneo-Mindlin under refinement)."""
+    problem = _patch(None, 1)
+    error = energy_norm_of_error(problem, _patch_stretch())
+    effectivity = problem.error_estimate().estimate / error
+    verification(
+        "patch test 2D, default contact rule",
+        "effectivity: estimate over the energy norm of the error",
+        effectivity,
+        1.0,
+        "in [1, 3]",
+        "the exact solution: a uniform stretch, the root of the plane-strain Neo-Hookean law",
+    )
+    assert 1.0 <= effectivity <= 3.0
 
 
 @pytest.fixture(scope="module")
@@ -66,7 +121,7 @@ def hertz():
 
 @pytest.mark.serial
 def test_the_estimate_falls_under_refinement(hertz):
-    """Halving the mesh size near the contact lowers the estimate (measured: 5.2e-3, 3.3e-3,
+    """Halving the mesh size near the contact lowers the estimate (measured: 2.6e-3, 1.7e-3,
     2.5e-3 of an energy norm of 1.0e-2) and every term is finite and non-negative."""
     etas = [e.estimate for _, _, e in hertz]
     assert etas[0] > etas[1] > etas[2] > 0.0

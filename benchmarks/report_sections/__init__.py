@@ -13,10 +13,19 @@ again.
 * :mod:`report_sections.closest_points`: the closest-point search.
 * :mod:`report_sections.solver_cost`: the cost of a Newton iteration, the linear solvers.
 * :mod:`report_sections.checkpoints`: the cost of a checkpoint at every step.
+* :mod:`report_sections.estimates`: the effectivity of the error estimate.
 * :mod:`report_sections.commands`: the command of each results file.
 """
 
-from report_sections import accuracy, checkpoints, closest_points, hertz, sliding, solver_cost
+from report_sections import (
+    accuracy,
+    checkpoints,
+    closest_points,
+    estimates,
+    hertz,
+    sliding,
+    solver_cost,
+)
 from report_sections.commands import COMMANDS
 
 #: the report's sections, in the order of the page
@@ -27,6 +36,7 @@ SECTIONS = (
     *closest_points.SECTIONS,
     *solver_cost.SECTIONS,
     *checkpoints.SECTIONS,
+    *estimates.SECTIONS,
 )
 
 __all__ = ["COMMANDS", "SECTIONS"]
