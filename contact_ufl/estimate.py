@@ -76,7 +76,7 @@ class ErrorEstimate:
         return self.estimate / self.energy if self.energy > 0 else float("inf")
 
 
-def _stress_field(bulk) -> dolfinx.fem.Function:
+def stress_field(bulk) -> dolfinx.fem.Function:
     """The first Piola stress of each body interpolated, body by body, into a discontinuous
     tensor space of the displacement's degree minus one (exact for P1 on affine cells)."""
     mesh = bulk.V.mesh
@@ -143,7 +143,7 @@ def error_estimate(problem) -> ErrorEstimate:
             for c in problem.contacts
             if not c.pair.on_obstacle and problem.bulk_of(c, "master") is bulk
         }
-        P, E = _stress_field(bulk), _modulus(bulk)  # once a mesh, for all its terms
+        P, E = stress_field(bulk), _modulus(bulk)  # once a mesh, for all its terms
         forms = {name: [form] for name, form in _bulk_forms(bulk, P, E, tags).items()}
         for c in contacts:
             for name, form in _contact_forms(bulk, P, E, c).items():
@@ -187,7 +187,7 @@ def _exterior_facets(bulk) -> ufl.Measure:
 def _bulk_forms(bulk, P, E, contact_tags: set[int]) -> dict[str, dolfinx.fem.Form]:
     """The bulk, jump and boundary terms of one mesh, each a form linear in a DG0 test
     function (its vector: the cells' shares). ``P``, ``E``: the stress and modulus fields
-    (:func:`_stress_field`, :func:`_modulus`); ``contact_tags``: the facet groups of the
+    (:func:`stress_field`, :func:`_modulus`); ``contact_tags``: the facet groups of the
     contact surfaces on this mesh (no boundary term)."""
     mesh = bulk.V.mesh
     comm = mesh.comm

@@ -605,3 +605,42 @@ def _inverted(bulk) -> np.ndarray:
     J = jit.expression(ufl.det(deformation_gradient(bulk.u)), points)
     values = J.eval(mesh, np.arange(owned, dtype=np.int32)).reshape(owned, len(points))
     return ~np.all(values > 0.0, axis=1)  # (NaN too: an iterate beyond the material's domain)
+
+
+def recovered_pressure(problem, pair: int = 0) -> dolfinx.fem.Function:
+    """The nominal contact pressure the slave body carries, recovered from its stress: the
+    L2 projection of ``nu . P N`` onto the P1 space of the slave surface (collective).
+
+    By property (c) of the formulation it is the multiplier ``lambda_N`` in the limit. On
+    non-matching meshes the standard multipliers oscillate node to node about the pressure
+    (their mass matrix amplifies the mismatch of the two surfaces' nodes in the contact
+    integrals); the traction of the bulk does not, and its projection is a smooth field to
+    read and plot (see the user guide, *Results*)."""
+    from dolfinx.fem import petsc as fem_petsc
+    from petsc4py import PETSc
+
+    from contact_ufl.estimate import stress_field
+
+    c = problem.contacts[pair]
+    bulk = problem.bulk_of(c)
+    P = stress_field(bulk)
+    N = ufl.FacetNormal(bulk.V.mesh)
+    space = c.slave.P1
+    p, q = ufl.TrialFunction(space), ufl.TestFunction(space)
+    maps = [c.slave.entity_map]
+    mass = fem_petsc.assemble_matrix(jit.form(p * q * c.ds, entity_maps=maps))
+    mass.assemble()
+    traction = ufl.dot(c.kinematics.nu, ufl.dot(P, N))
+    rhs = fem_petsc.assemble_vector(jit.form(traction * q * c.ds, entity_maps=maps))
+    rhs.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    recovered = dolfinx.fem.Function(space, name="recovered_pressure")
+    solver = PETSc.KSP().create(problem.comm)
+    solver.setOperators(mass)
+    solver.setType("cg")
+    solver.getPC().setType("jacobi")
+    solver.setTolerances(rtol=1e-12, atol=0.0, max_it=1000)
+    solver.solve(rhs, recovered.x.petsc_vec)
+    recovered.x.scatter_forward()
+    for obj in (solver, mass, rhs):
+        obj.destroy()
+    return recovered
