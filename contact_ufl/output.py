@@ -572,6 +572,7 @@ def plot_pressure_profile(
     span: tuple[float, float] | None = None,
     exact_label: str = "Hertz",
     comm: MPI.Comm | None = None,
+    label: str = "lambda_N (FE)",
 ) -> None:
     """A chart of the contact pressure along the slave surface, with an optional exact
     curve. Rank 0 writes the picture. Two forms:
@@ -592,7 +593,7 @@ def plot_pressure_profile(
         rank's arrays are its part of the profile, gathered to rank 0 of ``comm``.
 
     ``exact`` is ``(abscissa, pressure)`` on the same abscissa, drawn as a line labelled
-    ``exact_label``.
+    ``exact_label``; ``label`` names the arrays' points.
     """
     from contact_ufl.results import ALONG, ContactSamples
 
@@ -616,7 +617,7 @@ def plot_pressure_profile(
         if comm is not None:
             x = np.concatenate(comm.gather(x, root=0) or [x])
             pressure = np.concatenate(comm.gather(pressure, root=0) or [pressure])
-        touching, label = np.ones(len(x), dtype=bool), "lambda_N (FE)"
+        touching = np.ones(len(x), dtype=bool)
     if (comm or MPI.COMM_WORLD).rank != 0:
         return
     shown = np.ones(len(x), dtype=bool) if span is None else (x >= span[0]) & (x <= span[1])

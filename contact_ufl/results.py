@@ -116,8 +116,11 @@ class ContactSamples:
         return ContactSamples(**values)
 
 
-def contact_samples(problem, pair: int = 0) -> ContactSamples:
+def contact_samples(problem, pair: int = 0, recovered: bool = False) -> ContactSamples:
     """Gather the contact quantities of contact pair ``pair`` on every rank (collective).
+
+    ``recovered``: ``lambda_N`` and ``pressure`` are those of :func:`recovered_pressure`
+    (the bulk's traction, smooth on non-matching meshes) instead of the multipliers'.
 
     The in-contact flag is the formulation's active set (``lambda_N + eps_N g > 0``), the
     stick flag (friction) its Coulomb disc (``|lambda_T + eps_T s_T| <= mu t_N``); see
@@ -129,7 +132,8 @@ def contact_samples(problem, pair: int = 0) -> ContactSamples:
     comm = problem.comm
     gdim = c.gdim
     x = c.slave.positions(c.u).reshape(-1, gdim)
-    lam = c.multiplier_at_points()
+    lam = c.slave.p1_at_points(recovered_pressure(problem, pair)) if recovered else None
+    lam = c.multiplier_at_points() if lam is None else lam
     ratio = c.slave.area_ratio(c.u).ravel()
     if c.projection is None:  # not searched yet
         gap, active = np.full(len(lam), -np.inf), np.zeros(len(lam), dtype=bool)
