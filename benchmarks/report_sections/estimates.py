@@ -1,9 +1,18 @@
-"""The section of the report on the error estimate: its effectivity against a true error
+"""The sections of the report on the error estimate: its effectivity against a true error
 under refinement (``benchmarks/estimate_effectivity.py``), with unit weights and with the
-proposed per-term weights.
+package's per-term weights; adaptive against uniform refinement (``benchmarks/adaptive.py``).
 """
 
-from report_sections.tables import Column, Section, Table, fixed, integer, scientific, significant
+from report_sections.tables import (
+    Column,
+    Section,
+    Table,
+    fixed,
+    integer,
+    percent,
+    scientific,
+    significant,
+)
 
 #: the case of a record as the table shows it
 CASES = {
@@ -52,9 +61,10 @@ SECTIONS = (
         "points (body by body; *interpolated*: the norm with `u_h` interpolated into the "
         "reference space instead, which smears its kinks). Each case refines all its mesh "
         "sizes by the factor `s`. *Effectivity* is `eta / ||e||_E` with every term "
-        "weighted by 1; *weighted* with the proposed weights on the terms' `eta^2` (the "
-        "records' `weights`: 1/4 on the bulk's residuals, `bulk`, `jump` and `boundary`, "
-        "1/2 on the contact's, `traction`, `penetration`, `complementarity` and `cone`); "
+        "weighted by 1; *weighted* with the package's weights on the terms' `eta^2` "
+        "(`contact_ufl.estimate.WEIGHTS`, fitted to these records: 1/4 on the bulk's "
+        "residuals, `bulk`, `jump` and `boundary`, 1/2 on the contact's, `traction`, "
+        "`penetration`, `complementarity` and `cone`); "
         "*energy eff.* is `eta` over `(2 |W_h - W_ref|)^1/2`, the error "
         "the stored energy measures. The shares are those of the jump, contact traction and "
         "complementarity terms in the unit-weighted `eta^2`.",
@@ -83,6 +93,42 @@ SECTIONS = (
                     Column("estimate s", "estimate_s", significant),
                 ),
             ),
+        ),
+    ),
+    Section(
+        "Adaptive refinement",
+        "The 2D Hertz scene of the Hertz benchmark (linear elastic, one load step, the "
+        "default eps, depth 0.005) from a coarse mesh (`h_contact = 0.04`, a/h = 1.3), "
+        "refined by `cu.refine_to_tolerance` (Doerfler, theta = 0.5, the slave kept no "
+        "coarser than the master, the arc's new nodes on the circle) and, for comparison, "
+        "uniformly (every cell, the same loop). Errors against Hertz's closed form at the "
+        "computed force: p0 and a of the profile fitted to the multipliers at the reference "
+        "positions (*nominal*, as the small-strain solution compares), p0 of the pressure "
+        "recovered from the bulk (`results.recovered_pressure`), the pressure's L2 error. "
+        "*wall s*: the level's solve and estimate; *loop s*: the loop so far (solves, "
+        "estimates, marking, refinement, the problems' set-up). *start*: the first mesh "
+        "runs the load path, later ones start from the moved solution. The hand-graded "
+        "meshes to compare with are the Hertz benchmark's *graded* tables above.",
+        "python benchmarks/adaptive.py [--degree 2] [--max-unknowns N] --json FILE",
+        tuple(
+            Table(
+                f"P{degree}",
+                (f"adaptive_2d_p{degree}.json",),
+                (
+                    Column("refinement", "kind"),
+                    Column("unknowns", "dofs", integer),
+                    Column("relative estimate", "relative_estimate", scientific),
+                    Column("p0 (nominal)", "p0_error_nominal", percent),
+                    Column("p0 (recovered)", "p0_error_recovered", percent),
+                    Column("a (nominal)", "a_error_nominal", percent),
+                    Column("pressure L2", "pressure_l2_error", fixed(3)),
+                    Column("Newton", "newton_iterations", integer),
+                    Column("start", "start"),
+                    Column("wall s", "wall_s", significant),
+                    Column("loop s", "cumulative_s", significant),
+                ),
+            )
+            for degree in (1, 2)
         ),
     ),
 )
