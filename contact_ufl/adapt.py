@@ -202,10 +202,15 @@ def slave_finer_than_master(
     in the configuration displaced by ``displacements`` (one field per mesh of the scene,
     on any mesh: moved by interpolation; ``None``: the reference configuration).
     """
+    surfaces: dict[int, set[int]] = {}  # the contact groups of each mesh
+    for pair in scene.contacts:
+        if not pair.on_obstacle:
+            surfaces.setdefault(_domain_index(pair.slave_domain), set()).add(pair.slave)
+            surfaces.setdefault(_domain_index(pair.master_domain), set()).add(pair.master)
     for _ in range(max_passes):
         parts = scene.parts
         current = [
-            _nodes_moved(d, displacements[k] if displacements else None)
+            _nodes_moved(d, displacements[k] if displacements else None, surfaces.get(k, set()))
             for k, d in enumerate(parts)
         ]
         marked = [np.zeros(0, dtype=np.int32) for _ in parts]
@@ -228,20 +233,25 @@ def _domain_index(index: int | None) -> int:
     return 0 if index is None else int(index)
 
 
-def _nodes_moved(domain: Domain, u: dolfinx.fem.Function | None) -> np.ndarray:
-    """The geometry nodes of ``domain``'s mesh displaced by ``u`` (interpolated)."""
+def _nodes_moved(domain: Domain, u: dolfinx.fem.Function | None, groups: set[int]) -> np.ndarray:
+    """The geometry nodes of ``domain``'s mesh, those of the facet ``groups`` displaced by
+    ``u`` (interpolated on their cells)."""
     mesh = domain.mesh
     x = mesh.geometry.x.copy()
-    if u is None:
+    if u is None or not groups:
         return x
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    facets = np.concatenate([domain.facet_tags.find(tag) for tag in sorted(groups)])
+    cells = dolfinx.mesh.compute_incident_entities(mesh.topology, facets, tdim - 1, tdim)
     gdim = mesh.geometry.dim
     degree = mesh.geometry.cmaps[0].degree
     space = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (gdim,)))
     moved = dolfinx.fem.Function(space)
     if u.function_space.mesh is mesh:
-        moved.interpolate(u)
+        moved.interpolate(u, cells0=cells)
     else:
-        _interpolate(moved, u, 1e-6 * _size(mesh))
+        _interpolate(moved, u, 1e-6 * _size(mesh), cells)
     # the space's dofs and the geometry's nodes follow the same element: cell by cell
     nodes = mesh.geometry.dofmaps[0]
     dofs = space.dofmap.list
@@ -386,11 +396,19 @@ def transfer_state(source: ContactProblem, target: ContactProblem, padding: floa
     target.set_time(source.t)
 
 
-def _interpolate(new: dolfinx.fem.Function, old: dolfinx.fem.Function, padding: float) -> None:
+def _interpolate(
+    new: dolfinx.fem.Function,
+    old: dolfinx.fem.Function,
+    padding: float,
+    cells: np.ndarray | None = None,
+) -> None:
+    """``new`` at its dofs of ``cells`` (default: all this rank holds) from ``old`` on
+    another mesh (collective)."""
     mesh = new.function_space.mesh
-    tdim = mesh.topology.dim
-    n = mesh.topology.index_map(tdim).size_local + mesh.topology.index_map(tdim).num_ghosts
-    cells = np.arange(n, dtype=np.int32)
+    if cells is None:
+        tdim = mesh.topology.dim
+        n = mesh.topology.index_map(tdim).size_local + mesh.topology.index_map(tdim).num_ghosts
+        cells = np.arange(n, dtype=np.int32)
     data = dolfinx.fem.create_interpolation_data(
         new.function_space, old.function_space, cells, padding=padding
     )
