@@ -41,7 +41,8 @@ test-all: install
 	timeout $(PYTEST_TIMEOUT_ALL) $(MPIRUN) -n 2 $(PYTEST) -m "not serial" tests
 
 demo: install
-	cd demos && ../$(PY) hertz.py && ../$(PY) plastic_indentation.py && ../$(MPIRUN) -n 2 ../$(PY) beams.py && ../$(PY) membrane.py
+	cd demos && ../$(PY) hertz.py && ../$(PY) plastic_indentation.py && ../$(MPIRUN) -n 2 ../$(PY) beams.py && ../$(PY) membrane.py \
+	  && ../$(PY) adaptive_hertz.py
 
 # demos/hertz.ipynb: the Hertz demo as a notebook, executed (pictures inline, files in demos/output)
 notebook: install

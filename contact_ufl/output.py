@@ -694,6 +694,52 @@ def plot_deformed(
     _save(plotter, path)
 
 
+def plot_mesh_with_indicator(
+    problem,
+    indicators: list[dolfinx.fem.Function],
+    path: str | Path,
+    zoom: float = 1.0,
+    focus: tuple[float, float, float] | None = None,
+    clim: tuple[float, float] | None = None,
+    title: str = "",
+) -> None:
+    """The reference meshes, edges drawn, coloured by an error indicator per cell on a log
+    scale (2D: the plane view ``"xy"``). ``indicators``: one cellwise (DG0) function per mesh
+    of the problem, e.g. :attr:`ErrorEstimate.indicators
+    <contact_ufl.estimate.ErrorEstimate.indicators>` (``eta_K^2``); ``clim``: the colour
+    range (default: the largest value and 1e-6 of it), to draw several meshes on one scale.
+    Collective: the meshes of all ranks are gathered, rank 0 writes."""
+    names = [f"indicator {k}" for k in range(len(indicators))]
+    fields = dict(zip(names, indicators, strict=True))
+    grid = gathered_grid(problem, deformed=False, cell_data=fields)
+    if grid is None:
+        return
+    # each cell is in one mesh: its value is the one that is not NaN
+    values = np.nanmax(np.vstack([grid.cell_data[name] for name in names]), axis=0)
+    if clim is None:
+        top = float(values.max()) if values.max() > 0.0 else 1.0
+        clim = (1e-6 * top, top)
+    grid.cell_data["eta_K^2"] = np.clip(values, *clim)
+    pv = _pyvista()
+    plotter = pv.Plotter(off_screen=True, window_size=(1000, 700))
+    plotter.add_mesh(
+        grid,
+        scalars="eta_K^2",
+        show_edges=True,
+        edge_opacity=0.3,  # the cells show through the edges of fine meshes
+        cmap="viridis",
+        log_scale=True,
+        clim=clim,
+        scalar_bar_args={"title": "eta_K^2", "fmt": "%.0e"},
+    )
+    if problem.gdim == 2:
+        _view(plotter, "xy")
+    if focus is not None:
+        _focus(plotter, focus)
+    plotter.camera.zoom(zoom)
+    _screenshot(plotter, path, title)
+
+
 def _plane_patch(obstacle, t: float, size: float) -> pyvista.PolyData:
     """A square of side ``size`` on the rigid plane ``obstacle`` at pseudo-time ``t``,
     centred at its moved point (3D)."""

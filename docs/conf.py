@@ -26,7 +26,7 @@ sys.path.insert(0, str(DOCS / "_ext"))  # demo_notebooks, the demos' reader
 
 # -- the tutorial: the demos, copied into docs/tutorial/ (generated, git-ignored) -------------
 #: the demos, in the order of the tutorial
-DEMOS = ["hertz", "plastic_indentation", "beams", "membrane"]
+DEMOS = ["hertz", "adaptive_hertz", "plastic_indentation", "beams", "membrane"]
 TUTORIAL = DOCS / "tutorial"
 
 

@@ -103,6 +103,18 @@ def test_membrane_demo_runs(tmp_path, ranks):
     assert_written(out, pictures, [f"membrane_mu0.3/{name}" for name in files])
 
 
+@pytest.mark.serial
+@RANKS_SLOW_2
+def test_adaptive_hertz_demo_runs(tmp_path, ranks):
+    stdout, out = run_demo("adaptive_hertz.py", [], tmp_path, ranks=ranks)
+    # the loop stopped because the relative estimate met the demo's tolerance, 0.05
+    assert "stopped by the tolerance" in stdout
+    assert stdout.strip().splitlines()[-1] == "reached: True"
+    views = ["first_whole", "first_contact", "last_whole", "last_contact", "last_edge"]
+    pictures = [f"adaptive_hertz_{view}.png" for view in views] + ["adaptive_hertz_pressure.png"]
+    assert_written(out, pictures, [])
+
+
 @pytest.mark.parametrize("demo", sorted(DEMOS.glob("*.py")), ids=lambda p: p.name)
 def test_demo_is_a_notebook(demo):
     notebook = jupytext.read(demo)
