@@ -106,8 +106,9 @@ def test_membrane_demo_runs(tmp_path, ranks):
 @pytest.mark.serial
 @RANKS_SLOW_2
 def test_adaptive_hertz_demo_runs(tmp_path, ranks):
-    stdout, out = run_demo("adaptive_hertz.py", [], tmp_path, ranks=ranks)
-    # the loop stopped because the relative estimate met the demo's tolerance, 0.05
+    # a looser tolerance than the demo's 0.05: five meshes instead of seven
+    stdout, out = run_demo("adaptive_hertz.py", ["--tolerance", "0.1"], tmp_path, ranks=ranks)
+    # the loop stopped because the relative estimate met the tolerance
     assert "stopped by the tolerance" in stdout
     assert stdout.strip().splitlines()[-1] == "reached: True"
     views = ["first_whole", "first_contact", "last_whole", "last_contact", "last_edge"]
