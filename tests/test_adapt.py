@@ -12,7 +12,7 @@ from conftest import across_ranks
 from mpi4py import MPI
 
 import contact_ufl as cu
-from contact_ufl import adapt
+from contact_ufl import adapt, refinement
 from contact_ufl.errors import ContactInputError
 from contact_ufl.verification import scenes
 
@@ -57,7 +57,7 @@ def test_tags_are_carried_over_as_dolfinx_carries_them():
     scene = _hertz()
     cells = _every_other_cell(scene)
     domain = scene.parts[0]
-    fine = adapt.refine_scene(scene, cells).parts[0]
+    fine = refinement.refine_scene(scene, cells).parts[0]
     tdim = domain.mesh.topology.dim
     edges = dolfinx.mesh.compute_incident_entities(domain.mesh.topology, cells[0], tdim, 1)
     option = dolfinx.mesh.RefinementOption.parent_cell_and_facet
@@ -77,12 +77,12 @@ def test_tags_are_carried_over_on_any_number_of_ranks():
     DOLFINx's transfer refuses), and the arc's nodes are put back on the circle."""
     scene = _hertz()
     before = _group_measures(scene.parts[0])
-    fine = adapt.refine_scene(scene, _every_other_cell(scene)).parts[0]
+    fine = refinement.refine_scene(scene, _every_other_cell(scene)).parts[0]
     after = _group_measures(fine)
     assert before.keys() == after.keys()
     for key, value in before.items():
         assert after[key] == pytest.approx(value, rel=1e-12), key
-    snapped = adapt.refine_scene(
+    snapped = refinement.refine_scene(
         scene, _every_other_cell(scene), {"cylinder_contact": onto_circle}
     ).parts[0]
     arc = snapped.facet_tags.find(snapped.tags["cylinder_contact"])
@@ -163,7 +163,7 @@ def test_adaptive_meshes_beat_uniform_refinement(adaptive_hertz):
     mesh = scene.parts[0].mesh
     every = [np.arange(mesh.topology.index_map(2).size_local, dtype=np.int32)]
     uniform = cu.ContactProblem(
-        adapt.refine_scene(scene, every, {"cylinder_contact": onto_circle}), verbose=False
+        refinement.refine_scene(scene, every, {"cylinder_contact": onto_circle}), verbose=False
     )
     uniform.solve(num_steps=2)
     reference = uniform.error_estimate()
