@@ -15,6 +15,10 @@ records refine every cell at each level instead (``theta = 1``).
         [--degree 2] [--start 0.04] [--max-unknowns 60000]
     python benchmarks/adaptive.py --dim 3 --json ...
 
+``--case cattaneo``: Cattaneo-Mindlin (the 2D scene with mu = 0.3, pressed in 4 steps,
+then moved sideways in 4; every mesh replays them): the stick zone's half-width and the
+shear traction against Johnson 7.1.
+
 ``--dim 3``: the quarter ball on a block of the 3D Hertz benchmark (linear elastic, one
 step, depth 0.01, the default eps) from ``h_contact = 0.05``; the errors of
 :func:`contact_ufl.verification.runs.hertz_3d_errors` (p0 and a nominal).
@@ -31,10 +35,10 @@ from mpi4py import MPI
 
 from contact_ufl import adapt
 from contact_ufl.materials import LinearElastic
-from contact_ufl.results import contact_samples
+from contact_ufl.results import contact_samples, stick_zone_half_width
 from contact_ufl.verification import scenes
-from contact_ufl.verification.analytic import Hertz2D, fit_elliptic_profile
-from contact_ufl.verification.runs import hertz_3d_errors
+from contact_ufl.verification.analytic import CattaneoMindlin2D, Hertz2D, fit_elliptic_profile
+from contact_ufl.verification.runs import hertz_3d_errors, shear_error
 
 #: the disc of the 2D Hertz scene
 CENTRE = np.array([0.0, 1.0, 0.0])
@@ -69,6 +73,27 @@ def hertz_3d_setup(h: float, depth: float):
         }
 
     return scene, errors, {"sphere_contact": onto_sphere}
+
+
+def cattaneo_setup(h: float, depth: float):
+    """Cattaneo-Mindlin: the 2D Hertz scene with mu = 0.3 pressed by ``depth`` in 4 steps,
+    then moved sideways by 0.0015 in 4; the stick zone's half-width and the shear traction
+    against Johnson 7.1 at the last step."""
+    mu = 0.3
+    hertz = scenes.hertz_2d(h_contact=h, depth=depth, mu=mu, shift=0.0015)
+    scene = hertz.scene
+
+    def errors(problem) -> dict:
+        force = problem.history.steps[-1].contact_force
+        exact = CattaneoMindlin2D(Hertz2D(force[1], hertz.radius, hertz.E_star), abs(force[0]), mu)
+        c = stick_zone_half_width(problem)
+        return {
+            "stick_zone_error": c / exact.c - 1.0,
+            "shear_error": shear_error(problem, exact),
+            "Q_over_muP": abs(force[0]) / (mu * force[1]),
+        }
+
+    return scene, errors, {"cylinder_contact": onto_circle}
 
 
 def hertz_2d_setup(h: float, depth: float):
@@ -119,11 +144,22 @@ def run(
     max_unknowns: int,
     theta: float,
     dim: int = 2,
+    case: str = "hertz",
 ) -> list[dict]:
     """The levels of one loop: ``kind`` ``"adaptive"`` (Doerfler, ``theta``) or
-    ``"uniform"`` (every cell refined)."""
-    setup = hertz_2d_setup if dim == 2 else hertz_3d_setup
+    ``"uniform"`` (every cell refined), of ``case`` ``"hertz"`` or ``"cattaneo"``."""
+    setup = {(2, "hertz"): hertz_2d_setup, (3, "hertz"): hertz_3d_setup}.get(
+        (dim, case), cattaneo_setup
+    )
     scene, errors, boundaries = setup(start_h, depth)
+
+    def solve(problem) -> None:
+        if case == "cattaneo":
+            problem.solve(num_steps=4, t_end=1.0)
+            problem.solve(num_steps=4, t_end=2.0)
+        else:
+            problem.solve(num_steps=1)
+
     records = []
     begin = time.perf_counter()
 
@@ -131,6 +167,7 @@ def run(
         records.append(
             {
                 "kind": kind,
+                "case": case,
                 "dim": dim,
                 "degree": degree,
                 "start_h": start_h,
@@ -152,16 +189,20 @@ def run(
         if problem.comm.rank == 0:
             print(
                 f"{kind:8s} {r['dofs']:8d} eta {r['relative_estimate']:.3e} "
-                f"p0 {r['p0_error_nominal']:+.3%} "
-                f"a {r['a_error_nominal']:+.3%} "
-                f"L2 {r['pressure_l2_error']:.3f} newton {r['newton_iterations']} "
+                + (
+                    f"stick zone {r['stick_zone_error']:+.3%} shear {r['shear_error']:.3f} "
+                    if case == "cattaneo"
+                    else f"p0 {r['p0_error_nominal']:+.3%} a {r['a_error_nominal']:+.3%} "
+                    f"L2 {r['pressure_l2_error']:.3f} "
+                )
+                + f"newton {r['newton_iterations']} "
                 f"wall {r['wall_s']:.2f} s cumulative {r['cumulative_s']:.2f} s",
                 flush=True,
             )
 
     adapt.refine_to_tolerance(
         scene,
-        lambda p: p.solve(num_steps=1),
+        solve,
         tolerance=1e-9,
         max_unknowns=max_unknowns,
         theta=1.0 if kind == "uniform" else theta,
@@ -179,6 +220,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="to 15,000 unknowns")
     parser.add_argument("--degree", type=int, choices=(1, 2), default=1)
     parser.add_argument("--dim", type=int, choices=(2, 3), default=2)
+    parser.add_argument("--case", choices=("hertz", "cattaneo"), default="hertz")
     parser.add_argument("--start", type=float, default=None, help="h_contact (0.04, 3D 0.05)")
     parser.add_argument("--depth", type=float, default=None, help="0.005, 3D 0.01")
     parser.add_argument("--theta", type=float, default=0.5)
@@ -189,7 +231,7 @@ def main() -> None:
     depth = args.depth or (0.005 if args.dim == 2 else 0.01)
     records = []
     for kind in ("adaptive", "uniform"):
-        records += run(kind, start, depth, args.degree, budget, args.theta, args.dim)
+        records += run(kind, start, depth, args.degree, budget, args.theta, args.dim, args.case)
     if MPI.COMM_WORLD.rank == 0:
         resultfile.write(args.json, records)
 
