@@ -178,6 +178,7 @@ def run(
                 "relative_estimate": level.relative,
                 "newton_iterations": level.newton_iterations,
                 "newton_per_step": level.newton_iterations / len(problem.history.steps),
+                "newton_max": max(r.newton_iterations for r in problem.history.steps),
                 "start": level.start,
                 "wall_s": level.wall,
                 "cumulative_s": time.perf_counter() - begin,
@@ -195,7 +196,7 @@ def run(
                     else f"p0 {r['p0_error_nominal']:+.3%} a {r['a_error_nominal']:+.3%} "
                     f"L2 {r['pressure_l2_error']:.3f} "
                 )
-                + f"newton {r['newton_iterations']} "
+                + f"newton {r['newton_iterations']} (max {r['newton_max']} a step) "
                 f"wall {r['wall_s']:.2f} s cumulative {r['cumulative_s']:.2f} s",
                 flush=True,
             )
