@@ -65,7 +65,6 @@ import time
 import gmsh
 import numpy as np
 import resultfile
-import scipy.sparse.linalg
 import ufl
 from mpi4py import MPI
 
@@ -75,7 +74,7 @@ from contact_ufl.gmshio import generate_mesh
 from contact_ufl.loads import Dirichlet
 from contact_ufl.materials import LinearElastic, NeoHookean
 from contact_ufl.problem import ContactProblem
-from contact_ufl.results import slave_body
+from contact_ufl.results import recovered_pressure
 from contact_ufl.scene import Body, Scene
 from contact_ufl.verification import geometries
 from contact_ufl.verification.analytic import Hertz2D, plane_strain_modulus
@@ -297,14 +296,9 @@ def _slave_forms(problem, integrand):
 
 
 def recovered_traction(problem) -> np.ndarray:
-    """The L2 projection (consistent mass) onto the multiplier space of the slave body's
-    bulk normal traction ``nu . P N`` (nominal: per unit reference length)."""
-    c = problem.contacts[0]
-    bulk = problem.bulk_of(c)
-    P = bulk.first_piola(slave_body(problem, 0))
-    N = ufl.FacetNormal(bulk.V.mesh)
-    M, rhs = _slave_forms(problem, ufl.dot(c.kinematics.nu, P * N))
-    return scipy.sparse.linalg.spsolve(M.tocsc(), rhs)
+    """The package's recovered pressure (:func:`contact_ufl.results.recovered_pressure`:
+    the L2 projection of ``nu . P N`` onto the slave surface), nodal."""
+    return recovered_pressure(problem).x.array
 
 
 def nodal_force_pressure(problem) -> np.ndarray:

@@ -104,7 +104,8 @@ def test_membrane_demo_runs(tmp_path, ranks):
 
 
 @pytest.mark.serial
-@RANKS_SLOW_2
+@pytest.mark.slow  # its loop: tests/test_adapt.py
+@RANKS
 def test_adaptive_hertz_demo_runs(tmp_path, ranks):
     # a looser tolerance than the demo's 0.05: five meshes instead of seven
     stdout, out = run_demo("adaptive_hertz.py", ["--tolerance", "0.1"], tmp_path, ranks=ranks)

@@ -78,7 +78,9 @@ def test_taylor_smoothed_master_normal(mu, verification):
 )
 @pytest.mark.parametrize(
     "mu",
-    [pytest.param(0.0, marks=pytest.mark.serial), 0.05],  # 2 ranks: with friction
+    # 2 ranks: with friction; the frictionless variant with the slow tests (the frictional
+    # tangent holds every term of it)
+    [pytest.param(0.0, marks=[pytest.mark.serial, pytest.mark.slow]), 0.05],
 )
 def test_taylor_smoothed_master_normal_3d(cell, nn, mu, verification):
     """In 3D the smoothed normal depends on the fans of the master facet's nodes (triangles

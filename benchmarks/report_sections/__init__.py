@@ -13,7 +13,9 @@ again.
 * :mod:`report_sections.closest_points`: the closest-point search.
 * :mod:`report_sections.solver_cost`: the cost of a Newton iteration, the linear solvers.
 * :mod:`report_sections.checkpoints`: the cost of a checkpoint at every step.
-* :mod:`report_sections.estimates`: the effectivity of the error estimate.
+* :mod:`report_sections.estimates`: the effectivity of the error estimate, adaptive
+  refinement.
+* :mod:`report_sections.oscillation`: the multipliers' oscillation on non-matching meshes.
 * :mod:`report_sections.commands`: the command of each results file.
 """
 
@@ -23,6 +25,7 @@ from report_sections import (
     closest_points,
     estimates,
     hertz,
+    oscillation,
     sliding,
     solver_cost,
 )
@@ -37,6 +40,7 @@ SECTIONS = (
     *solver_cost.SECTIONS,
     *checkpoints.SECTIONS,
     *estimates.SECTIONS,
+    *oscillation.SECTIONS,
 )
 
 __all__ = ["COMMANDS", "SECTIONS"]
