@@ -361,6 +361,7 @@ def test_indentation_leaves_an_imprint(verification):
 
 
 @across_ranks
+@pytest.mark.slow  # default suite: test_restart's plastic case, this scene on 2 ranks vs 1
 def test_indentation_on_any_number_of_ranks():
     """The plastic indentation and lift-off distributed equals the solve on one rank (each
     rank redoes it alone), to solver tolerance: peak pressure, imprint, plastic strain and
