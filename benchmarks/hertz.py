@@ -104,13 +104,7 @@ def run(
     start, cpu = time.perf_counter(), time.process_time()
     problem.solve(num_steps=steps)
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
-    samples = contact_samples(problem)
-    exact = Hertz2D(problem.contact_force()[1], hertz.radius, hertz.E_star)
-    a, p0, _ = fit_elliptic_profile(samples.x[:, 0], samples.pressure)
-    # as the small-strain model compares: the nominal multiplier at the reference positions
-    c = problem.contacts[0]
-    X = np.concatenate(problem.comm.allgather(c.slave.X.reshape(-1, 2)))
-    a_nominal, p0_nominal, _ = fit_elliptic_profile(X[:, 0], samples.lambda_N)
+    errors = hertz_2d_errors(problem, hertz)
     timings = problem.solver.timings
     newton = sum(r.newton_iterations for r in problem.history.steps)
     return {
@@ -124,12 +118,8 @@ def run(
         "eps": eps,
         "eps_N": float(problem.contacts[0].normal.eps_N.value),
         "h": h,
-        "a_over_h": exact.a / h,
-        "p0_error": p0 / exact.p0 - 1.0,
-        "a_error": a / exact.a - 1.0,
-        "p0_error_nominal": p0_nominal / exact.p0 - 1.0,
-        "a_error_nominal": a_nominal / exact.a - 1.0,
-        "pressure_l2_error": _pressure_l2_error(problem, samples, exact),
+        "a_over_h": errors.pop("a") / h,
+        **errors,
         "newton_iterations": newton,
         "newton_per_step": newton / len(problem.history.steps),
         "wall_s": wall,
@@ -138,6 +128,27 @@ def run(
         "search_s": problem.search_time,
         "solver_s": timings.linear_solve,
         "ranks": problem.comm.size,
+    }
+
+
+def hertz_2d_errors(problem, hertz) -> dict:
+    """The errors of a 2D Hertz solve against Hertz's solution at the computed force: p0 and
+    a of the profile fitted to the Cauchy pressure at the current positions, and
+    (``_nominal``) to the multiplier at the reference positions, as the small-strain model
+    compares; the pressure's L2 error; ``a``, Hertz's half-width."""
+    samples = contact_samples(problem)
+    exact = Hertz2D(problem.contact_force()[1], hertz.radius, hertz.E_star)
+    a, p0, _ = fit_elliptic_profile(samples.x[:, 0], samples.pressure)
+    c = problem.contacts[0]
+    X = np.concatenate(problem.comm.allgather(c.slave.X.reshape(-1, 2)))
+    a_nominal, p0_nominal, _ = fit_elliptic_profile(X[:, 0], samples.lambda_N)
+    return {
+        "p0_error": p0 / exact.p0 - 1.0,
+        "a_error": a / exact.a - 1.0,
+        "p0_error_nominal": p0_nominal / exact.p0 - 1.0,
+        "a_error_nominal": a_nominal / exact.a - 1.0,
+        "pressure_l2_error": _pressure_l2_error(problem, samples, exact),
+        "a": exact.a,
     }
 
 
