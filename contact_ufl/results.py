@@ -132,8 +132,10 @@ def contact_samples(problem, pair: int = 0, recovered: bool = False) -> ContactS
     comm = problem.comm
     gdim = c.gdim
     x = c.slave.positions(c.u).reshape(-1, gdim)
-    lam = c.slave.p1_at_points(recovered_pressure(problem, pair)) if recovered else None
-    lam = c.multiplier_at_points() if lam is None else lam
+    if recovered:
+        lam = c.slave.p1_at_points(recovered_pressure(problem, pair))
+    else:
+        lam = c.multiplier_at_points()
     ratio = c.slave.area_ratio(c.u).ravel()
     if c.projection is None:  # not searched yet
         gap, active = np.full(len(lam), -np.inf), np.zeros(len(lam), dtype=bool)

@@ -54,6 +54,14 @@ def _percent(x) -> str:
     return "-" if x is None or x != x else f"{100.0 * x:.0f}%"
 
 
+#: the first and last columns of a table of adaptive levels
+LEVEL = (
+    Column("refinement", "kind"),
+    Column("unknowns", "dofs", integer),
+    Column("relative estimate", "relative_estimate", scientific),
+)
+TIMES = (Column("wall s", "wall_s", significant), Column("loop s", "cumulative_s", significant))
+
 SECTIONS = (
     Section(
         "Effectivity of the error estimate",
@@ -123,17 +131,14 @@ SECTIONS = (
                 f"P{degree}",
                 (f"adaptive_2d_p{degree}.json",),
                 (
-                    Column("refinement", "kind"),
-                    Column("unknowns", "dofs", integer),
-                    Column("relative estimate", "relative_estimate", scientific),
+                    *LEVEL,
                     Column("p0 (nominal)", "p0_error_nominal", percent),
                     Column("p0 (recovered)", "p0_error_recovered", percent),
                     Column("a (nominal)", "a_error_nominal", percent),
                     Column("pressure L2", "pressure_l2_error", fixed(3)),
                     Column("Newton", "newton_iterations", integer),
                     Column("start", "start"),
-                    Column("wall s", "wall_s", significant),
-                    Column("loop s", "cumulative_s", significant),
+                    *TIMES,
                 ),
             )
             for degree in (1, 2)
@@ -143,16 +148,13 @@ SECTIONS = (
                 "3D, P1 (the quarter ball on a block, depth 0.01, from h_contact = 0.05)",
                 ("adaptive_3d_p1.json",),
                 (
-                    Column("refinement", "kind"),
-                    Column("unknowns", "dofs", integer),
-                    Column("relative estimate", "relative_estimate", scientific),
+                    *LEVEL,
                     Column("p0 (nominal)", "p0_error_nominal", percent),
                     Column("a (nominal)", "a_error_nominal", percent),
                     Column("pressure L2", "pressure_l2_error", fixed(3)),
                     Column("Newton", "newton_iterations", integer),
                     Column("start", "start"),
-                    Column("wall s", "wall_s", significant),
-                    Column("loop s", "cumulative_s", significant),
+                    *TIMES,
                 ),
             ),
             Table(
@@ -160,15 +162,12 @@ SECTIONS = (
                 "mesh replays them), from h_contact = 0.02",
                 ("adaptive_cattaneo.json",),
                 (
-                    Column("refinement", "kind"),
-                    Column("unknowns", "dofs", integer),
-                    Column("relative estimate", "relative_estimate", scientific),
+                    *LEVEL,
                     Column("Q / mu P", "Q_over_muP", fixed(3)),
                     Column("stick zone", "stick_zone_error", percent),
                     Column("shear error", "shear_error", fixed(3)),
                     Column("Newton (max a step)", _newton_total_max),
-                    Column("wall s", "wall_s", significant),
-                    Column("loop s", "cumulative_s", significant),
+                    *TIMES,
                 ),
             ),
         ),
