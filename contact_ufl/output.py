@@ -49,9 +49,21 @@ class ResultWriter:
     contact_surfaces
         Also write ``contact_surface_<k>.pvd`` for each pair ``k``: its slave points at
         every step (:class:`ContactSurfaceWriter`).
+    error_indicators
+        Also write the error indicators of every step (:meth:`ContactProblem.error_estimate
+        <contact_ufl.problem.ContactProblem.error_estimate>`, ``eta_K^2`` per cell) to
+        ``error_indicators.bp`` (``error_indicators_<k>.bp`` per mesh), and the estimate,
+        its value relative to the solution's energy norm and its terms to
+        ``error_estimate.csv``, one line a step (hyperelastic solids only).
     """
 
-    def __init__(self, problem, folder: str | Path, contact_surfaces: bool = True):
+    def __init__(
+        self,
+        problem,
+        folder: str | Path,
+        contact_surfaces: bool = True,
+        error_indicators: bool = False,
+    ):
         folder = Path(folder)
         if problem.comm.rank == 0:
             folder.mkdir(parents=True, exist_ok=True)
@@ -81,11 +93,20 @@ class ResultWriter:
             ContactSurfaceWriter(problem, folder / f"contact_surface_{k}.pvd", k)
             for k in range(len(problem.contacts) if contact_surfaces else 0)
         ]
+        self.estimates = (
+            _EstimateWriter(problem, folder, [n.replace("displacement", "") for n in names], suffix)
+            if error_indicators
+            else None
+        )
+        if self.estimates:
+            self.writers += self.estimates.writers
 
     def write(self, t: float) -> None:
         """Write the current state at pseudo-time ``t``."""
         for h in self.histories:
             h.update_plastic_strain()
+        if self.estimates:
+            self.estimates.update(t)
         for w in self.writers:
             w.write(t)
         for w in self.surfaces:
@@ -101,6 +122,44 @@ class ResultWriter:
     def __call__(self, problem, record) -> None:
         """Use as the ``callback`` of :meth:`ContactProblem.solve`."""
         self.write(record.t)
+
+
+class _EstimateWriter:
+    """The error indicators of each mesh (DG0, VTX) and the estimate's lines of
+    ``error_estimate.csv`` (rank 0) of a :class:`ResultWriter`."""
+
+    def __init__(self, problem, folder: Path, endings: list[str], suffix: str):
+        from contact_ufl.estimate import TERMS, check_estimable
+
+        check_estimable(problem.bulks)
+        self.problem = problem
+        self.fields = []
+        for bulk in problem.bulks:
+            field = dolfinx.fem.Function(dolfinx.fem.functionspace(bulk.V.mesh, ("DG", 0)))
+            field.name = "error_indicator"
+            self.fields.append(field)
+        comm = problem.comm
+        self.writers = [
+            dolfinx.io.VTXWriter(comm, folder / f"error_indicators{end}{suffix}.bp", [f])
+            for f, end in zip(self.fields, endings, strict=True)
+        ]
+        self.table = folder / f"error_estimate{suffix}.csv"
+        if comm.rank == 0:
+            header = ",".join(["t", "estimate", "relative", *TERMS])
+            self.table.write_text(header + "\n")
+
+    def update(self, t: float) -> None:
+        """The indicators and the estimate of the current state (collective)."""
+        from contact_ufl.estimate import TERMS
+
+        estimate = self.problem.error_estimate()
+        for field, eta in zip(self.fields, estimate.indicators, strict=True):
+            field.x.array[:] = eta.x.array
+        if self.problem.comm.rank == 0:
+            values = [t, estimate.estimate, estimate.relative]
+            values += [estimate.parts[name] for name in TERMS]
+            with self.table.open("a") as f:
+                f.write(",".join(f"{v:.10g}" for v in values) + "\n")
 
 
 class ContactSurfaceWriter:

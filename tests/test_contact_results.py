@@ -342,13 +342,14 @@ def test_arc_length_on_any_number_of_ranks():
 
 @pytest.fixture(scope="module")
 def written(tmp_path_factory):
-    """Hertz (a/h ~ 2.5) in 2 load steps, written by a ResultWriter at t = 0 (before any
-    contact search) and after each step: the problem and the folder."""
+    """Hertz (a/h ~ 2.5) in 2 load steps, written by a ResultWriter (with the error
+    indicators) at t = 0 (before any contact search) and after each step: the problem and
+    the folder."""
     folder = tmp_path_factory.mktemp("written") if MPI.COMM_WORLD.rank == 0 else None
     folder = MPI.COMM_WORLD.bcast(folder)
     scene = scenes.hertz_2d(h_contact=0.02, depth=0.005)
     problem = ContactProblem(scene.scene, verbose=False)
-    writer = output.ResultWriter(problem, folder)
+    writer = output.ResultWriter(problem, folder, error_indicators=True)
     writer.write(0.0)
     problem.solve(num_steps=2, callback=writer)
     writer.close()
@@ -403,6 +404,37 @@ def test_surface_time_series_is_written_once(written, verification):
     assert np.array_equal(gap[~np.isnan(gap)], s.gap[np.isfinite(s.gap)])
     text = path.read_text()
     assert text.count("<DataSet ") == 1 + len(steps)
+
+def test_the_error_estimate_is_written_with_every_step(written, verification):
+    """``error_estimate.csv`` has a line for each write, its last the estimate of the
+    converged state (a consistency check: the same computation); the indicators' VTX file
+    exists beside the displacement's."""
+    problem, folder = written
+    estimate = problem.error_estimate()
+    if MPI.COMM_WORLD.rank != 0:
+        return
+    lines = (folder / "error_estimate.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    assert header[:3] == ["t", "estimate", "relative"]
+    rows = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+    steps = problem.history.steps
+    assert rows[:, 0] == pytest.approx([0.0] + [r.t for r in steps], rel=1e-12)
+    difference = abs(rows[-1, 1] / estimate.estimate - 1.0)
+    verification(
+        "Hertz 2D, Neo-Hookean, a/h ~ 2.5",
+        "written estimate of the last step, relative difference",
+        difference,
+        0.0,
+        "< 1e-8",
+        "problem.error_estimate() of the converged state",
+        kind="consistency",
+    )
+    assert difference < 1e-8
+    parts = dict(zip(header[3:], rows[-1, 3:], strict=True))
+    assert parts == pytest.approx(estimate.parts, rel=1e-8)
+    assert rows[0, 1] == 0.0  # the reference configuration: no load, no error
+    assert (folder / "error_indicators.bp").is_dir()
+
 
 
 def test_pictures_are_written_by_rank_0_in_the_plane(written, monkeypatch):
