@@ -6,6 +6,11 @@ set-up time (see ``docs/developer.md``). A process that finds a form being compi
 another (parallel tests, two notebooks) waits for it, ``timeout`` seconds, long enough for
 the largest contact kernels.
 
+A form compiled once in a process is kept, by its UFL signature, and the next form of the
+same signature (the same problem on another mesh: a new scene, a level of adaptive
+refinement) is made from it with :func:`dolfinx.fem.create_form` instead of looking it up
+in the disk cache of FFCx again.
+
 Change :data:`JIT_OPTIONS` before a problem is built to compile otherwise; it takes
 precedence over DOLFINx's ``dolfinx_jit_options.json`` for the options it names.
 """
@@ -14,14 +19,70 @@ from __future__ import annotations
 
 import dolfinx
 import numpy as np
+import ufl
+from dolfinx.fem import IntegralType
+from dolfinx.fem.forms import get_integration_domains
 
 #: The DOLFINx JIT options of every form and expression the package compiles.
 JIT_OPTIONS: dict = {"cffi_extra_compile_args": ["-O1", "-g0"], "timeout": 300}
 
+#: the forms compiled in this process, by signature and options
+_COMPILED: dict[tuple[str, str], dolfinx.fem.CompiledForm] = {}
 
-def form(forms, **kwargs) -> dolfinx.fem.Form:
-    """:func:`dolfinx.fem.form` with :data:`JIT_OPTIONS` (nested lists of forms too)."""
-    return dolfinx.fem.form(forms, jit_options=JIT_OPTIONS, **kwargs)
+_INTEGRAL_TYPES = {t.name: t for t in IntegralType}
+
+
+def form(forms, entity_maps=None, **kwargs):
+    """:func:`dolfinx.fem.form` with :data:`JIT_OPTIONS` (nested lists of forms too), a form
+    compiled before in this process made from its compiled code."""
+    if isinstance(forms, list | tuple):
+        return [form(f, entity_maps, **kwargs) for f in forms]
+    mesh = _integration_mesh(forms) if not kwargs else None
+    if mesh is None:
+        return dolfinx.fem.form(forms, jit_options=JIT_OPTIONS, entity_maps=entity_maps, **kwargs)
+    key = (forms.signature(), repr(sorted(JIT_OPTIONS.items())))
+    compiled = _COMPILED.get(key)
+    if compiled is None:
+        compiled = dolfinx.fem.compile_form(mesh.comm, forms, jit_options=JIT_OPTIONS)
+        _COMPILED[key] = compiled
+    return _create(compiled, forms, mesh, entity_maps)
+
+
+def _integration_mesh(a) -> dolfinx.mesh.Mesh | None:
+    """The DOLFINx mesh ``a`` integrates over, found among its arguments' and coefficients'
+    spaces (``None``: not a form with integrals, or no such space: left to DOLFINx)."""
+    if not isinstance(a, ufl.Form) or a.empty():
+        return None
+    domains = list(a.subdomain_data())
+    if len(domains) != 1:
+        return None
+    cpp = domains[0].ufl_cargo()
+    spaces = [v.ufl_function_space() for v in a.arguments()]
+    spaces += [c.function_space for c in a.coefficients() if hasattr(c, "function_space")]
+    for space in spaces:
+        if space.mesh._cpp_object is cpp:
+            return space.mesh
+    return None
+
+
+def _create(compiled, a: ufl.Form, mesh, entity_maps) -> dolfinx.fem.Form:
+    """The form ``a`` from the code compiled for a form of the same signature: the
+    coefficients and constants correspond in order (the signature numbers them so)."""
+    ufcx = compiled.ufcx_form
+    coefficients = dict(zip(compiled.ufl_form.coefficients(), a.coefficients(), strict=True))
+    constants = dict(zip(compiled.ufl_form.constants(), a.constants(), strict=True))
+    (data,) = a.subdomain_data().values()
+    offsets = [ufcx.form_integral_offsets[i] for i in range(len(IntegralType) + 1)]
+    subdomains = {}
+    for name, tags in data.items():
+        kind = _INTEGRAL_TYPES[name]
+        first, last = offsets[kind.value], offsets[kind.value + 1]
+        ids = [ufcx.form_integral_ids[j] for j in range(first, last)]
+        subdomains[kind] = get_integration_domains(kind, tags[0], ids)
+    spaces = [v.ufl_function_space() for v in a.arguments()]
+    return dolfinx.fem.create_form(
+        compiled, spaces, mesh, subdomains, coefficients, constants, entity_maps
+    )
 
 
 def expression(expr, points: np.ndarray, **kwargs) -> dolfinx.fem.Expression:
