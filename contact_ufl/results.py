@@ -13,6 +13,7 @@ import ufl
 from mpi4py import MPI
 
 from contact_ufl import jit, keysets
+from contact_ufl.errors import ContactInputError
 
 #: The abscissae of a profile along the slave surface (:meth:`ContactSamples.abscissa`).
 ALONG = ("x", "arc length", "current arc length")
@@ -620,8 +621,11 @@ def recovered_pressure(problem, pair: int = 0) -> dolfinx.fem.Function:
     By property (c) of the formulation it is the multiplier ``lambda_N`` in the limit. On
     non-matching meshes the standard multipliers oscillate node to node about the pressure
     (their mass matrix amplifies the mismatch of the two surfaces' nodes in the contact
-    integrals); the traction of the bulk does not, and its projection is a smooth field to
-    read and plot (see the user guide, *Results*)."""
+    integrals); the traction of the bulk of a P1 displacement does not, and its projection
+    is a smooth field to read and plot. The projection is onto the multipliers' space (P1
+    unless ``multiplier_degree`` says otherwise). With P2 displacements the bulk's traction
+    follows the multipliers' oscillation in part: :func:`nodal_pressure` is the smoother
+    reading there (see the user guide, *Results*)."""
     from dolfinx.fem import petsc as fem_petsc
     from petsc4py import PETSc
 
@@ -650,3 +654,31 @@ def recovered_pressure(problem, pair: int = 0) -> dolfinx.fem.Function:
     for obj in (solver, mass, rhs):
         obj.destroy()
     return recovered
+
+
+def nodal_pressure(problem, pair: int = 0) -> dolfinx.fem.Function:
+    """The nominal contact pressure node by node as a nodal force over a nodal area,
+    ``int lambda_N phi_i dS / int phi_i dS`` (collective): the reading a lumped (dual)
+    multiplier basis would give of the same contact forces, its integral the contact's
+    normal force.
+
+    Smoother than the multipliers on non-matching meshes, and than
+    :func:`recovered_pressure` with P2 displacements (see the user guide, *Results*).
+    P2 multipliers on triangles (3D, ``multiplier_degree=2``) have no nodal areas (their
+    vertex shape functions integrate to zero): refused."""
+    c = problem.contacts[pair]
+    if c.slave.multiplier_degree == 2 and problem.gdim == 3:
+        raise ContactInputError(
+            "nodal_pressure: P2 multipliers on triangles have no nodal areas (the vertex "
+            "shape functions integrate to zero); use recovered_pressure"
+        )
+    space = c.slave.P1
+    q = ufl.TestFunction(space)
+    force = c.slave.assemble_nodal(
+        jit.form(c.lambda_N * q * c.ds, entity_maps=[c.slave.entity_map]), space
+    )
+    owned = space.dofmap.index_map.size_local
+    pressure = dolfinx.fem.Function(space, name="nodal_pressure")
+    pressure.x.array[:owned] = force[:owned] / c.slave.nodal_mass
+    pressure.x.scatter_forward()
+    return pressure
