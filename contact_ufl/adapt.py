@@ -25,6 +25,7 @@ from contact_ufl.refinement import (
     Boundary,
     check_boundaries,
     check_refinable,
+    interpolate_by_body,
     interpolate_onto,
     refine_scene,
     slave_finer_than_master,
@@ -137,7 +138,12 @@ def transfer_state(source: ContactProblem, target: ContactProblem, padding: floa
     within which a point outside the source's cells (a node put onto a curved boundary) is
     still found."""
     size = source.scales()[0]
+    for old, new in zip(source.bulks, target.bulks, strict=True):
+        interpolate_by_body(new.u, new.domain, old.u, old.domain, padding * size)
+    displacements = {id(b.u) for b in source.bulks}
     for old, new in zip(source.unknowns, target.unknowns, strict=True):
+        if id(old) in displacements:
+            continue
         if old.function_space.mesh.topology.dim == 0 or old.x.index_map.size_global <= 1:
             new.x.array[:] = old.x.array  # a control's global unknown
             continue
@@ -156,11 +162,10 @@ def _check_estimable(scene: Scene) -> None:
     """Refuse, before any work, the bodies the error estimate does not cover yet."""
     for k, d in enumerate(scene.parts):
         for body in d.bodies:
-            if body.membrane or isinstance(body.material, J2Plasticity):
-                kind = "a membrane" if body.membrane else "an elastoplastic body"
+            if body.membrane:
                 raise NotImplementedError(
-                    f"{d.name or f'mesh {k}'} has {kind} (tag {body.tag}): the error estimate, "
-                    "and so adaptive refinement, covers hyperelastic solids only"
+                    f"{d.name or f'mesh {k}'} has a membrane (tag {body.tag}): the error "
+                    "estimate, and so adaptive refinement, covers solids only"
                 )
 
 
@@ -254,7 +259,8 @@ def refine_to_tolerance(
         marked = doerfler_marking(estimate.indicators, theta, comm)
         scene = refine_scene(problem.scene, marked, boundaries)
         moved = [b.u for b in problem.bulks]
-        scene = slave_finer_than_master(scene, moved, boundaries)
+        sources = [b.domain for b in problem.bulks]
+        scene = slave_finer_than_master(scene, moved, boundaries, sources=sources)
         finer = ContactProblem(scene, **options)
         if not _check_budget(finer, max_unknowns):
             finer.close()

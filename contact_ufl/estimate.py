@@ -26,13 +26,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import basix
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
 
 from contact_ufl import jit
-from contact_ufl.loads import BodyForce, DeadForce, DeadTraction, FollowerForce, FollowerPressure
+from contact_ufl.loads import (
+    BodyForce,
+    DeadForce,
+    DeadTraction,
+    FollowerForce,
+    FollowerPressure,
+    deformation_gradient,
+)
 
 #: the terms of the estimate, in the order reported
 TERMS = ("bulk", "jump", "boundary", "traction", "penetration", "complementarity", "cone")
@@ -77,8 +85,10 @@ class ErrorEstimate:
 
 
 def stress_field(bulk) -> dolfinx.fem.Function:
-    """The first Piola stress of each body interpolated, body by body, into a discontinuous
-    tensor space of the displacement's degree minus one (exact for P1 on affine cells)."""
+    """The first Piola stress of each body in a discontinuous tensor space of the
+    displacement's degree minus one, body by body: interpolated (exact for P1 on affine
+    cells), or, for an elastoplastic body, whose stress is known at the points of its
+    history, projected cell by cell (L2) from those points."""
     mesh = bulk.V.mesh
     gdim = mesh.geometry.dim
     degree = max(bulk.V.ufl_element().degree - 1, 0)
@@ -87,9 +97,44 @@ def stress_field(bulk) -> dolfinx.fem.Function:
     points = space.element.interpolation_points
     for body in bulk.bodies:
         cells = bulk.domain.cell_tags.find(body.tag)
-        P.interpolate(dolfinx.fem.Expression(bulk.first_piola(body), points), cells0=cells)
+        history = bulk.histories.get(body.tag)
+        if history is None:
+            P.interpolate(dolfinx.fem.Expression(bulk.first_piola(body), points), cells0=cells)
+        else:
+            _project_from_points(P, history.first_piola(), history.quadrature_degree, cells)
     P.x.scatter_forward()
     return P
+
+
+def _project_from_points(
+    target: dolfinx.fem.Function, expr: ufl.core.expr.Expr, degree: int, cells: np.ndarray
+) -> None:
+    """``target`` (discontinuous Lagrange) on ``cells``: the cell-wise L2 projection of
+    ``expr`` known at the points of the quadrature rule of ``degree`` (that rule's
+    weights times ``|det J|``)."""
+    space = target.function_space
+    mesh = space.mesh
+    cells = np.asarray(cells, dtype=np.int32)
+    if len(cells) == 0:
+        return
+    points, weights = basix.make_quadrature(mesh.basix_cell(), degree)
+    scalar = basix.create_element(
+        basix.ElementFamily.P,
+        mesh.basix_cell(),
+        space.ufl_element().degree,
+        basix.LagrangeVariant.gll_warped,
+        discontinuous=True,
+    )
+    phi = scalar.tabulate(0, points)[0, :, :, 0]  # (points, dofs)
+    values = jit.expression(expr, points).eval(mesh, cells).reshape(len(cells), len(weights), -1)
+    detJ = jit.expression(abs(ufl.JacobianDeterminant(mesh)), points).eval(mesh, cells)
+    w = weights[None, :] * detJ.reshape(len(cells), len(weights))  # (cells, points)
+    mass = np.einsum("cq,qa,qb->cab", w, phi, phi)
+    rhs = np.einsum("cq,qa,cqk->cak", w, phi, values)
+    coefficients = np.linalg.solve(mass, rhs)  # (cells, dofs, components)
+    bs = space.dofmap.index_map_bs
+    dofs = space.dofmap.list[cells]
+    target.x.array.reshape(-1, bs)[dofs] = coefficients
 
 
 def _modulus(bulk) -> dolfinx.fem.Function:
@@ -122,13 +167,11 @@ def _load_density(load, bulk, constant) -> ufl.core.expr.Expr:
 
 
 def check_estimable(bulks) -> None:
-    """Refuse the meshes whose residuals the estimate does not cover yet: membranes and
-    elastoplastic bodies (``NotImplementedError``)."""
+    """Refuse the meshes whose residuals the estimate does not cover yet: membranes
+    (``NotImplementedError``)."""
     for k, bulk in enumerate(bulks):
-        if bulk.membrane or bulk.histories:
-            raise NotImplementedError(
-                f"mesh {k}: error estimates are written for hyperelastic solids only"
-            )
+        if bulk.membrane:
+            raise NotImplementedError(f"mesh {k}: error estimates are written for solids only")
 
 
 def error_estimate(problem) -> ErrorEstimate:
@@ -137,7 +180,7 @@ def error_estimate(problem) -> ErrorEstimate:
     Raises
     ------
     NotImplementedError
-        A membrane or an elastoplastic body (their residuals are not written yet).
+        A membrane (its residuals are not written yet).
     """
     comm = problem.comm
     check_estimable(problem.bulks)
@@ -167,8 +210,29 @@ def error_estimate(problem) -> ErrorEstimate:
         eta.x.scatter_forward()
         eta.name = "error_indicator"
         indicators.append(eta)
-    energy = float(np.sqrt(max(2.0 * problem.stored_energy(), 0.0)))
+    energy = float(np.sqrt(max(2.0 * _stored_energy(problem), 0.0)))
     return ErrorEstimate(indicators, parts, energy)
+
+
+def _stored_energy(problem) -> float:
+    """The stored energy of all bodies: an elastoplastic body's elastic part (its history
+    committed)."""
+    if not any(bulk.histories for bulk in problem.bulks):
+        return problem.stored_energy()
+    total = 0.0
+    for bulk in problem.bulks:
+        F = deformation_gradient(bulk.u)
+        density = sum(
+            (
+                bulk.histories[b.tag].elastic_energy_density()
+                if b.tag in bulk.histories
+                else b.material.strain_energy(F)
+            )
+            * bulk.dx(b.tag)
+            for b in bulk.bodies
+        )
+        total += problem.comm.allreduce(dolfinx.fem.assemble_scalar(jit.form(density)), MPI.SUM)
+    return total
 
 
 #: the marker of the exterior facets in no group (free)

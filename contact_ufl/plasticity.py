@@ -190,6 +190,8 @@ class PlasticHistory:
 
         self.material = material
         self.u = u
+        #: the degree of the quadrature rule of the history's points
+        self.quadrature_degree = quadrature_degree
         self.Cp_inv = dolfinx.fem.Function(space((3, 3)), name="Cp_inv")
         self.Cp_inv.x.array.reshape(-1, 9)[:] = np.eye(3).ravel()
         self.alpha = dolfinx.fem.Function(space(()), name="equivalent_plastic_strain")
@@ -207,6 +209,14 @@ class PlasticHistory:
         P = self.tau * ufl.inv(self.F3).T
         gdim = self.u.function_space.mesh.geometry.dim
         return ufl.as_matrix([[P[i, j] for j in range(gdim)] for i in range(gdim)])
+
+    def elastic_energy_density(self) -> ufl.core.expr.Expr:
+        """The stored (elastic) energy density ``U(J) + mu/2 (tr bbar_e - 3)`` at the current
+        displacement and the committed history (the converged state's once committed)."""
+        J = ufl.det(self.F3)
+        b_e = J ** (-2.0 / 3.0) * self.F3 * self.Cp_inv * self.F3.T
+        m = self.material
+        return m.kappa / 2.0 * ((J**2 - 1.0) / 2.0 - ufl.ln(J)) + m.mu / 2.0 * (ufl.tr(b_e) - 3.0)
 
     @functools.cached_property
     def _cell_mean_forms(self) -> tuple[dolfinx.fem.Form, dolfinx.fem.Form]:

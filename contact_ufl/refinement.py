@@ -87,6 +87,7 @@ def slave_finer_than_master(
     displacements: list[dolfinx.fem.Function] | None = None,
     boundaries: Mapping[int | str, Boundary] | None = None,
     max_passes: int = 4,
+    sources: list[Domain] | None = None,
 ) -> Scene:
     """``scene`` with its slave surfaces refined until no slave facet is larger than a
     master facet it faces (collective).
@@ -97,6 +98,8 @@ def slave_finer_than_master(
     a master facet's midpoint within the slave facet's size of the slave facet's midpoint,
     in the configuration displaced by ``displacements`` (one field per mesh of the scene,
     on any mesh: moved by interpolation; ``None``: the reference configuration).
+    ``sources``: the domains of the displacements' meshes, whose cell tags let each body
+    take its displacement from its own cells (see :func:`interpolate_by_body`).
     """
     surfaces: dict[int, set[int]] = {}  # the contact groups of each mesh
     for pair in scene.contacts:
@@ -106,7 +109,12 @@ def slave_finer_than_master(
     for _ in range(max_passes):
         parts = scene.parts
         current = [
-            _nodes_moved(d, displacements[k] if displacements else None, surfaces.get(k, set()))
+            _nodes_moved(
+                d,
+                displacements[k] if displacements else None,
+                surfaces.get(k, set()),
+                sources[k] if sources else None,
+            )
             for k, d in enumerate(parts)
         ]
         marked = [np.zeros(0, dtype=np.int32) for _ in parts]
@@ -129,9 +137,15 @@ def _domain_index(index: int | None) -> int:
     return 0 if index is None else int(index)
 
 
-def _nodes_moved(domain: Domain, u: dolfinx.fem.Function | None, groups: set[int]) -> np.ndarray:
+def _nodes_moved(
+    domain: Domain,
+    u: dolfinx.fem.Function | None,
+    groups: set[int],
+    source: Domain | None = None,
+) -> np.ndarray:
     """The geometry nodes of ``domain``'s mesh, those of the facet ``groups`` displaced by
-    ``u`` (interpolated on their cells)."""
+    ``u`` (interpolated on their cells; body by body from ``source``, the domain of ``u``'s
+    mesh, if given)."""
     mesh = domain.mesh
     x = mesh.geometry.x.copy()
     if u is None or not groups:
@@ -146,6 +160,8 @@ def _nodes_moved(domain: Domain, u: dolfinx.fem.Function | None, groups: set[int
     moved = dolfinx.fem.Function(space)
     if u.function_space.mesh is mesh:
         moved.interpolate(u, cells0=cells)
+    elif source is not None:
+        interpolate_by_body(moved, domain, u, source, 1e-6 * _size(mesh), cells)
     else:
         interpolate_onto(moved, u, 1e-6 * _size(mesh), cells)
     # the space's dofs and the geometry's nodes follow the same element: cell by cell
@@ -295,6 +311,38 @@ def interpolate_onto(
     )
     new.interpolate_nonmatching(old, cells, data)
     new.x.scatter_forward()
+
+
+def interpolate_by_body(
+    new: dolfinx.fem.Function,
+    new_domain: Domain,
+    old: dolfinx.fem.Function,
+    old_domain: Domain,
+    padding: float,
+    cells: np.ndarray | None = None,
+) -> None:
+    """:func:`interpolate_onto` body by body: the dofs of each body's cells (of ``cells``;
+    default all) from ``old`` on that body's cells of ``old_domain`` only (collective).
+
+    Where two bodies of one mesh touch, a point of one lies in the other's cells too, and a
+    search over the whole mesh may take the other body's value: after the bodies part, a
+    node of one carries the other's displacement."""
+    mesh = old.function_space.mesh
+    tdim = mesh.topology.dim
+    for body in new_domain.bodies:
+        targets = new_domain.cell_tags.find(body.tag)
+        if cells is not None:
+            targets = np.intersect1d(targets, cells)
+        sources = old_domain.cell_tags.find(body.tag)
+        sub, entity_map, _, _ = dolfinx.mesh.create_submesh(mesh, tdim, sources)
+        cell_map = sub.topology.index_map(tdim)
+        local = np.arange(cell_map.size_local + cell_map.num_ghosts, dtype=np.int32)
+        parents = entity_map.sub_topology_to_topology(local, inverse=False)
+        restricted = dolfinx.fem.Function(
+            dolfinx.fem.functionspace(sub, old.function_space.ufl_element())
+        )
+        restricted.interpolate(old, cells0=parents, cells1=local)
+        interpolate_onto(new, restricted, padding, targets.astype(np.int32))
 
 
 def check_boundaries(scene: Scene, boundaries: Mapping[int | str, Boundary]) -> None:

@@ -94,6 +94,31 @@ def test_tags_are_carried_over_on_any_number_of_ranks():
     assert MPI.COMM_WORLD.allreduce(float(np.min(inside, initial=1.0)), MPI.MIN) < 1.0 - 1e-5
 
 
+def test_each_body_takes_its_own_displacement_onto_the_refined_mesh():
+    """The disc and the block of the Hertz mesh touch at the origin. A field that is (0, 1)
+    on the disc and (0, -1) on the block, moved onto a refined mesh body by body, is
+    exactly that again on every node of each body (moved over the whole mesh, the disc's
+    nodes at the block may take the block's value)."""
+    scene = _hertz()
+    domain = scene.parts[0]
+    V = dolfinx.fem.functionspace(domain.mesh, ("Lagrange", 1, (2,)))
+    old = dolfinx.fem.Function(V)
+    values = {domain.tags["cylinder"]: 1.0, domain.tags["block"]: -1.0}
+    for tag, value in values.items():
+        old.interpolate(
+            lambda x, v=value: np.vstack([np.zeros(x.shape[1]), np.full(x.shape[1], v)]),
+            cells0=domain.cell_tags.find(tag),
+        )
+    fine = refinement.refine_scene(scene, _every_other_cell(scene)).parts[0]
+    new = dolfinx.fem.Function(dolfinx.fem.functionspace(fine.mesh, ("Lagrange", 1, (2,))))
+    refinement.interpolate_by_body(new, fine, old, domain, padding=1e-8)
+    for tag, value in values.items():
+        cells = fine.cell_tags.find(tag)
+        dofs = np.unique(new.function_space.dofmap.list[cells])
+        taken = new.x.array.reshape(-1, 2)[dofs]
+        assert np.abs(taken - [0.0, value]).max() < 1e-12, tag
+
+
 def test_doerfler_marks_the_fewest_cells_that_carry_theta():
     """The marked cells carry at least theta of the sum of the indicators, and without the
     smallest of them less than theta (the definition), over all ranks."""
