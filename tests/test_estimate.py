@@ -22,10 +22,17 @@ from contact_ufl.verification import scenes
 TIGHT = {"snes_rtol": 1e-13, "snes_atol": 1e-15}
 
 
-def _patch(quadrature_degree, subdivisions, comm=MPI.COMM_WORLD):
+#: the elastoplastic material of the patch test's yielding variant
+YIELDING = cu.J2Plasticity(1.0, 0.3, yield_stress=0.005, hardening=0.1)
+
+
+def _patch(quadrature_degree, subdivisions, comm=MPI.COMM_WORLD, material=None, steps=1):
+    """The patch test solved (its bodies of ``material`` if given)."""
     scene = scenes.patch(quadrature_degree=quadrature_degree, subdivisions=subdivisions, comm=comm)
+    if material is not None:
+        scene.bodies = [dataclasses.replace(b, material=material) for b in scene.bodies]
     problem = cu.ContactProblem(scene, verbose=False, petsc_options=TIGHT)
-    problem.solve(num_steps=1)
+    problem.solve(num_steps=steps)
     return problem
 
 
@@ -151,12 +158,15 @@ def test_the_indicators_point_at_the_contact_zone(hertz):
 
 
 @across_ranks
-def test_the_estimate_is_the_same_on_any_number_of_ranks(verification):
+@pytest.mark.parametrize("material", [None, YIELDING], ids=["hyperelastic", "elastoplastic"])
+def test_the_estimate_is_the_same_on_any_number_of_ranks(verification, material):
     """The estimate and its parts on two ranks equal those of one rank to round-off."""
-    world = _patch(None, 1, MPI.COMM_WORLD).error_estimate()
-    alone = _patch(None, 1, MPI.COMM_SELF).error_estimate()
+    steps = 1 if material is None else 2
+    world = _patch(None, 1, MPI.COMM_WORLD, material, steps).error_estimate()
+    alone = _patch(None, 1, MPI.COMM_SELF, material, steps).error_estimate()
     difference = abs(world.estimate / alone.estimate - 1.0)
-    case = "patch test 2D, default contact rule"
+    kind = "" if material is None else ", J2 plasticity (yielding)"
+    case = f"patch test 2D{kind}, default contact rule"
     source = "the same estimate on one rank"
     verification(
         case,
@@ -194,11 +204,7 @@ def test_the_estimate_of_an_elastoplastic_patch_test_vanishes_with_its_error(ver
     1.5e-2, 1.6e-3, 3.8e-4 of the elastic energy norm)."""
     relative, flow = [], []
     for degree, subdivisions in ((None, 1), (3, 8), (3, 32)):
-        scene = scenes.patch(quadrature_degree=degree, subdivisions=subdivisions)
-        material = cu.J2Plasticity(1.0, 0.3, yield_stress=0.005, hardening=0.1)
-        scene.bodies = [dataclasses.replace(b, material=material) for b in scene.bodies]
-        problem = cu.ContactProblem(scene, verbose=False, petsc_options=TIGHT)
-        problem.solve(num_steps=2)
+        problem = _patch(degree, subdivisions, material=YIELDING, steps=2)
         estimate = problem.error_estimate()
         relative.append(estimate.relative)
         assert estimate.parts["bulk"] == 0.0  # Div P of a cellwise constant stress
