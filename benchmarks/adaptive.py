@@ -105,10 +105,12 @@ def hertz_2d_setup(h: float, depth: float):
     return scene, lambda problem: hertz_errors(problem, hertz), {"cylinder_contact": onto_circle}
 
 
-#: the hand-graded meshes (h_contact) of the Hertz benchmark's graded tables, by degree
+#: the hand-graded meshes (h_contact) by case and degree: Hertz's are those of the Hertz
+#: benchmark's graded tables
 GRADED = {
-    1: (0.01, 0.0075, 0.005, 0.0035, 0.0025, 0.00175),
-    2: (0.03, 0.025, 0.02, 0.015, 0.01, 0.0075),
+    ("hertz", 1): (0.01, 0.0075, 0.005, 0.0035, 0.0025, 0.00175),
+    ("hertz", 2): (0.03, 0.025, 0.02, 0.015, 0.01, 0.0075),
+    ("cattaneo", 1): (0.01, 0.005, 0.0025, 0.00125),
 }
 
 
