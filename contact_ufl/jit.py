@@ -21,13 +21,15 @@ import dolfinx
 import numpy as np
 import ufl
 from dolfinx.fem import IntegralType
-from dolfinx.fem.forms import get_integration_domains
+from dolfinx.fem.forms import CompiledForm, get_integration_domains
 
 #: The DOLFINx JIT options of every form and expression the package compiles.
 JIT_OPTIONS: dict = {"cffi_extra_compile_args": ["-O1", "-g0"], "timeout": 300}
 
-#: the forms compiled in this process, by signature and options
-_COMPILED: dict[tuple[str, str], dolfinx.fem.CompiledForm] = {}
+#: the code of the forms compiled in this process (the compiled form, its module, its C
+#: code and scalar type; not the UFL form, which would keep its mesh), by signature and
+#: options
+_COMPILED: dict[tuple[str, str], tuple] = {}
 
 _INTEGRAL_TYPES = {t.name: t for t in IntegralType}
 
@@ -41,11 +43,11 @@ def form(forms, entity_maps=None, **kwargs):
     if mesh is None:
         return dolfinx.fem.form(forms, jit_options=JIT_OPTIONS, entity_maps=entity_maps, **kwargs)
     key = (forms.signature(), repr(sorted(JIT_OPTIONS.items())))
-    compiled = _COMPILED.get(key)
-    if compiled is None:
+    code = _COMPILED.get(key)
+    if code is None:
         compiled = dolfinx.fem.compile_form(mesh.comm, forms, jit_options=JIT_OPTIONS)
-        _COMPILED[key] = compiled
-    return _create(compiled, forms, mesh, entity_maps)
+        code = _COMPILED[key] = (compiled.ufcx_form, compiled.module, compiled.code, compiled.dtype)
+    return _create(CompiledForm(forms, *code), mesh, entity_maps)
 
 
 def _integration_mesh(a) -> dolfinx.mesh.Mesh | None:
@@ -65,12 +67,12 @@ def _integration_mesh(a) -> dolfinx.mesh.Mesh | None:
     return None
 
 
-def _create(compiled, a: ufl.Form, mesh, entity_maps) -> dolfinx.fem.Form:
-    """The form ``a`` from the code compiled for a form of the same signature: the
-    coefficients and constants correspond in order (the signature numbers them so)."""
-    ufcx = compiled.ufcx_form
-    coefficients = dict(zip(compiled.ufl_form.coefficients(), a.coefficients(), strict=True))
-    constants = dict(zip(compiled.ufl_form.constants(), a.constants(), strict=True))
+def _create(compiled: CompiledForm, mesh, entity_maps) -> dolfinx.fem.Form:
+    """The form of ``compiled`` (its UFL form with the code compiled for a form of the same
+    signature, whose coefficients and constants the signature numbers in the same order)."""
+    a, ufcx = compiled.ufl_form, compiled.ufcx_form
+    coefficients = {c: c for c in a.coefficients()}
+    constants = {c: c for c in a.constants()}
     (data,) = a.subdomain_data().values()
     offsets = [ufcx.form_integral_offsets[i] for i in range(len(IntegralType) + 1)]
     subdomains = {}
