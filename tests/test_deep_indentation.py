@@ -6,7 +6,7 @@ Newton 2-cycles between the normals of neighbouring facets with the active set u
 (measured at depth 0.35 with a finer far field, h_far = 0.04: the residual alternates
 7.9e-5 / 9.4e-5 while no point changes status).
 The smoothed normal (continuous from facet to facet) removes the jumps: the run reaches the
-end without a cut-back, until the whole arc is in contact. It is the default in 2D: a new
+end without a cut-back, the contact zone then 1.5 R wide. It is the default in 2D: a new
 user's ``scenes.hertz_2d(depth=0.5)`` runs to the end.
 """
 
@@ -27,27 +27,30 @@ def deep_hertz(master_normal: str | None) -> cu.ContactProblem:
     return cu.ContactProblem(hertz.scene, verbose=False)
 
 
-#: the contact spreads over the whole arc: the bound on the half-width of the pressed zone
-#: over the disc's radius (1), a regression bound on this code's output (1.01 measured)
-WHOLE_ARC = 0.95
-SNAPSHOT = "this code's output (half-width 1.01 R measured: the disc bulges)"
+#: the contact spreads over most of the arc: the bound on the half-width of the zone in
+#: contact over the disc's radius (1), a regression bound on this code's output (0.737
+#: measured; the undeformed overlap's half-chord at that depth is 0.866)
+WIDE = 0.7
+SNAPSHOT = "this code's output (half-width 0.737 R measured)"
 
 
 def record_half_width(verification, case: str, problem) -> float:
-    """Record and return the half-width of the pressed zone (lambda_N > 0) over R = 1."""
+    """Record and return the half-width of the zone in contact over R = 1 (the contact flag:
+    the open points beyond it carry multipliers of either sign, up to 1e-3 of the peak, to the
+    arc's ends)."""
     samples = contact_samples(problem)
-    pressed = samples.x[samples.lambda_N > 0, 0]
+    pressed = samples.x[samples.in_contact, 0]
     half_width = float(np.ptp(pressed) / 2)
-    quantity = "half-width of the pressed zone over R"
-    verification(case, quantity, half_width, 1.01, f"> {WHOLE_ARC}", SNAPSHOT, kind="regression")
+    quantity = "half-width of the zone in contact over R"
+    verification(case, quantity, half_width, 0.737, f"> {WIDE}", SNAPSHOT, kind="regression")
     return half_width
 
 
 def test_default_master_normal_reaches_half_the_radius(verification):
     """10 steps to depth 0.5 R with the library default (``master_normal=None``, the
     smoothed normal in 2D): every step converged by SNES's own test, no cut-back, at most
-    10 Newton iterations a step (measured 4 to 8), and the contact spreads over the whole
-    arc (half-width 1.01 R: the disc bulges)."""
+    10 Newton iterations a step (measured 4 to 8), and the contact spreads over most of the
+    arc (half-width 0.737 R)."""
     problem = deep_hertz(None)
     assert problem.contacts[0].pair.master_normal == "smoothed"
     history = problem.solve(num_steps=10)
@@ -55,7 +58,7 @@ def test_default_master_normal_reaches_half_the_radius(verification):
     assert all(r.reason.startswith("CONVERGED") for r in history.steps)
     assert max(r.newton_iterations for r in history.steps) <= 10
     case = "Hertz 2D pressed to half the radius, h = 0.02, smoothed master normal, 10 steps"
-    assert record_half_width(verification, case, problem) > WHOLE_ARC
+    assert record_half_width(verification, case, problem) > WIDE
 
 
 @pytest.mark.serial  # a property of the facet normal, not of the partition
@@ -78,7 +81,7 @@ def test_new_user_hertz_half_the_radius_runs_to_the_end(verification):
     """The scene as a new user makes it, with every library default (h_contact = 0.005, 10
     steps, the default master normal): pressed down by half the radius, it runs to the end
     (it stopped at depth 0.24 after 8 cut-backs with the facet normal, the old default);
-    measured 11 steps (one cut-back), 5 to 24 Newton iterations a step, half-width 1.01 R.
+    measured 11 steps (one cut-back), 5 to 24 Newton iterations a step.
     Slow: about a minute."""
     hertz = scenes.hertz_2d(depth=0.5)
     assert hertz.scene.contacts[0].master_normal is None
@@ -88,7 +91,7 @@ def test_new_user_hertz_half_the_radius_runs_to_the_end(verification):
     assert problem.t == pytest.approx(1.0)
     assert all(r.reason.startswith("CONVERGED") for r in history.steps)
     case = "Hertz 2D pressed to half the radius, h = 0.005, every library default"
-    assert record_half_width(verification, case, problem) > WHOLE_ARC
+    assert record_half_width(verification, case, problem) > WIDE
 
 
 @pytest.mark.slow

