@@ -19,6 +19,10 @@ records refine every cell at each level instead (``theta = 1``).
 then moved sideways in 4; every mesh replays them): the stick zone's half-width and the
 shear traction against Johnson 7.1.
 
+``--case plastic``: the plastic indentation scene (a stiff half disc pressed by 0.02 into
+a perfectly plastic block in 8 steps and lifted off in 8; every mesh replays them): the
+imprint's depth, which has no closed form; the estimate and the Newton iterations.
+
 ``--dim 3``: the quarter ball on a block of the 3D Hertz benchmark (linear elastic, one
 step, depth 0.01, the default eps) from ``h_contact = 0.05``; the errors of
 :func:`contact_ufl.verification.runs.hertz_3d_errors` (p0 and a nominal).
@@ -36,7 +40,7 @@ from mpi4py import MPI
 
 from contact_ufl import ContactProblem, adapt
 from contact_ufl.materials import LinearElastic
-from contact_ufl.results import contact_samples, stick_zone_half_width
+from contact_ufl.results import contact_samples, lowest_displacement, stick_zone_half_width
 from contact_ufl.verification import scenes
 from contact_ufl.verification.analytic import CattaneoMindlin2D, Hertz2D, fit_elliptic_profile
 from contact_ufl.verification.runs import hertz_3d_errors, shear_error
@@ -99,6 +103,17 @@ def cattaneo_setup(h: float, depth: float, refine_radius: float = 0.3):
     return scene, errors, {"cylinder_contact": onto_circle}
 
 
+def plastic_setup(h: float, depth: float):
+    """The plastic indentation scene (depth 0.02, whatever ``depth``): the imprint's depth,
+    the curved boundary."""
+    scene = scenes.plastic_indentation(h_contact=h)
+
+    def errors(problem) -> dict:
+        return {"imprint": -lowest_displacement(problem, "block_contact")}
+
+    return scene, errors, {"cylinder_contact": onto_circle}
+
+
 def hertz_2d_setup(h: float, depth: float):
     """The 2D scene, its errors and curved boundary."""
     hertz, scene = hertz_scene(h, depth)
@@ -142,8 +157,11 @@ def hertz_errors(problem, hertz) -> dict:
 
 def solve_load_path(problem, case: str) -> None:
     """The load path of ``case``: Hertz in one step; Cattaneo-Mindlin pressed in 4 steps,
-    then moved sideways in 4."""
-    if case == "cattaneo":
+    then moved sideways in 4; the plastic indentation pressed in 8 and lifted off in 8."""
+    if case == "plastic":
+        problem.solve(num_steps=8, t_end=1.0)
+        problem.solve(num_steps=8, t_end=2.0)
+    elif case == "cattaneo":
         problem.solve(num_steps=4, t_end=1.0)
         problem.solve(num_steps=4, t_end=2.0)
     else:
@@ -194,6 +212,18 @@ def run_graded(case: str, depth: float, degree: int) -> list[dict]:
     return records
 
 
+def _errors_text(record: dict, case: str) -> str:
+    """A record's errors as the benchmark prints them."""
+    if case == "cattaneo":
+        return f"stick zone {record['stick_zone_error']:+.3%} shear {record['shear_error']:.3f} "
+    if case == "plastic":
+        return f"imprint {record['imprint']:.5f} "
+    return (
+        f"p0 {record['p0_error_nominal']:+.3%} a {record['a_error_nominal']:+.3%} "
+        f"L2 {record['pressure_l2_error']:.3f} "
+    )
+
+
 def run(
     kind: str,
     start_h: float,
@@ -205,10 +235,13 @@ def run(
     case: str = "hertz",
 ) -> list[dict]:
     """The levels of one loop: ``kind`` ``"adaptive"`` (Doerfler, ``theta``) or
-    ``"uniform"`` (every cell refined), of ``case`` ``"hertz"`` or ``"cattaneo"``."""
-    setup = {(2, "hertz"): hertz_2d_setup, (3, "hertz"): hertz_3d_setup}.get(
-        (dim, case), cattaneo_setup
-    )
+    ``"uniform"`` (every cell refined), of ``case`` ``"hertz"``, ``"cattaneo"`` or
+    ``"plastic"``."""
+    setup = {
+        (2, "hertz"): hertz_2d_setup,
+        (3, "hertz"): hertz_3d_setup,
+        (2, "plastic"): plastic_setup,
+    }.get((dim, case), cattaneo_setup)
     scene, errors, boundaries = setup(start_h, depth)
 
     def solve(problem) -> None:
@@ -244,12 +277,7 @@ def run(
         if problem.comm.rank == 0:
             print(
                 f"{kind:8s} {r['dofs']:8d} eta {r['relative_estimate']:.3e} "
-                + (
-                    f"stick zone {r['stick_zone_error']:+.3%} shear {r['shear_error']:.3f} "
-                    if case == "cattaneo"
-                    else f"p0 {r['p0_error_nominal']:+.3%} a {r['a_error_nominal']:+.3%} "
-                    f"L2 {r['pressure_l2_error']:.3f} "
-                )
+                + _errors_text(r, case)
                 + f"newton {r['newton_iterations']} (max {r['newton_max']} a step) "
                 f"wall {r['wall_s']:.2f} s cumulative {r['cumulative_s']:.2f} s",
                 flush=True,
@@ -275,7 +303,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="to 15,000 unknowns")
     parser.add_argument("--degree", type=int, choices=(1, 2), default=1)
     parser.add_argument("--dim", type=int, choices=(2, 3), default=2)
-    parser.add_argument("--case", choices=("hertz", "cattaneo"), default="hertz")
+    parser.add_argument("--case", choices=("hertz", "cattaneo", "plastic"), default="hertz")
     parser.add_argument("--start", type=float, default=None, help="h_contact (0.04, 3D 0.05)")
     parser.add_argument("--depth", type=float, default=None, help="0.005, 3D 0.01")
     parser.add_argument("--theta", type=float, default=0.5)

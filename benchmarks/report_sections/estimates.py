@@ -137,9 +137,10 @@ SECTIONS = (
         "size h within 0.1 R; P2 on the curved mesh), solved one after another from the "
         "coarsest, as a user who does not know which mesh is fine enough would; their "
         "*loop s* is that sweep's time so far (meshing, set-up, solve). The same "
-        "loop on the 3D Hertz scene and on Cattaneo-Mindlin (the stick zone's half-width "
-        "and the shear traction against Johnson 7.1 at the last step) follows.",
-        "python benchmarks/adaptive.py [--degree 2] [--dim 3] [--case cattaneo] "
+        "loop on the 3D Hertz scene, on Cattaneo-Mindlin (the stick zone's half-width "
+        "and the shear traction against Johnson 7.1 at the last step) and on the plastic "
+        "indentation (the imprint's depth: no closed form) follows.",
+        "python benchmarks/adaptive.py [--degree 2] [--dim 3] [--case cattaneo|plastic] "
         "[--max-unknowns N] --json FILE",
         tuple(
             Table(
@@ -181,6 +182,18 @@ SECTIONS = (
                     Column("Q / mu P", "Q_over_muP", fixed(3)),
                     Column("stick zone", "stick_zone_error", percent),
                     Column("shear error", "shear_error", fixed(3)),
+                    Column("Newton (max a step)", _newton_total_max),
+                    *TIMES,
+                ),
+            ),
+            Table(
+                "Plastic indentation (a stiff disc pressed by 0.02 into a perfectly plastic "
+                "block in 8 steps and lifted off in 8; every mesh replays them), from "
+                "h_contact = 0.04",
+                ("adaptive_plastic.json",),
+                (
+                    *LEVEL,
+                    Column("imprint", "imprint", fixed(5)),
                     Column("Newton (max a step)", _newton_total_max),
                     *TIMES,
                 ),
