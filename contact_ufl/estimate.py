@@ -118,13 +118,7 @@ def _project_from_points(
     if len(cells) == 0:
         return
     points, weights = basix.make_quadrature(mesh.basix_cell(), degree)
-    scalar = basix.create_element(
-        basix.ElementFamily.P,
-        mesh.basix_cell(),
-        space.ufl_element().degree,
-        basix.LagrangeVariant.gll_warped,
-        discontinuous=True,
-    )
+    scalar = space.ufl_element().sub_elements[0].basix_element  # the space's own
     phi = scalar.tabulate(0, points)[0, :, :, 0]  # (points, dofs)
     values = jit.expression(expr, points).eval(mesh, cells).reshape(len(cells), len(weights), -1)
     detJ = jit.expression(abs(ufl.JacobianDeterminant(mesh)), points).eval(mesh, cells)

@@ -9,7 +9,8 @@ the largest contact kernels.
 A form compiled once in a process is kept, by its UFL signature, and the next form of the
 same signature (the same problem on another mesh: a new scene, a level of adaptive
 refinement) is made from it with :func:`dolfinx.fem.create_form` instead of looking it up
-in the disk cache of FFCx again.
+in the disk cache of FFCx again. Each rank compiles (or finds in the disk cache) on its
+own, so that ranks whose memos differ do not wait for each other.
 
 Change :data:`JIT_OPTIONS` before a problem is built to compile otherwise; it takes
 precedence over DOLFINx's ``dolfinx_jit_options.json`` for the options it names.
@@ -22,6 +23,7 @@ import numpy as np
 import ufl
 from dolfinx.fem import IntegralType
 from dolfinx.fem.forms import CompiledForm, get_integration_domains
+from mpi4py import MPI
 
 #: The DOLFINx JIT options of every form and expression the package compiles.
 JIT_OPTIONS: dict = {"cffi_extra_compile_args": ["-O1", "-g0"], "timeout": 300}
@@ -44,8 +46,8 @@ def form(forms, entity_maps=None, **kwargs):
         return dolfinx.fem.form(forms, jit_options=JIT_OPTIONS, entity_maps=entity_maps, **kwargs)
     key = (forms.signature(), repr(sorted(JIT_OPTIONS.items())))
     code = _COMPILED.get(key)
-    if code is None:
-        compiled = dolfinx.fem.compile_form(mesh.comm, forms, jit_options=JIT_OPTIONS)
+    if code is None:  # on this rank alone: the memo's hits may differ between ranks
+        compiled = dolfinx.fem.compile_form(MPI.COMM_SELF, forms, jit_options=JIT_OPTIONS)
         code = _COMPILED[key] = (compiled.ufcx_form, compiled.module, compiled.code, compiled.dtype)
     return _create(CompiledForm(forms, *code), mesh, entity_maps)
 
@@ -55,10 +57,14 @@ def _integration_mesh(a) -> dolfinx.mesh.Mesh | None:
     spaces (``None``: not a form with integrals, or no such space: left to DOLFINx)."""
     if not isinstance(a, ufl.Form) or a.empty():
         return None
-    domains = list(a.subdomain_data())
-    if len(domains) != 1:
+    data = a.subdomain_data()
+    if len(data) != 1:
         return None
-    cpp = domains[0].ufl_cargo()
+    (domain,) = data
+    for tags in data[domain].values():  # one subdomain data an integral type, as DOLFINx asks
+        if any(t is not tags[0] for t in tags if t is not None):
+            return None
+    cpp = domain.ufl_cargo()
     spaces = [v.ufl_function_space() for v in a.arguments()]
     spaces += [c.function_space for c in a.coefficients() if hasattr(c, "function_space")]
     for space in spaces:

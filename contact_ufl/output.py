@@ -54,7 +54,7 @@ class ResultWriter:
         <contact_ufl.problem.ContactProblem.error_estimate>`, ``eta_K^2`` per cell) to
         ``error_indicators.bp`` (``error_indicators_<k>.bp`` per mesh), and the estimate,
         its value relative to the solution's energy norm and its terms to
-        ``error_estimate.csv``, one line a step (hyperelastic solids only).
+        ``error_estimate.csv``, one line a step (solids only: a membrane is refused).
     """
 
     def __init__(
@@ -64,6 +64,10 @@ class ResultWriter:
         contact_surfaces: bool = True,
         error_indicators: bool = False,
     ):
+        if error_indicators:  # refused before any file is opened
+            from contact_ufl.estimate import check_estimable
+
+            check_estimable(problem.bulks)
         folder = Path(folder)
         if problem.comm.rank == 0:
             folder.mkdir(parents=True, exist_ok=True)
@@ -129,9 +133,8 @@ class _EstimateWriter:
     ``error_estimate.csv`` (rank 0) of a :class:`ResultWriter`."""
 
     def __init__(self, problem, folder: Path, endings: list[str], suffix: str):
-        from contact_ufl.estimate import TERMS, check_estimable
+        from contact_ufl.estimate import TERMS
 
-        check_estimable(problem.bulks)
         self.problem = problem
         self.fields = []
         for bulk in problem.bulks:

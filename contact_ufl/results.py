@@ -664,13 +664,15 @@ def nodal_pressure(problem, pair: int = 0) -> dolfinx.fem.Function:
 
     Smoother than the multipliers on non-matching meshes, and than
     :func:`recovered_pressure` with P2 displacements (see the user guide, *Results*).
-    P2 multipliers on triangles (3D, ``multiplier_degree=2``) have no nodal areas (their
-    vertex shape functions integrate to zero): refused."""
+    Multipliers whose shape functions do not all integrate to a positive area (P2 on
+    triangles: the vertex ones integrate to zero) are refused."""
     c = problem.contacts[pair]
-    if c.slave.multiplier_degree == 2 and problem.gdim == 3:
+    area = c.slave.nodal_mass
+    largest = problem.comm.allreduce(float(np.max(area, initial=0.0)), MPI.MAX)
+    if problem.comm.allreduce(bool(np.any(area <= 1e-12 * largest)), MPI.LOR):
         raise ContactInputError(
-            "nodal_pressure: P2 multipliers on triangles have no nodal areas (the vertex "
-            "shape functions integrate to zero); use recovered_pressure"
+            "nodal_pressure: some multiplier shape functions integrate to zero or less (P2 "
+            "multipliers on triangles): they have no nodal area; use recovered_pressure"
         )
     space = c.slave.P1
     q = ufl.TestFunction(space)
@@ -679,6 +681,6 @@ def nodal_pressure(problem, pair: int = 0) -> dolfinx.fem.Function:
     )
     owned = space.dofmap.index_map.size_local
     pressure = dolfinx.fem.Function(space, name="nodal_pressure")
-    pressure.x.array[:owned] = force[:owned] / c.slave.nodal_mass
+    pressure.x.array[:owned] = force[:owned] / area
     pressure.x.scatter_forward()
     return pressure
