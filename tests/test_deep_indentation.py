@@ -29,12 +29,12 @@ def deep_hertz(master_normal: str | None) -> cu.ContactProblem:
 
 #: the contact spreads over most of the arc: the bound on the half-width of the zone in
 #: contact over the disc's radius (1), a regression bound on this code's output (0.737
-#: measured; the undeformed overlap's half-chord at that depth is 0.866)
-WIDE = 0.7
-SNAPSHOT = "this code's output (half-width 0.737 R measured)"
+#: measured at h = 0.02, 0.704 at h = 0.005; the undeformed overlap's half-chord at that
+#: depth is 0.866)
+WIDE = 0.65
 
 
-def record_half_width(verification, case: str, problem) -> float:
+def record_half_width(verification, case: str, problem, measured: float) -> float:
     """Record and return the half-width of the zone in contact over R = 1 (the contact flag:
     the open points beyond it carry multipliers of either sign, up to 1e-3 of the peak, to the
     arc's ends)."""
@@ -42,7 +42,8 @@ def record_half_width(verification, case: str, problem) -> float:
     pressed = samples.x[samples.in_contact, 0]
     half_width = float(np.ptp(pressed) / 2)
     quantity = "half-width of the zone in contact over R"
-    verification(case, quantity, half_width, 0.737, f"> {WIDE}", SNAPSHOT, kind="regression")
+    snapshot = f"this code's output (half-width {measured} R measured)"
+    verification(case, quantity, half_width, measured, f"> {WIDE}", snapshot, kind="regression")
     return half_width
 
 
@@ -58,7 +59,7 @@ def test_default_master_normal_reaches_half_the_radius(verification):
     assert all(r.reason.startswith("CONVERGED") for r in history.steps)
     assert max(r.newton_iterations for r in history.steps) <= 10
     case = "Hertz 2D pressed to half the radius, h = 0.02, smoothed master normal, 10 steps"
-    assert record_half_width(verification, case, problem) > WIDE
+    assert record_half_width(verification, case, problem, 0.737) > WIDE
 
 
 @pytest.mark.serial  # a property of the facet normal, not of the partition
@@ -81,7 +82,7 @@ def test_new_user_hertz_half_the_radius_runs_to_the_end(verification):
     """The scene as a new user makes it, with every library default (h_contact = 0.005, 10
     steps, the default master normal): pressed down by half the radius, it runs to the end
     (it stopped at depth 0.24 after 8 cut-backs with the facet normal, the old default);
-    measured 11 steps (one cut-back), 5 to 24 Newton iterations a step.
+    measured 11 steps (one cut-back), 5 to 24 Newton iterations a step, half-width 0.704 R.
     Slow: about a minute."""
     hertz = scenes.hertz_2d(depth=0.5)
     assert hertz.scene.contacts[0].master_normal is None
@@ -91,7 +92,7 @@ def test_new_user_hertz_half_the_radius_runs_to_the_end(verification):
     assert problem.t == pytest.approx(1.0)
     assert all(r.reason.startswith("CONVERGED") for r in history.steps)
     case = "Hertz 2D pressed to half the radius, h = 0.005, every library default"
-    assert record_half_width(verification, case, problem) > WIDE
+    assert record_half_width(verification, case, problem, 0.704) > WIDE
 
 
 @pytest.mark.slow
