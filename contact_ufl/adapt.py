@@ -19,6 +19,7 @@ import numpy as np
 from mpi4py import MPI
 
 from contact_ufl.errors import ContactInputError, ConvergenceError, collective_check
+from contact_ufl.estimate import check_estimable
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.problem import ContactProblem
 from contact_ufl.refinement import (
@@ -158,17 +159,6 @@ def has_history(scene: Scene) -> bool:
     return bool(frictional or plastic)
 
 
-def _check_estimable(scene: Scene) -> None:
-    """Refuse, before any work, the bodies the error estimate does not cover yet."""
-    for k, d in enumerate(scene.parts):
-        for body in d.bodies:
-            if body.membrane:
-                raise NotImplementedError(
-                    f"{d.name or f'mesh {k}'} has a membrane (tag {body.tag}): the error "
-                    "estimate, and so adaptive refinement, covers solids only"
-                )
-
-
 def refine_to_tolerance(
     scene: Scene,
     solve: Callable[[ContactProblem], object],
@@ -222,7 +212,7 @@ def refine_to_tolerance(
     _check_loop_input(comm, tolerance, max_unknowns, theta, max_levels)
     check_refinable(scene)
     check_boundaries(scene, boundaries or {})
-    _check_estimable(scene)
+    check_estimable(scene)
     history = has_history(scene)
     problem = ContactProblem(scene, **options)
     _check_budget(problem, max_unknowns, first=True)

@@ -160,12 +160,16 @@ def _load_density(load, bulk, constant) -> ufl.core.expr.Expr:
     raise NotImplementedError(f"no error estimate with a load {type(load).__name__}")
 
 
-def check_estimable(bulks) -> None:
-    """Refuse the meshes whose residuals the estimate does not cover yet: membranes
-    (``NotImplementedError``)."""
-    for k, bulk in enumerate(bulks):
-        if bulk.membrane:
-            raise NotImplementedError(f"mesh {k}: error estimates are written for solids only")
+def check_estimable(scene) -> None:
+    """Refuse, before any work, the bodies whose residuals the estimate does not cover yet:
+    membranes (``NotImplementedError`` naming the mesh and the body)."""
+    for k, d in enumerate(scene.parts):
+        for body in d.bodies:
+            if body.membrane:
+                raise NotImplementedError(
+                    f"{d.name or f'mesh {k}'} has a membrane (tag {body.tag}): the error "
+                    "estimate, and so adaptive refinement, covers solids only"
+                )
 
 
 def error_estimate(problem) -> ErrorEstimate:
@@ -177,7 +181,7 @@ def error_estimate(problem) -> ErrorEstimate:
         A membrane (its residuals are not written yet).
     """
     comm = problem.comm
-    check_estimable(problem.bulks)
+    check_estimable(problem.scene)
     indicators, parts = [], dict.fromkeys(TERMS, 0.0)
     for bulk in problem.bulks:
         contacts = [c for c in problem.contacts if problem.bulk_of(c) is bulk]

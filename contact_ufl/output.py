@@ -67,7 +67,7 @@ class ResultWriter:
         if error_indicators:  # refused before any file is opened
             from contact_ufl.estimate import check_estimable
 
-            check_estimable(problem.bulks)
+            check_estimable(problem.scene)
         folder = Path(folder)
         if problem.comm.rank == 0:
             folder.mkdir(parents=True, exist_ok=True)
