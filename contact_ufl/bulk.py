@@ -129,13 +129,22 @@ class Bulk:
 
     def energy(self) -> ufl.Form:
         """The stored energy ``sum_b int psi_b dV`` (per unit reference area on a
-        membrane) of the hyperelastic bodies."""
+        membrane) of the bodies: of an elastoplastic one its elastic part, at the committed
+        history."""
         if self.membrane:
             return sum(
                 b.material.strain_energy(self.u, self.n0) * self.dx(b.tag) for b in self.bodies
             )
         F = deformation_gradient(self.u)
-        return sum(b.material.strain_energy(F) * self.dx(b.tag) for b in self.bodies)
+        return sum(
+            (
+                self.histories[b.tag].elastic_energy_density()
+                if b.tag in self.histories
+                else b.material.strain_energy(F)
+            )
+            * self.dx(b.tag)
+            for b in self.bodies
+        )
 
     def virtual_work(self, load, v, constant: dolfinx.fem.Constant) -> ufl.Form:
         """External virtual work of ``load`` (its value in ``constant``) on ``v``."""
@@ -223,7 +232,7 @@ class Bulk:
         return self.comm.allreduce(np.asarray(local, dtype=float), MPI.SUM)
 
     def stored_energy(self) -> float:
-        """Elastic energy ``sum_b int psi_b(F) dV`` of the (hyperelastic) bodies."""
+        """Stored energy ``sum_b int psi_b dV`` of the bodies (:meth:`energy`)."""
         if self._energy_form is None:
             self._energy_form = jit.form(self.energy())
         return self.comm.allreduce(dolfinx.fem.assemble_scalar(self._energy_form))

@@ -33,14 +33,7 @@ import ufl
 from mpi4py import MPI
 
 from contact_ufl import jit
-from contact_ufl.loads import (
-    BodyForce,
-    DeadForce,
-    DeadTraction,
-    FollowerForce,
-    FollowerPressure,
-    deformation_gradient,
-)
+from contact_ufl.loads import BodyForce, DeadForce, DeadTraction, FollowerForce, FollowerPressure
 
 #: the terms of the estimate, in the order reported
 TERMS = ("bulk", "jump", "boundary", "traction", "penetration", "complementarity", "cone")
@@ -208,29 +201,10 @@ def error_estimate(problem) -> ErrorEstimate:
         eta.x.scatter_forward()
         eta.name = "error_indicator"
         indicators.append(eta)
-    energy = float(np.sqrt(max(2.0 * _stored_energy(problem), 0.0)))
+    # an elastoplastic body's elastic part (problem.stored_energy refuses plastic scenes)
+    stored = sum(bulk.stored_energy() for bulk in problem.bulks)
+    energy = float(np.sqrt(max(2.0 * stored, 0.0)))
     return ErrorEstimate(indicators, parts, energy)
-
-
-def _stored_energy(problem) -> float:
-    """The stored energy of all bodies: an elastoplastic body's elastic part (its history
-    committed)."""
-    if not any(bulk.histories for bulk in problem.bulks):
-        return problem.stored_energy()
-    total = 0.0
-    for bulk in problem.bulks:
-        F = deformation_gradient(bulk.u)
-        density = sum(
-            (
-                bulk.histories[b.tag].elastic_energy_density()
-                if b.tag in bulk.histories
-                else b.material.strain_energy(F)
-            )
-            * bulk.dx(b.tag)
-            for b in bulk.bodies
-        )
-        total += problem.comm.allreduce(dolfinx.fem.assemble_scalar(jit.form(density)), MPI.SUM)
-    return total
 
 
 #: the marker of the exterior facets in no group (free)

@@ -18,6 +18,8 @@ import dolfinx
 import numpy as np
 from mpi4py import MPI
 
+from contact_ufl.estimate import TERMS, check_estimable
+
 if TYPE_CHECKING:
     import pyvista
 
@@ -65,8 +67,6 @@ class ResultWriter:
         error_indicators: bool = False,
     ):
         if error_indicators:  # refused before any file is opened
-            from contact_ufl.estimate import check_estimable
-
             check_estimable(problem.scene)
         folder = Path(folder)
         if problem.comm.rank == 0:
@@ -133,8 +133,6 @@ class _EstimateWriter:
     ``error_estimate.csv`` (rank 0) of a :class:`ResultWriter`."""
 
     def __init__(self, problem, folder: Path, endings: list[str], suffix: str):
-        from contact_ufl.estimate import TERMS
-
         self.problem = problem
         self.fields = []
         for bulk in problem.bulks:
@@ -153,8 +151,6 @@ class _EstimateWriter:
 
     def update(self, t: float) -> None:
         """The indicators and the estimate of the current state (collective)."""
-        from contact_ufl.estimate import TERMS
-
         estimate = self.problem.error_estimate()
         for field, eta in zip(self.fields, estimate.indicators, strict=True):
             field.x.array[:] = eta.x.array
