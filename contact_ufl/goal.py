@@ -220,7 +220,8 @@ def _localise(problem, rich, residual: PETSc.Vec, dual: PETSc.Vec):
         owned = index_map.size_local * bs
         consistency -= float(np.dot(R.x.array[:owned], interpolant.x.array[:owned]))
         share = dolfinx.fem.Function(V)
-        share.x.array[:owned] = -R.x.array[:owned] * (z.x.array[:owned] - interpolant.x.array[:owned])
+        above = z.x.array[:owned] - interpolant.x.array[:owned]  # the dual beyond degree 1
+        share.x.array[:owned] = -R.x.array[:owned] * above
         share.x.scatter_forward()
         indicators.append(_cell_shares(share, coarse.V.mesh))
     return indicators, float(problem.comm.allreduce(consistency, MPI.SUM))

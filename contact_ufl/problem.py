@@ -35,6 +35,7 @@ from contact_ufl.control import VolumeConstraint, VolumeControl
 from contact_ufl.diagnosis import StepDiagnosis
 from contact_ufl.errors import NonUniqueSolutionWarning
 from contact_ufl.estimate import ErrorEstimate, error_estimate
+from contact_ufl.goal import GoalEstimate, normal_force_error
 from contact_ufl.layout import StackedLayout
 from contact_ufl.mpi import collective, global_bounds, global_diameter
 from contact_ufl.newton import NewtonDriver
@@ -650,6 +651,13 @@ class ContactProblem:
         (:func:`contact_ufl.estimate.error_estimate`): per-cell indicators, the estimate in
         the energy norm and its parts."""
         return error_estimate(self)
+
+    @collective
+    def normal_force_error(self, pair: int | None = None) -> GoalEstimate:
+        """The estimated error in the normal contact force ``int lambda_N dS_o`` of ``pair``
+        (all pairs: ``None``) at the converged state, by dual-weighted residuals
+        (:func:`contact_ufl.goal.normal_force_error`): signed, with each cell's share."""
+        return normal_force_error(self, pair)
 
     @collective
     def reaction(
