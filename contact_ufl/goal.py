@@ -10,10 +10,10 @@ normal force of the multipliers, ``J = int lambda_N dS_o``) the dual-weighted re
 with ``R`` the residual and ``A`` its tangent in a richer space (the displacement of one
 degree more on the same meshes, the multipliers and the contact rules unchanged) at the
 converged state ``u_h`` moved into it, and ``z`` the dual solution there. The tangent is that
-of the converged contact state (the active set fixed), as in the DWR estimates for contact
-of Blum, Rademacher and Schroeder. The estimate is signed: ``J(u_h) + error`` is the force
-the richer space would give. Its measured effectivity is in the user guide, *Error
-estimates*.
+of the converged contact state (the active set fixed), as in Blum and Suttmeier's DWR
+estimate for the Signorini problem. The estimate is signed: ``J(u_h) + error`` is, to first
+order, the force the richer space would give. Its measured effectivity is in the user
+guide, *Error estimates*.
 """
 
 from __future__ import annotations

@@ -121,6 +121,42 @@ SECTIONS = (
         ),
     ),
     Section(
+        "Effectivity of the contact force's error estimate",
+        "The signed estimate of `problem.normal_force_error()` (dual-weighted residuals, "
+        "the dual solved with the displacement of degree 2 on the same mesh) against the "
+        "true error of the P1 normal force `int lambda_N dS_o`, on meshes refined "
+        "uniformly (every cell; the disc's new nodes on its circle). *hertz_2d*: the scene "
+        "of `tests/test_goal.py` (neo-Hookean, depth 0.02 R in 2 steps); "
+        "*hertz_2d_linear*: the Hertz benchmark's scene (linear elastic, depth 0.005 in "
+        "one step, graded to `h_contact = 0.01`). The true force is the Richardson limit "
+        "of the P2 forces on the three meshes (*effectivity*), or of the P1 forces "
+        "(*eff. P1 limit*). *P2 / estimate*: the P2 solve's change of the force on the same "
+        "mesh over the estimate, which it predicts to first order. *estimate s*: the "
+        "estimate's wall time (the degree-2 problem's set-up, one tangent, one transposed "
+        "solve), beside the P1 and P2 solves'.",
+        "python benchmarks/goal_estimate.py --json FILE",
+        (
+            Table(
+                "The normal force's error estimate under uniform refinement",
+                ("goal_estimate.json",),
+                (
+                    Column("case", "case"),
+                    Column("level", "level"),
+                    Column("unknowns", "unknowns", integer),
+                    Column("force", "force", scientific),
+                    Column("estimate", "estimate", scientific),
+                    Column("true error", "true_error", scientific),
+                    Column("effectivity", "effectivity", fixed(2)),
+                    Column("eff. P1 limit", "effectivity_p1", fixed(2)),
+                    Column("P2 / estimate", "ratio", fixed(2)),
+                    Column("wall s", "wall_s", significant),
+                    Column("estimate s", "estimate_s", significant),
+                    Column("P2 wall s", "wall_p2_s", significant),
+                ),
+            ),
+        ),
+    ),
+    Section(
         "Adaptive refinement",
         "The 2D Hertz scene of the Hertz benchmark (linear elastic, one load step, the "
         "default eps, depth 0.005) from a coarse mesh (`h_contact = 0.04`, a/h = 1.3), "
