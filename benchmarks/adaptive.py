@@ -19,6 +19,9 @@ records refine every cell at each level instead (``theta = 1``).
 then moved sideways in 4; every mesh replays them): the stick zone's half-width and the
 shear traction against Johnson 7.1.
 
+``--load-steps N``: Cattaneo-Mindlin pressed in N steps and moved in N (the Newton
+iterations of a step against the size of the step).
+
 ``--case plastic``: the plastic indentation scene (a stiff half disc pressed by 0.02 into
 a perfectly plastic block in 8 steps and lifted off in 8; every mesh replays them): the
 imprint's depth, which has no closed form; the estimate and the Newton iterations.
@@ -155,15 +158,17 @@ def hertz_errors(problem, hertz) -> dict:
     }
 
 
+#: the load steps of each phase of a case's load path (``--load-steps`` changes them)
+LOAD_STEPS = {"hertz": 1, "cattaneo": 4, "plastic": 8}
+
+
 def solve_load_path(problem, case: str) -> None:
     """The load path of ``case``: Hertz in one step; Cattaneo-Mindlin pressed in 4 steps,
     then moved sideways in 4; the plastic indentation pressed in 8 and lifted off in 8."""
-    if case == "plastic":
-        problem.solve(num_steps=8, t_end=1.0)
-        problem.solve(num_steps=8, t_end=2.0)
-    elif case == "cattaneo":
-        problem.solve(num_steps=4, t_end=1.0)
-        problem.solve(num_steps=4, t_end=2.0)
+    steps = LOAD_STEPS[case]
+    if case in ("plastic", "cattaneo"):
+        problem.solve(num_steps=steps, t_end=1.0)
+        problem.solve(num_steps=steps, t_end=2.0)
     else:
         problem.solve(num_steps=1)
 
@@ -195,6 +200,7 @@ def run_graded(case: str, depth: float, degree: int) -> list[dict]:
                 "newton_iterations": sum(r.newton_iterations for r in steps),
                 "newton_per_step": sum(r.newton_iterations for r in steps) / len(steps),
                 "newton_max": max(r.newton_iterations for r in steps),
+                "load_steps": len(steps),
                 "wall_s": wall,
                 "cumulative_s": time.perf_counter() - begin,
                 "ranks": problem.comm.size,
@@ -266,6 +272,7 @@ def run(
                 "newton_iterations": level.newton_iterations,
                 "newton_per_step": level.newton_iterations / len(problem.history.steps),
                 "newton_max": max(r.newton_iterations for r in problem.history.steps),
+                "load_steps": len(problem.history.steps),
                 "start": level.start,
                 "wall_s": level.wall,
                 "cumulative_s": time.perf_counter() - begin,
@@ -308,7 +315,10 @@ def main() -> None:
     parser.add_argument("--depth", type=float, default=None, help="0.005, 3D 0.01")
     parser.add_argument("--theta", type=float, default=0.5)
     parser.add_argument("--max-unknowns", type=int, default=None)
+    parser.add_argument("--load-steps", type=int, default=None, help="steps of each phase")
     args = parser.parse_args()
+    if args.load_steps is not None:
+        LOAD_STEPS[args.case] = args.load_steps
     budget = args.max_unknowns or (15_000 if args.quick else 120_000)
     start = args.start or (0.04 if args.dim == 2 else 0.05)
     depth = args.depth or (0.005 if args.dim == 2 else 0.01)
