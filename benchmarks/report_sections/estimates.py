@@ -223,6 +223,18 @@ SECTIONS = (
                 ),
             ),
             Table(
+                "Cattaneo-Mindlin as above, pressed in 8 steps and moved sideways in 8 "
+                "(`--load-steps 8`): the Newton iterations of a step against its size",
+                ("adaptive_cattaneo_steps8.json",),
+                (
+                    *LEVEL,
+                    Column("stick zone", "stick_zone_error", percent),
+                    Column("Newton (max a step)", _newton_total_max),
+                    Column("steps", "load_steps", integer),
+                    *TIMES,
+                ),
+            ),
+            Table(
                 "Plastic indentation (a stiff disc pressed by 0.02 into a perfectly plastic "
                 "block in 8 steps and lifted off in 8; every mesh replays them), from "
                 "h_contact = 0.04",
