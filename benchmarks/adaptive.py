@@ -19,6 +19,11 @@ records refine every cell at each level instead (``theta = 1``).
 then moved sideways in 4; every mesh replays them): the stick zone's half-width and the
 shear traction against Johnson 7.1.
 
+``--goal normal_force``: the loop driven by the estimated error of the normal contact
+force (:func:`contact_ufl.goal.normal_force_error`) instead of the energy norm's estimate
+(2D Hertz, P1). Every 2D Hertz record has the force and its error against the limit that
+``benchmarks/goal_estimate.py`` measured for this scene (``force``, ``force_error``).
+
 ``--load-steps N``: Cattaneo-Mindlin pressed in N steps and moved in N (the Newton
 iterations of a step against the size of the step).
 
@@ -35,18 +40,22 @@ import argparse
 import dataclasses
 import functools
 import time
+from pathlib import Path
 
 import numpy as np
 import resultfile
 from hertz import hertz_2d_errors
 from mpi4py import MPI
 
-from contact_ufl import ContactProblem, adapt
+from contact_ufl import ContactProblem, adapt, goal
 from contact_ufl.materials import LinearElastic
 from contact_ufl.results import contact_samples, lowest_displacement, stick_zone_half_width
 from contact_ufl.verification import scenes
 from contact_ufl.verification.analytic import CattaneoMindlin2D, Hertz2D, fit_elliptic_profile
 from contact_ufl.verification.runs import hertz_3d_errors, shear_error
+
+#: the results files
+RESULTS = Path(__file__).parent / "results"
 
 #: the disc of the 2D Hertz scene
 CENTRE = np.array([0.0, 1.0, 0.0])
@@ -144,6 +153,15 @@ def hertz_scene(h: float, depth: float, order: int = 1, refine_radius: float = 0
     return hertz, scene
 
 
+def force_limit() -> float:
+    """The limit of the normal contact force of the 2D Hertz scene under refinement, as
+    ``benchmarks/goal_estimate.py`` measured it (its ``hertz_2d_linear`` case: the same
+    geometry, material, eps and depth)."""
+    records = resultfile.load(RESULTS / "goal_estimate.json")
+    (limit,) = {r["limit"] for r in records if r["case"] == "hertz_2d_linear"}
+    return limit
+
+
 def hertz_errors(problem, hertz) -> dict:
     """The errors of :func:`hertz.hertz_2d_errors`, and those of the pressure recovered from
     the bulk (p0 and a of its fitted profile, nominal)."""
@@ -152,9 +170,12 @@ def hertz_errors(problem, hertz) -> dict:
     recovered = contact_samples(problem, recovered=True).lambda_N
     a_recovered, p0_recovered, _ = fit_elliptic_profile(X[:, 0], recovered)
     exact = Hertz2D(problem.contact_force()[1], hertz.radius, hertz.E_star)
+    force = goal.normal_force(problem)
     return hertz_2d_errors(problem, hertz) | {
         "p0_error_recovered": p0_recovered / exact.p0 - 1.0,
         "a_error_recovered": a_recovered / exact.a - 1.0,
+        "force": force,
+        "force_error": force / force_limit() - 1.0,
     }
 
 
@@ -239,6 +260,7 @@ def run(
     theta: float,
     dim: int = 2,
     case: str = "hertz",
+    goal_name: str | None = None,
 ) -> list[dict]:
     """The levels of one loop: ``kind`` ``"adaptive"`` (Doerfler, ``theta``) or
     ``"uniform"`` (every cell refined), of ``case`` ``"hertz"``, ``"cattaneo"`` or
@@ -277,6 +299,7 @@ def run(
                 "wall_s": level.wall,
                 "cumulative_s": time.perf_counter() - begin,
                 "ranks": problem.comm.size,
+                "goal": goal_name or "energy",
                 **errors(problem),
             }
         )
@@ -300,6 +323,7 @@ def run(
         boundaries=boundaries,
         problem_options={"degree": degree, "verbose": False},
         on_level=record,
+        goal=goal_name,
     )
     return records
 
@@ -316,6 +340,7 @@ def main() -> None:
     parser.add_argument("--theta", type=float, default=0.5)
     parser.add_argument("--max-unknowns", type=int, default=None)
     parser.add_argument("--load-steps", type=int, default=None, help="steps of each phase")
+    parser.add_argument("--goal", choices=("normal_force",), default=None)
     args = parser.parse_args()
     if args.load_steps is not None:
         LOAD_STEPS[args.case] = args.load_steps
@@ -324,7 +349,9 @@ def main() -> None:
     depth = args.depth or (0.005 if args.dim == 2 else 0.01)
     records = []
     for kind in ("adaptive", "uniform"):
-        records += run(kind, start, depth, args.degree, budget, args.theta, args.dim, args.case)
+        records += run(
+            kind, start, depth, args.degree, budget, args.theta, args.dim, args.case, args.goal
+        )
     if (args.case, args.degree) in GRADED and args.dim == 2 and not args.quick:
         records += run_graded(args.case, depth, args.degree)
     if MPI.COMM_WORLD.rank == 0:

@@ -1,7 +1,8 @@
 """Adaptive refinement of a scene's meshes to a target accuracy.
 
-One level of the loop: solve, estimate (:mod:`contact_ufl.estimate`), mark the cells that
-carry a fraction ``theta`` of the estimate (Doerfler), refine every mesh of the scene there
+One level of the loop: solve, estimate (:mod:`contact_ufl.estimate`, or the error of the
+normal contact force, :mod:`contact_ufl.goal`), mark the cells that carry a fraction
+``theta`` of the estimate (Doerfler), refine every mesh of the scene there
 (:mod:`contact_ufl.refinement`), and solve on the new meshes. A scene without history (no
 friction, no plasticity) starts each new mesh from the last solution moved onto it and
 brings it to equilibrium at the same load; a scene with history replays its load path on
@@ -20,6 +21,7 @@ from mpi4py import MPI
 
 from contact_ufl.errors import ContactInputError, ConvergenceError, collective_check
 from contact_ufl.estimate import check_estimable
+from contact_ufl.goal import check_goal_estimable
 from contact_ufl.plasticity import J2Plasticity
 from contact_ufl.problem import ContactProblem
 from contact_ufl.refinement import (
@@ -45,7 +47,9 @@ class Level:
     cells
         Number of cells of each mesh.
     estimate, relative
-        The error estimate and its ratio to the solution's energy norm.
+        The error estimate and its ratio to the solution's energy norm (with the goal
+        ``"normal_force"``: the force's estimated error, its magnitude, and that over the
+        force).
     newton_iterations
         Newton iterations of the solve on this mesh (all steps).
     wall
@@ -73,7 +77,8 @@ class AdaptiveSolve:
     problem
         The problem on the last mesh, solved (its :attr:`estimate` is the last level's).
     estimate
-        The error estimate of :attr:`problem`.
+        The error estimate of :attr:`problem` (an :class:`~contact_ufl.estimate.ErrorEstimate`,
+        or with a goal a :class:`~contact_ufl.goal.GoalEstimate`).
     levels
         Every mesh the loop solved on, coarsest first.
     reached
@@ -90,17 +95,23 @@ class AdaptiveSolve:
     stopped_by: str = ""
 
 
+#: the goals of :func:`refine_to_tolerance` (``None``: the energy norm)
+GOALS = (None, "normal_force")
+
+
 def doerfler_marking(
     indicators: list[dolfinx.fem.Function], theta: float, comm: MPI.Comm
 ) -> list[np.ndarray]:
-    """The fewest cells (largest indicators first) whose ``eta_K^2`` sum to at least
+    """The fewest cells (largest indicators first) whose indicators sum to at least
     ``theta`` of the total, over all meshes and ranks (Doerfler's bulk criterion).
 
     Parameters
     ----------
     indicators
-        ``eta_K^2`` per cell, a DG0 function per mesh
-        (:attr:`ErrorEstimate.indicators <contact_ufl.estimate.ErrorEstimate.indicators>`).
+        A non-negative value per cell, a DG0 function per mesh: ``eta_K^2`` of the energy
+        estimate (:attr:`ErrorEstimate.indicators
+        <contact_ufl.estimate.ErrorEstimate.indicators>`), or a goal's ``|eta_K|``
+        (:attr:`GoalEstimate.indicators <contact_ufl.goal.GoalEstimate.indicators>`).
     theta
         The fraction, in (0, 1].
 
@@ -169,10 +180,11 @@ def refine_to_tolerance(
     boundaries: Mapping[int | str, Boundary] | None = None,
     problem_options: Mapping | None = None,
     on_level: Callable[[ContactProblem, Level], None] | None = None,
+    goal: str | None = None,
 ) -> AdaptiveSolve:
     """Solve ``scene``, refine its meshes where the error estimate says, and solve again,
-    until the relative estimate (over the solution's energy norm) is at most ``tolerance``
-    or the next mesh would exceed ``max_unknowns`` (collective).
+    until the relative estimate (over the solution's energy norm, or over the goal) is at
+    most ``tolerance`` or the next mesh would exceed ``max_unknowns`` (collective).
 
     Parameters
     ----------
@@ -186,7 +198,8 @@ def refine_to_tolerance(
         replayed if that fails).
     tolerance
         The target of :attr:`ErrorEstimate.relative
-        <contact_ufl.estimate.ErrorEstimate.relative>`, > 0.
+        <contact_ufl.estimate.ErrorEstimate.relative>` (with a goal, of
+        :attr:`GoalEstimate.relative <contact_ufl.goal.GoalEstimate.relative>`), > 0.
     max_unknowns
         The budget: no mesh with more unknowns is solved on.
     theta
@@ -202,6 +215,11 @@ def refine_to_tolerance(
     on_level
         Called with the problem and its :class:`Level` after each solve (e.g. to write
         pictures of the meshes and indicators).
+    goal
+        ``None``: the energy norm's estimate drives the loop; ``"normal_force"``: the
+        estimated error of the normal contact force of all pairs
+        (:func:`~contact_ufl.goal.normal_force_error`; frictionless contact of hyperelastic
+        solids, degree 1), its cells' shares marked.
 
     Returns
     -------
@@ -210,11 +228,22 @@ def refine_to_tolerance(
     comm = scene.parts[0].mesh.comm
     options = dict(problem_options or {})
     _check_loop_input(comm, tolerance, max_unknowns, theta, max_levels)
+    collective_check(
+        comm,
+        goal in GOALS,
+        f"goal must be one of {', '.join(map(repr, GOALS))}, got {goal!r}",
+    )
     check_refinable(scene)
     check_boundaries(scene, boundaries or {})
     check_estimable(scene)
     history = has_history(scene)
     problem = ContactProblem(scene, **options)
+    if goal is not None:
+        try:
+            check_goal_estimable(problem)
+        except NotImplementedError:
+            problem.close()
+            raise
     _check_budget(problem, max_unknowns, first=True)
     levels: list[Level] = []
     previous = None
@@ -226,11 +255,16 @@ def refine_to_tolerance(
         else:
             problem, kind = _solve_from(previous, problem, solve, options)
             previous.close()
-        estimate = problem.error_estimate()
+        if goal is None:
+            estimate = problem.error_estimate()
+            size = estimate.estimate
+        else:
+            estimate = problem.normal_force_error()
+            size = abs(estimate.error)
         level = Level(
             unknowns=problem.layout.global_size,
             cells=[_num_cells(b.V.mesh) for b in problem.bulks],
-            estimate=estimate.estimate,
+            estimate=size,
             relative=estimate.relative,
             newton_iterations=sum(r.newton_iterations for r in problem.history.steps),
             wall=time.perf_counter() - start,
