@@ -177,7 +177,7 @@ SECTIONS = (
         "and the shear traction against Johnson 7.1 at the last step) and on the plastic "
         "indentation (the imprint's depth: no closed form) follows.",
         "python benchmarks/adaptive.py [--degree 2] [--dim 3] [--case cattaneo|plastic] "
-        "[--max-unknowns N] --json FILE",
+        "[--goal normal_force] [--load-steps N] [--max-unknowns N] --json FILE",
         tuple(
             Table(
                 f"P{degree}",
@@ -196,6 +196,20 @@ SECTIONS = (
             for degree in (1, 2)
         )
         + (
+            Table(
+                "P1, the normal contact force: the loop driven by the energy estimate "
+                "(`goal` energy) and by the force's estimated error (`--goal normal_force`), "
+                "against the force's limit measured by `benchmarks/goal_estimate.py` "
+                "(*relative estimate*: of the loop's own estimate, the energy norm's or the "
+                "force's)",
+                ("adaptive_2d_p1.json", "adaptive_2d_p1_force.json"),
+                (
+                    *LEVEL,
+                    Column("goal", "goal"),
+                    Column("force", "force_error", percent),
+                    *TIMES,
+                ),
+            ),
             Table(
                 "3D, P1 (the quarter ball on a block, depth 0.01, from h_contact = 0.05)",
                 ("adaptive_3d_p1.json",),
