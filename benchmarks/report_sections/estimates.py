@@ -50,6 +50,13 @@ def _newton_total_max(record: dict) -> str:
     return f"{record['newton_iterations']} ({record.get('newton_max', '-')})"
 
 
+def _force_effectivity(record: dict) -> float | None:
+    """The force's estimated relative error over its true one (the force-driven loop)."""
+    if record.get("goal") != "normal_force" or not record.get("force_error"):
+        return None
+    return record["relative_estimate"] / abs(record["force_error"])
+
+
 def _percent(x) -> str:
     return "-" if x is None or x != x else f"{100.0 * x:.0f}%"
 
@@ -207,6 +214,7 @@ SECTIONS = (
                     *LEVEL,
                     Column("goal", "goal"),
                     Column("force", "force_error", percent),
+                    Column("force effectivity", _force_effectivity, fixed(2)),
                     *TIMES,
                 ),
             ),
