@@ -42,19 +42,33 @@ def _solved(scene: cu.Scene, degree: int = 1) -> cu.ContactProblem:
     return problem
 
 
+@pytest.fixture(scope="module")
+def coarse() -> tuple[cu.Scene, goal.GoalEstimate]:
+    """The scene at ``h_contact = 0.02`` and the force estimate of its P1 solve."""
+    scene = _hertz()
+    return scene, goal.normal_force_error(_solved(scene))
+
+
+@pytest.fixture(scope="module")
+def reference_force(coarse) -> float:
+    """The force of a converged solve: P2 on the scene's mesh refined once everywhere, the
+    disc snapped to its circle (2.6e-4 off the limit extrapolated from three meshes)."""
+    scene, _ = coarse
+    return goal.normal_force(_solved(_refined_everywhere(scene), degree=2))
+
+
 @pytest.mark.serial
-def test_the_force_error_is_within_a_factor_2_of_the_true_one(verification):
+def test_the_force_error_is_within_a_factor_2_of_the_true_one(
+    coarse, reference_force, verification
+):
     """2D Hertz (neo-Hookean, pressed by 0.02 R): the estimated error of the P1 normal force
     against the force of a converged solve (P2 on the mesh refined once everywhere, the disc
     snapped to its circle; it is 4% of the P1 error from the extrapolated limit). Measured:
     effectivity 1.53 (estimate -5.38e-5, error -3.52e-5 of a force of 5.6e-3); the next two
     meshes 1.24 and 1.30 against the extrapolated limit (the user guide, *Error
     estimates*)."""
-    scene = _hertz()
-    estimate = goal.normal_force_error(_solved(scene))
-    refined = _refined_everywhere(scene)
-    reference = goal.normal_force(_solved(refined, degree=2))
-    effectivity = estimate.error / (reference - estimate.value)
+    _, estimate = coarse
+    effectivity = estimate.error / (reference_force - estimate.value)
     verification(
         "2D Hertz, neo-Hookean, depth 0.02 R, P1, h_contact = 0.02",
         "effectivity of the normal force's error estimate (estimate over true error)",
@@ -69,13 +83,12 @@ def test_the_force_error_is_within_a_factor_2_of_the_true_one(verification):
 
 
 @pytest.mark.serial
-def test_the_force_error_predicts_the_richer_space(verification):
+def test_the_force_error_predicts_the_richer_space(coarse, verification):
     """The estimate is the first-order change of the force from P1 to P2 on the same mesh:
     the P2 solve's force differs from the P1 one by 0.82 of the estimate (the rest: the
     contact zone's edge moves and the law is nonlinear), and the cells' shares account for
     the estimate less its consistency part (a regression and consistency check)."""
-    scene = _hertz()
-    estimate = goal.normal_force_error(_solved(scene))
+    scene, estimate = coarse
     change = goal.normal_force(_solved(scene, degree=2)) - estimate.value
     ratio = change / estimate.error
     verification(
@@ -131,17 +144,16 @@ def test_the_force_error_says_what_it_does_not_cover():
 
 
 @pytest.mark.serial
-def test_the_loop_driven_by_the_force_reaches_its_tolerance(verification):
-    """``refine_to_tolerance(..., goal="normal_force")`` from a coarse 2D Hertz mesh stops
-    when the estimated relative error of the force is at most 0.2% (after 5 levels, 13,894
-    unknowns); the force it leaves is then within twice that of a converged solve's (P2 on
-    the starting mesh refined twice everywhere, itself 0.03% off the extrapolated limit):
-    measured 0.23%."""
+def test_the_loop_driven_by_the_force_reaches_its_tolerance(reference_force, verification):
+    """``refine_to_tolerance(..., goal="normal_force")`` from a coarser 2D Hertz mesh
+    (``h_contact = 0.04``) stops when the estimated relative error of the force is at most
+    0.4% (after 4 levels, 7,106 unknowns); the force it leaves is then within twice that of
+    the converged solve's (:func:`reference_force`): measured 0.37%."""
     scene = scenes.hertz_2d(h_contact=0.04, h_far=0.2, depth=0.02).scene
     result = cu.refine_to_tolerance(
         scene,
         lambda p: p.solve(num_steps=2),
-        tolerance=2e-3,
+        tolerance=4e-3,
         max_unknowns=60_000,
         boundaries={"cylinder_contact": onto_circle},
         problem_options={"verbose": False},
@@ -149,15 +161,14 @@ def test_the_loop_driven_by_the_force_reaches_its_tolerance(verification):
     )
     assert result.reached and result.stopped_by == "tolerance"
     assert isinstance(result.estimate, goal.GoalEstimate)
-    reference = goal.normal_force(_solved(_refined_everywhere(_refined_everywhere(scene)), 2))
-    error = abs(result.estimate.value / reference - 1.0)
+    error = abs(result.estimate.value / reference_force - 1.0)
     verification(
         "2D Hertz, neo-Hookean, depth 0.02 R, P1, from h_contact = 0.04",
-        "relative error of the force where the force-driven loop stopped (tolerance 0.2%)",
+        "relative error of the force where the force-driven loop stopped (tolerance 0.4%)",
         error,
         0.0,
-        "< 4e-3 (the tolerance, 2e-3, over the effectivity's lower bound, 1/2)",
-        "the force of a converged solve (P2, the starting mesh refined twice everywhere)",
+        "< 8e-3 (the tolerance, 4e-3, over the effectivity's lower bound, 1/2)",
+        "the force of a converged solve (P2 on the mesh of h_contact = 0.02 refined once)",
     )
-    assert error < 4e-3
-    assert [level.relative for level in result.levels][-1] <= 2e-3
+    assert error < 8e-3
+    assert [level.relative for level in result.levels][-1] <= 4e-3
