@@ -3,8 +3,9 @@
 :class:`StepDiagnosis` watches the iterates of each solve (the contact state of each, and
 the inverted cells of an iterate whose residual is not a number) and tells, at the last
 iterate of a failed one: inverted elements and where, a contact pairing or status that
-cycles, or a residual that stalls with neither (a limit point, a singular tangent); with
-hints where a body is free to turn, or a faceted master normal could cycle.
+cycles (the pairing alone: where the residual stalls), or a residual that stalls with
+neither (a limit point, a singular tangent); with hints where a body is free to turn, or a
+faceted master normal could cycle.
 """
 
 from __future__ import annotations
@@ -35,6 +36,8 @@ class StepDiagnosis:
     signatures
         A signature of the contact state (pairing, contact and stick/slip status of this
         rank's points) at each iterate of the last solve.
+    statuses
+        A signature of the contact and stick/slip status alone at each iterate.
     not_finite
         The inverted cells of the last iterate whose residual was not a number.
     """
@@ -51,25 +54,29 @@ class StepDiagnosis:
         self.free_pieces = [(piece, on) for piece, on in free_pieces if on]
         self._inverted_cells = inverted_cells
         self.signatures: list[int] = []
+        self.statuses: list[int] = []
         self.not_finite: np.ndarray | None = None
 
     def start_solve(self) -> None:
         """A new solve: forget the last one's iterates."""
         self.signatures = []
+        self.statuses = []
         self.not_finite = None
 
     def record_iterate(self, norm: float) -> None:
         """The contact state of an iterate (the pairing, the contact status and, with
         friction, the stick/slip status)."""
-        state = [
+        paired = [c for c in self.contacts if c.projection is not None]
+        status = [
             np.concatenate(
-                [c.projection.facet, c.active().astype(np.int64)]
-                + ([c.stick().astype(np.int64)] if c.friction else [])
+                [c.active().astype(np.int64)] + ([c.stick().astype(np.int64)] if c.friction else [])
             )
-            for c in self.contacts
-            if c.projection is not None
+            for c in paired
         ]
+        pairing = [c.projection.facet for c in paired]
+        state = [np.concatenate([f, s]) for f, s in zip(pairing, status, strict=True)]
         self.signatures.append(hash(np.concatenate(state).tobytes()) if state else 0)
+        self.statuses.append(hash(np.concatenate(status).tobytes()) if status else 0)
 
     def record_not_finite(self) -> None:
         """An iterate whose residual is not a number: where are its inverted cells?"""
@@ -97,6 +104,16 @@ class StepDiagnosis:
             for k in range(2, len(signatures))
         )
         if self.comm.allreduce(revisits, MPI.LOR):
+            if self._pairing_alone() and len(norms) > 1 and norms[0] > 0.0:
+                stall = norms[-1] / norms[0]
+                return (
+                    "the contact pairing cycles: the master facets of some slave points "
+                    "alternate between iterates while no point changes contact status (the "
+                    "iterates straddle edges between master facets, where the facet normal "
+                    f"jumps); the residual stalls at {norms[-1]:.3g}, {stall:.2g} of the "
+                    f"first: a snes_rtol above {stall:.2g} (petsc_options) accepts that state "
+                    "(pairing cycling)" + self._normal_hint()
+                )
             return (
                 "the contact pairing or status cycles: an iterate returns to the contact state "
                 "of an earlier one (active-set cycling)" + self._normal_hint()
@@ -121,6 +138,13 @@ class StepDiagnosis:
             else ""
         )
         return f"the residual does not converge (no inverted element, no contact cycling){fell}"
+
+    def _pairing_alone(self) -> bool:
+        """Whether the last four iterates share one contact status on every rank (what
+        cycles is then the pairing alone; collective)."""
+        statuses = self.statuses
+        alone = len(statuses) == len(self.signatures) >= 4 and len(set(statuses[-4:])) == 1
+        return bool(self.comm.allreduce(alone, MPI.LAND))
 
     def _turning_hint(self) -> str:
         """The hint for a piece free to turn (the same on every rank)."""
