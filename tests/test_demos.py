@@ -112,6 +112,7 @@ def test_adaptive_hertz_demo_runs(tmp_path, ranks):
     # the loop stopped because the relative estimate met the tolerance
     assert "stopped by the tolerance" in stdout
     assert stdout.strip().splitlines()[-1] == "reached: True"
+    assert "normal contact force" in stdout and "estimated error -" in stdout
     views = ["first_whole", "first_contact", "last_whole", "last_contact", "last_edge"]
     pictures = [f"adaptive_hertz_{view}.png" for view in views] + ["adaptive_hertz_pressure.png"]
     assert_written(out, pictures, [])
