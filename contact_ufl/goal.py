@@ -19,7 +19,6 @@ guide, *Error estimates*.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import dolfinx
@@ -66,35 +65,15 @@ class GoalEstimate:
         return abs(self.error) / abs(self.value) if self.value else float("inf")
 
 
-#: A weight of the pressure, ``weight(X) -> w``: values at reference points ``X`` of shape
-#: ``(3, n)``, shape ``(n,)``.
-Weight = Callable[[np.ndarray], np.ndarray]
-
-
-def normal_force(problem, pair: int | None = None, weight: Weight | None = None) -> float:
-    """``int w lambda_N dS_o`` over the slave surface of ``pair`` (all pairs: ``None``): with
-    no ``weight`` (``w = 1``) the normal contact force the multipliers carry; with one, a
-    weighted mean of the pressure (e.g. a region's share over its area) (collective)."""
+def normal_force(problem, pair: int | None = None) -> float:
+    """``int lambda_N dS_o`` over the slave surface of ``pair`` (all pairs: ``None``), the
+    normal contact force the multipliers carry (collective)."""
+    contacts = problem.contacts if pair is None else [problem.contacts[pair]]
     local = 0.0
-    for c in _contacts(problem, pair):
-        w = _weight(c, weight)
-        form = jit.form(w * c.normal.lambda_N * c.slave.ds, entity_maps=[c.slave.entity_map])
+    for c in contacts:
+        form = jit.form(c.normal.lambda_N * c.slave.ds, entity_maps=[c.slave.entity_map])
         local += dolfinx.fem.assemble_scalar(form)
     return float(problem.comm.allreduce(local, MPI.SUM))
-
-
-def _contacts(problem, pair: int | None) -> list:
-    return problem.contacts if pair is None else [problem.contacts[pair]]
-
-
-def _weight(c, weight: Weight | None):
-    """The weight on the slave surface of ``c``: 1, or ``weight`` interpolated into its
-    multipliers' space (at the reference positions)."""
-    if weight is None:
-        return 1.0
-    w = dolfinx.fem.Function(c.normal.lambda_N.function_space)
-    w.interpolate(weight)
-    return w
 
 
 def check_goal_estimable(problem) -> None:
@@ -162,12 +141,10 @@ def enriched_problem(problem):
     return rich
 
 
-def normal_force_error(
-    problem, pair: int | None = None, weight: Weight | None = None
-) -> GoalEstimate:
-    """The estimated error in :func:`normal_force` (of ``pair``, with ``weight``) of the
-    converged state of ``problem`` (collective): the dual-weighted residual in the
-    displacement of degree 2 (see the module's docstring).
+def normal_force_error(problem, pair: int | None = None) -> GoalEstimate:
+    """The estimated error in :func:`normal_force` of the converged state of ``problem``
+    (collective): the dual-weighted residual in the displacement of degree 2 (see the
+    module's docstring).
 
     Raises
     ------
@@ -184,7 +161,7 @@ def normal_force_error(
         residual = operator.evaluate_residual(x)
         residual.array[rows] = 0.0  # the prescribed values' interpolation is not the goal's
         tangent = operator.evaluate_jacobian(x)
-        goal = operator.assemble(_force_derivative(rich, pair, weight))
+        goal = operator.assemble(_force_derivative(rich, pair))
         goal.array[rows] = 0.0
         dual = goal.duplicate()
         ksp = PETSc.KSP().create(rich.comm)
@@ -202,19 +179,19 @@ def normal_force_error(
             v.destroy()
     finally:
         rich.close()
-    value = normal_force(problem, pair, weight)
-    return GoalEstimate(value, float(error), indicators, consistency)
+    return GoalEstimate(normal_force(problem, pair), float(error), indicators, consistency)
 
 
-def _force_derivative(problem, pair: int | None, weight: Weight | None) -> list[list]:
+def _force_derivative(problem, pair: int | None) -> list[list]:
     """The derivative of :func:`normal_force` as a blocked form over ``problem``'s fields:
-    ``int w lambda_N* dS_o`` in the multiplier block of each pair counted."""
+    ``int lambda_N* dS_o`` in the multiplier block of each pair counted."""
     blocks: list[list] = [[] for _ in problem.fields]
     fields = [id(f) for f in problem.fields]
-    for c in _contacts(problem, pair):
+    contacts = problem.contacts if pair is None else [problem.contacts[pair]]
+    for c in contacts:
         lam = c.normal.lambda_N
         test = ufl.TestFunction(lam.function_space)
-        form = jit.form(_weight(c, weight) * test * c.slave.ds, entity_maps=[c.slave.entity_map])
+        form = jit.form(test * c.slave.ds, entity_maps=[c.slave.entity_map])
         blocks[fields.index(id(lam))].append(form)
     return blocks
 
