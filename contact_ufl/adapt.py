@@ -29,7 +29,7 @@ from contact_ufl.refinement import (
     check_boundaries,
     check_refinable,
     interpolate_by_body,
-    interpolate_onto,
+    interpolate_unknowns,
     refine_scene,
     slave_finer_than_master,
 )
@@ -153,13 +153,7 @@ def transfer_state(source: ContactProblem, target: ContactProblem, padding: floa
     for old, new in zip(source.bulks, target.bulks, strict=True):
         interpolate_by_body(new.u, new.domain, old.u, old.domain, padding * size)
     displacements = {id(b.u) for b in source.bulks}
-    for old, new in zip(source.unknowns, target.unknowns, strict=True):
-        if id(old) in displacements:
-            continue
-        if old.function_space.mesh.topology.dim == 0 or old.x.index_map.size_global <= 1:
-            new.x.array[:] = old.x.array  # a control's global unknown
-            continue
-        interpolate_onto(new, old, padding * size)
+    interpolate_unknowns(source.unknowns, target.unknowns, displacements, padding * size)
     target.set_time(source.t)
 
 

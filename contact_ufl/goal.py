@@ -31,7 +31,7 @@ from petsc4py import PETSc
 from contact_ufl import jit
 from contact_ufl.errors import collective_check
 from contact_ufl.estimate import check_estimable
-from contact_ufl.refinement import interpolate_onto
+from contact_ufl.refinement import interpolate_unknowns
 
 
 @dataclass
@@ -129,14 +129,8 @@ def enriched_problem(problem):
     for old, new in zip(problem.bulks, rich.bulks, strict=True):
         new.u.interpolate(old.u)
     displacements = {id(b.u) for b in problem.bulks}
-    size = problem.scales()[0]
-    for old, new in zip(problem.unknowns, rich.unknowns, strict=True):
-        if id(old) in displacements:
-            continue
-        if old.function_space.mesh.topology.dim == 0 or old.x.index_map.size_global <= 1:
-            new.x.array[:] = old.x.array  # a control's global unknown
-        else:
-            interpolate_onto(new, old, 1e-6 * size)  # the same submesh, made anew
+    # the multipliers: the same slave submesh, made anew
+    interpolate_unknowns(problem.unknowns, rich.unknowns, displacements, 1e-6 * problem.scales()[0])
     rich.set_time(problem.t)
     return rich
 

@@ -313,6 +313,20 @@ def interpolate_onto(
     new.x.scatter_forward()
 
 
+def interpolate_unknowns(old: list, new: list, skip: set[int], padding: float) -> None:
+    """The unknowns ``new`` of a problem on other (or remade) meshes from ``old``, those
+    whose ``id`` is in ``skip`` (the displacements, moved by the caller) left out: a
+    global unknown (a control's load factor) copied, a field (a pair's multipliers)
+    interpolated (:func:`interpolate_onto`; collective)."""
+    for source, target in zip(old, new, strict=True):
+        if id(source) in skip:
+            continue
+        if source.function_space.mesh.topology.dim == 0 or source.x.index_map.size_global <= 1:
+            target.x.array[:] = source.x.array
+        else:
+            interpolate_onto(target, source, padding)
+
+
 def interpolate_by_body(
     new: dolfinx.fem.Function,
     new_domain: Domain,

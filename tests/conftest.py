@@ -15,6 +15,16 @@ from contact_ufl.problem import ContactProblem
 from contact_ufl.taylor import taylor_test
 from contact_ufl.verification import scenes
 
+#: the disc of the 2D Hertz scene (``scenes.hertz_2d``): radius 1, centre (0, 1)
+CENTRE = np.array([0.0, 1.0, 0.0])
+
+
+def onto_circle(x: np.ndarray) -> np.ndarray:
+    """Points moved radially onto the 2D Hertz disc's circle (a refined arc's new nodes)."""
+    d = x - CENTRE
+    return CENTRE + d / np.linalg.norm(d, axis=1)[:, None]
+
+
 #: A comparison of a run on all ranks with the same run on one rank: skipped on one rank,
 #: where it would compare a run with itself.
 across_ranks = pytest.mark.skipif(

@@ -8,22 +8,13 @@ import dolfinx
 import numpy as np
 import pytest
 import ufl
-from conftest import across_ranks
+from conftest import CENTRE, across_ranks, onto_circle
 from mpi4py import MPI
 
 import contact_ufl as cu
 from contact_ufl import adapt, refinement
 from contact_ufl.errors import ContactInputError
 from contact_ufl.verification import scenes
-
-#: the disc of the 2D Hertz scene: radius 1, centre (0, 1)
-CENTRE = np.array([0.0, 1.0, 0.0])
-
-
-def onto_circle(x: np.ndarray) -> np.ndarray:
-    """Points moved radially onto the disc's circle."""
-    d = x - CENTRE
-    return CENTRE + d / np.linalg.norm(d, axis=1)[:, None]
 
 
 def _hertz(comm=MPI.COMM_WORLD, mu: float = 0.0):

@@ -8,20 +8,12 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import across_ranks
+from conftest import across_ranks, onto_circle
 from mpi4py import MPI
 
 import contact_ufl as cu
 from contact_ufl import goal, refinement
 from contact_ufl.verification import scenes
-
-CENTRE = np.array([0.0, 1.0, 0.0])
-
-
-def onto_circle(x: np.ndarray) -> np.ndarray:
-    """Points moved radially onto the disc's circle."""
-    d = x - CENTRE
-    return CENTRE + d / np.linalg.norm(d, axis=1)[:, None]
 
 
 def _hertz(comm=MPI.COMM_WORLD, **kwargs) -> cu.Scene:
